@@ -1,0 +1,19 @@
+"""Element kernels. Each maps node coordinates ``xyz`` (n_cells, nodes_per_cell, 3) and one property
+to stiffness and mass matrices (n_cells, 6 * nodes_per_cell, 6 * nodes_per_cell) in global axes,
+vectorised over cells.
+"""
+
+from . import discrete
+
+KERNELS = {
+    "spring": discrete.spring_matrices,
+    "mass": discrete.mass_matrices,
+}
+
+
+def kernel(etype: str):
+    """The matrices function for an element type."""
+    try:
+        return KERNELS[etype]
+    except KeyError:
+        raise KeyError(f"no element kernel registered for '{etype}'") from None

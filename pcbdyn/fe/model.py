@@ -1,0 +1,122 @@
+"""The FE model: nodes, element sets (each with one property), fixed DOFs and multi-point constraints."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from .mesh import NDOF, dof_index
+
+#: nodes per cell for each element type
+NODES_PER_CELL = {"quad4": 4, "tri3": 3, "beam2": 2, "edge_spring": 2, "mass": 1}
+
+
+class ModelError(ValueError):
+    """A model that cannot be assembled or solved, with what to change."""
+
+
+@dataclass
+class ElementSet:
+    """Cells of one element type sharing one property.
+
+    ``etype`` is one of quad4, tri3, beam2, spring (1 node: to ground, 2 nodes: node to node),
+    edge_spring, mass. ``conn`` holds node indices, shape (n_cells, nodes_per_cell).
+    """
+
+    name: str
+    etype: str
+    conn: np.ndarray
+    prop: object
+
+    def __post_init__(self):
+        self.conn = np.atleast_2d(np.asarray(self.conn, dtype=np.int64))
+        if self.etype == "spring":
+            if self.conn.shape[1] not in (1, 2):
+                raise ModelError(f"element set '{self.name}': a spring cell has 1 or 2 nodes")
+        elif self.etype in NODES_PER_CELL:
+            if self.conn.shape[1] != NODES_PER_CELL[self.etype]:
+                raise ModelError(
+                    f"element set '{self.name}': {self.etype} cells need {NODES_PER_CELL[self.etype]} "
+                    f"nodes, got {self.conn.shape[1]}"
+                )
+        else:
+            raise ModelError(
+                f"element set '{self.name}': unknown element type '{self.etype}' "
+                f"(use one of {', '.join(sorted(NODES_PER_CELL) + ['spring'])})"
+            )
+
+
+@dataclass
+class Model:
+    """Nodes (n, 3) [m], element sets, named node groups, constraints.
+
+    ``fixed``: global DOF numbers held at zero. ``mpcs``: linear constraints, each a pair
+    ``(slave_dof, [(master_dof, coefficient), ...])`` meaning u_slave = sum(c * u_master);
+    they are applied by elimination. ``free``: the model is meant to float (rigid-body modes
+    are expected and reported, not an error).
+    """
+
+    nodes: np.ndarray
+    sets: dict = field(default_factory=dict)
+    node_groups: dict = field(default_factory=dict)
+    fixed: set = field(default_factory=set)
+    mpcs: list = field(default_factory=list)
+    free: bool = False
+
+    def __post_init__(self):
+        self.nodes = np.asarray(self.nodes, dtype=float).reshape(-1, 3)
+
+    @property
+    def n_nodes(self) -> int:
+        return self.nodes.shape[0]
+
+    @property
+    def n_dof(self) -> int:
+        return NDOF * self.n_nodes
+
+    def add(self, name: str, etype: str, conn, prop) -> ElementSet:
+        """Add an element set; names are unique (a parameter addresses a set by name)."""
+        if name in self.sets:
+            raise ModelError(f"element set '{name}' already exists")
+        es = ElementSet(name, etype, conn, prop)
+        if es.conn.size and (es.conn.min() < 0 or es.conn.max() >= self.n_nodes):
+            raise ModelError(f"element set '{name}' refers to a node outside 0..{self.n_nodes - 1}")
+        self.sets[name] = es
+        return es
+
+    def add_nodes(self, xyz) -> np.ndarray:
+        """Append nodes and return their indices."""
+        xyz = np.asarray(xyz, dtype=float).reshape(-1, 3)
+        first = self.n_nodes
+        self.nodes = np.vstack([self.nodes, xyz])
+        return np.arange(first, first + xyz.shape[0])
+
+    def fix(self, nodes, dofs=None) -> None:
+        """Hold DOFs of nodes at zero (names from ux..rz or 0-5; default all six)."""
+        self.fixed.update(int(d) for d in np.ravel(dof_index(nodes, dofs)))
+
+    def rigid_link(self, master: int, slaves) -> None:
+        """Tie ``slaves`` to ``master`` as a rigid body: u_s = u_m + theta_m x (x_s - x_m), theta_s = theta_m."""
+        xm = self.nodes[master]
+        for s in np.atleast_1d(slaves):
+            d = self.nodes[int(s)] - xm
+            m = dof_index(master)
+            sd = dof_index(int(s))
+            # translations: u_s = u_m + theta x d
+            self.mpcs.append((int(sd[0]), [(int(m[0]), 1.0), (int(m[4]), d[2]), (int(m[5]), -d[1])]))
+            self.mpcs.append((int(sd[1]), [(int(m[1]), 1.0), (int(m[5]), d[0]), (int(m[3]), -d[2])]))
+            self.mpcs.append((int(sd[2]), [(int(m[2]), 1.0), (int(m[3]), d[1]), (int(m[4]), -d[0])]))
+            for j in range(3, 6):
+                self.mpcs.append((int(sd[j]), [(int(m[j]), 1.0)]))
+
+    def couple(self, dof_a: int, dof_b: int) -> None:
+        """Make global DOF ``dof_b`` equal to ``dof_a``."""
+        self.mpcs.append((int(dof_b), [(int(dof_a), 1.0)]))
+
+    def with_property(self, name: str, **changes) -> "Model":
+        """A shallow copy whose set ``name`` has its property fields changed (for re-analysis)."""
+        new = replace(self, sets=dict(self.sets))
+        es = self.sets[name]
+        new.sets[name] = ElementSet(es.name, es.etype, es.conn, replace(es.prop, **changes))
+        return new

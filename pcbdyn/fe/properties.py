@@ -1,0 +1,112 @@
+"""Section properties, one per element set, so that one updating parameter can change one set.
+
+Every property is a frozen dataclass; :func:`dataclasses.replace` makes a perturbed copy
+(which is how parameter sensitivities re-evaluate the few element matrices they touch).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class ShellProperty:
+    """Homogeneous isotropic shell: Young's modulus E [Pa], Poisson ratio nu, density rho [kg/m^3],
+    thickness t [m].
+
+    The element kernels only use the stress resultant matrices below, so an equivalent
+    laminate (classical lamination theory) is another class with the same five methods.
+    ``nsm`` is a non-structural mass per unit area [kg/m^2] (smeared parts, coatings).
+    """
+
+    E: float
+    nu: float
+    rho: float
+    t: float
+    nsm: float = 0.0
+    shear_factor: float = 5.0 / 6.0
+
+    def membrane(self) -> np.ndarray:
+        """In-plane stiffness A (3x3), N = A eps, [N/m]."""
+        c = self.E * self.t / (1.0 - self.nu**2)
+        return c * np.array([[1.0, self.nu, 0.0], [self.nu, 1.0, 0.0], [0.0, 0.0, 0.5 * (1.0 - self.nu)]])
+
+    def bending(self) -> np.ndarray:
+        """Bending stiffness D (3x3), M = D kappa, [N m]."""
+        return self.membrane() * (self.t**2 / 12.0)
+
+    def shear(self) -> np.ndarray:
+        """Transverse shear stiffness (2x2), Q = S gamma, [N/m]."""
+        G = self.E / (2.0 * (1.0 + self.nu))
+        return self.shear_factor * G * self.t * np.eye(2)
+
+    def mass_per_area(self) -> float:
+        """Translational mass per unit area [kg/m^2]."""
+        return self.rho * self.t + self.nsm
+
+    def rotary_inertia_per_area(self) -> float:
+        """Rotary inertia per unit area about the mid-surface [kg]."""
+        return self.rho * self.t**3 / 12.0
+
+
+@dataclass(frozen=True)
+class BeamProperty:
+    """3-D beam section. ``orientation`` is a vector in the local x-y plane (not along the axis);
+    local y follows it, local z = x cross y. ``Iy``/``Iz`` are second moments about local y/z.
+    ``offset`` [m] is the vector from each node to the beam's axis (a rib's centroid above a plate).
+    ``shear_area_y``/``shear_area_z`` switch on Timoshenko shear (None: Euler-Bernoulli).
+    """
+
+    E: float
+    nu: float
+    rho: float
+    A: float
+    Iy: float
+    Iz: float
+    J: float
+    orientation: tuple = (0.0, 0.0, 1.0)
+    offset: tuple = (0.0, 0.0, 0.0)
+    shear_area_y: float | None = None
+    shear_area_z: float | None = None
+    rotary_inertia: bool = True
+
+    @property
+    def G(self) -> float:
+        return self.E / (2.0 * (1.0 + self.nu))
+
+
+@dataclass(frozen=True)
+class SpringProperty:
+    """Discrete 6-DOF spring, diagonal in global axes: ``k`` = (kx, ky, kz [N/m], krx, kry, krz [N m/rad]).
+
+    A set of 1-node cells connects each node to ground; 2-node cells connect node pairs.
+    """
+
+    k: tuple = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class EdgeSpringProperty:
+    """Springs distributed along a line of element edges (2-node cells), per unit length.
+
+    ``k`` = (k1, k2, k3 [N/m/m], kr1, kr2, kr3 [N m/rad/m]) in the edge frame: axis 1 along the
+    edge, axis 3 along ``normal`` (the shell normal), axis 2 = 3 x 1. A wedge-lock guide is a
+    rotational stiffness kr1 about the edge with the translations held.
+    """
+
+    k: tuple = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    normal: tuple = (0.0, 0.0, 1.0)
+
+
+@dataclass(frozen=True)
+class MassProperty:
+    """Point mass ``m`` [kg] with rotary inertia ``inertia`` (3,) diagonal or (3,3) [kg m^2], global axes."""
+
+    m: float
+    inertia: tuple = (0.0, 0.0, 0.0)
+
+    def inertia_matrix(self) -> np.ndarray:
+        J = np.asarray(self.inertia, dtype=float)
+        return np.diag(J) if J.ndim == 1 else J
