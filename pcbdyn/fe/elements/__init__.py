@@ -3,17 +3,23 @@ to stiffness and mass matrices (n_cells, 6 * nodes_per_cell, 6 * nodes_per_cell)
 vectorised over cells.
 """
 
-from . import discrete
+from importlib import import_module
 
+#: element type -> (module in this package, function name)
 KERNELS = {
-    "spring": discrete.spring_matrices,
-    "mass": discrete.mass_matrices,
+    "spring": ("discrete", "spring_matrices"),
+    "mass": ("discrete", "mass_matrices"),
+    "quad4": ("shell_quad4", "matrices"),
+    "tri3": ("shell_tri3", "matrices"),
+    "beam2": ("beam", "matrices"),
+    "edge_spring": ("edge_spring", "matrices"),
 }
 
 
 def kernel(etype: str):
     """The matrices function for an element type."""
     try:
-        return KERNELS[etype]
+        module, func = KERNELS[etype]
     except KeyError:
         raise KeyError(f"no element kernel registered for '{etype}'") from None
+    return getattr(import_module(f"{__name__}.{module}"), func)

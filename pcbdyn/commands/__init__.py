@@ -1,0 +1,1 @@
+"""Click commands, one module each (``command`` is the click object); ``pcbdyn.cli`` collects them."""
