@@ -96,23 +96,34 @@ class Model:
         """Hold DOFs of nodes at zero (names from ux..rz or 0-5; default all six)."""
         self.fixed.update(int(d) for d in np.ravel(dof_index(nodes, dofs)))
 
-    def rigid_link(self, master: int, slaves) -> None:
-        """Tie ``slaves`` to ``master`` as a rigid body: u_s = u_m + theta_m x (x_s - x_m), theta_s = theta_m."""
+    def rigid_link(self, master: int, slaves, dofs=range(6)) -> None:
+        """Tie ``slaves`` to ``master`` as a rigid body: u_s = u_m + theta_m x (x_s - x_m), theta_s = theta_m.
+
+        ``dofs`` (0-5) limits the link to some slave DOFs, e.g. (0, 1, 2) for a pinned joint.
+        """
         xm = self.nodes[master]
+        m = dof_index(master)
         for s in np.atleast_1d(slaves):
             d = self.nodes[int(s)] - xm
-            m = dof_index(master)
             sd = dof_index(int(s))
-            # translations: u_s = u_m + theta x d
-            self.mpcs.append((int(sd[0]), [(int(m[0]), 1.0), (int(m[4]), d[2]), (int(m[5]), -d[1])]))
-            self.mpcs.append((int(sd[1]), [(int(m[1]), 1.0), (int(m[5]), d[0]), (int(m[3]), -d[2])]))
-            self.mpcs.append((int(sd[2]), [(int(m[2]), 1.0), (int(m[3]), d[1]), (int(m[4]), -d[0])]))
-            for j in range(3, 6):
-                self.mpcs.append((int(sd[j]), [(int(m[j]), 1.0)]))
+            rows = {
+                0: [(m[0], 1.0), (m[4], d[2]), (m[5], -d[1])],
+                1: [(m[1], 1.0), (m[5], d[0]), (m[3], -d[2])],
+                2: [(m[2], 1.0), (m[3], d[1]), (m[4], -d[0])],
+                3: [(m[3], 1.0)],
+                4: [(m[4], 1.0)],
+                5: [(m[5], 1.0)],
+            }
+            for j in dofs:
+                self.constrain(sd[j], rows[j])
+
+    def constrain(self, slave_dof: int, terms) -> None:
+        """General multi-point constraint u_slave = sum(c * u_master) over ``terms`` = [(master_dof, c), ...]."""
+        self.mpcs.append((int(slave_dof), [(int(m), float(c)) for m, c in terms]))
 
     def couple(self, dof_a: int, dof_b: int) -> None:
         """Make global DOF ``dof_b`` equal to ``dof_a``."""
-        self.mpcs.append((int(dof_b), [(int(dof_a), 1.0)]))
+        self.constrain(dof_b, [(dof_a, 1.0)])
 
     def with_property(self, name: str, **changes) -> "Model":
         """A shallow copy whose set ``name`` has its property fields changed (for re-analysis)."""

@@ -57,6 +57,8 @@ class BeamProperty:
     local y follows it, local z = x cross y. ``Iy``/``Iz`` are second moments about local y/z.
     ``offset`` [m] is the vector from each node to the beam's axis (a rib's centroid above a plate).
     ``shear_area_y``/``shear_area_z`` switch on Timoshenko shear (None: Euler-Bernoulli).
+    ``rotary_inertia`` switches the section's rotary inertia in bending; the twisting inertia
+    rho (Iy + Iz) is always kept so that no DOF is left without mass.
     """
 
     E: float
@@ -79,7 +81,8 @@ class BeamProperty:
 
 @dataclass(frozen=True)
 class SpringProperty:
-    """Discrete 6-DOF spring, diagonal in global axes: ``k`` = (kx, ky, kz [N/m], krx, kry, krz [N m/rad]).
+    """Discrete 6-DOF spring in global axes: ``k`` = (kx, ky, kz [N/m], krx, kry, krz [N m/rad]) on the
+    diagonal, or a symmetric 6x6 matrix.
 
     A set of 1-node cells connects each node to ground; 2-node cells connect node pairs.
     """
