@@ -1,0 +1,208 @@
+"""Measured data as plain arrays in SI units: points, measured DOFs, modes, FRFs.
+
+Every measured quantity belongs to a *DOF*: a point (an id into :class:`Points`) and a unit
+direction in the board frame (a laser vibrometer gives +z at each point). Shapes and FRFs are
+stored per DOF, so a test with several directions at one point is just several rows.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+class TestDataError(ValueError):
+    """Measured data that cannot be read, written or used, with the file, the dataset and the fix."""
+
+    __test__ = False  # not a pytest test class
+
+
+#: UFF direction codes 1..3 (x, y, z) and their negatives
+AXES = {1: (1.0, 0.0, 0.0), 2: (0.0, 1.0, 0.0), 3: (0.0, 0.0, 1.0)}
+_AXIS_NAMES = {"x": 1, "y": 2, "z": 3}
+
+
+@dataclass
+class Points:
+    """Measurement points: integer ids and coordinates (n, 3) [m] in the board frame."""
+
+    ids: np.ndarray
+    xyz: np.ndarray
+
+    def __post_init__(self):
+        self.ids = np.asarray(self.ids, dtype=np.int64).ravel()
+        self.xyz = np.asarray(self.xyz, dtype=float).reshape(-1, 3)
+        if self.ids.size != self.xyz.shape[0]:
+            raise TestDataError(f"points: {self.ids.size} ids but {self.xyz.shape[0]} coordinates")
+        uniq, counts = np.unique(self.ids, return_counts=True)
+        if np.any(counts > 1):
+            raise TestDataError(
+                f"points: ids {uniq[counts > 1].tolist()[:20]} appear more than once; give each point one id"
+            )
+
+    def __len__(self):
+        return self.ids.size
+
+    def index(self, ids) -> np.ndarray:
+        """Row of each id in ``ids``; unknown ids raise :class:`TestDataError`."""
+        ids = np.asarray(ids, dtype=np.int64)
+        order = np.argsort(self.ids)
+        pos = np.clip(np.searchsorted(self.ids[order], ids), 0, max(self.ids.size - 1, 0))
+        rows = order[pos] if self.ids.size else np.zeros(ids.shape, dtype=np.int64)
+        bad = (self.ids[rows] != ids) if self.ids.size else np.ones(ids.shape, dtype=bool)
+        if np.any(bad):
+            raise TestDataError(
+                f"point ids {np.unique(ids[bad]).tolist()[:20]} have no coordinates; add them to the geometry "
+                "(UFF dataset 2411/15 or the points CSV)"
+            )
+        return rows
+
+
+@dataclass
+class Dofs:
+    """Measured DOFs: the point id and the unit direction (board frame) of each measured quantity."""
+
+    point_ids: np.ndarray
+    directions: np.ndarray
+
+    def __post_init__(self):
+        self.point_ids = np.asarray(self.point_ids, dtype=np.int64).ravel()
+        d = np.asarray(self.directions, dtype=float)
+        if d.ndim == 1 and d.size == 3:
+            d = np.tile(d, (self.point_ids.size, 1))
+        d = d.reshape(-1, 3)
+        if d.shape[0] != self.point_ids.size:
+            raise TestDataError(f"dofs: {self.point_ids.size} points but {d.shape[0]} directions")
+        norm = np.linalg.norm(d, axis=1)
+        if np.any(norm == 0):
+            raise TestDataError("dofs: a measured direction is the zero vector; give a direction such as +z")
+        self.directions = d / norm[:, None]
+
+    def __len__(self):
+        return self.point_ids.size
+
+    @classmethod
+    def from_codes(cls, point_ids, codes) -> "Dofs":
+        """DOFs from UFF direction codes (+-1, +-2, +-3 for x, y, z) or names ('+z', 'x', '-y')."""
+        point_ids = np.atleast_1d(point_ids)
+        codes = np.broadcast_to(np.asarray(codes, dtype=object), point_ids.shape)
+        dirs = np.array([_code_vector(c) for c in codes]).reshape(-1, 3)
+        return cls(point_ids, dirs)
+
+    def codes(self) -> np.ndarray:
+        """UFF direction code of each DOF (+-1..3); a direction not along an axis raises."""
+        d = self.directions
+        k = np.argmax(np.abs(d), axis=1)
+        val = d[np.arange(len(d)), k]
+        off = np.abs(np.abs(val) - 1.0) > 1e-12
+        if np.any(off):
+            i = int(np.flatnonzero(off)[0])
+            raise TestDataError(
+                f"DOF at point {self.point_ids[i]} has direction {d[i].tolist()}, not along x, y or z: "
+                "UFF stores axis directions only; write CSV instead"
+            )
+        return (np.sign(val) * (k + 1)).astype(int)
+
+    def take(self, rows) -> "Dofs":
+        return Dofs(self.point_ids[rows], self.directions[rows])
+
+
+def _code_vector(code):
+    if isinstance(code, str):
+        s = code.strip().lower()
+        sign = -1.0 if s.startswith("-") else 1.0
+        s = s.lstrip("+-")
+        if s not in _AXIS_NAMES:
+            raise TestDataError(f"direction '{code}' is not one of x, y, z (optionally signed, e.g. '+z')")
+        code = int(sign) * _AXIS_NAMES[s]
+    code = int(code)
+    if abs(code) not in AXES:
+        raise TestDataError(f"direction code {code} is not a translation (use +-1, +-2, +-3 for x, y, z)")
+    return np.sign(code) * np.array(AXES[abs(code)])
+
+
+@dataclass
+class Modes:
+    """Measured (real, normal) modes: frequencies [Hz], viscous damping ratios, shapes (n_dof, n_modes).
+
+    ``mpc`` is the modal phase collinearity of each mode before it was made real (1 for a mode
+    that was real already); shapes are in whatever scaling the test gave.
+    """
+
+    points: Points
+    dofs: Dofs
+    frequencies: np.ndarray
+    shapes: np.ndarray
+    damping: np.ndarray | None = None
+    mpc: np.ndarray | None = None
+
+    def __post_init__(self):
+        self.frequencies = np.asarray(self.frequencies, dtype=float).ravel()
+        self.shapes = np.asarray(self.shapes, dtype=float).reshape(len(self.dofs), -1)
+        n = self.frequencies.size
+        if self.shapes.shape[1] != n:
+            raise TestDataError(f"modes: {n} frequencies but {self.shapes.shape[1]} shape columns")
+        self.damping = np.zeros(n) if self.damping is None else np.asarray(self.damping, float).ravel()
+        self.mpc = np.ones(n) if self.mpc is None else np.asarray(self.mpc, float).ravel()
+        self.points.index(np.unique(self.dofs.point_ids))
+
+    @property
+    def n_modes(self) -> int:
+        return self.frequencies.size
+
+    def dof_xyz(self) -> np.ndarray:
+        """Coordinates of the point of each DOF, (n_dof, 3)."""
+        return self.points.xyz[self.points.index(self.dofs.point_ids)]
+
+
+#: FRF kinds and the power of (i omega) that turns a receptance into each
+FRF_KINDS = {"receptance": 0, "mobility": 1, "accelerance": 2}
+FRF_UNITS = {"receptance": "m/N", "mobility": "m/s/N", "accelerance": "m/s^2/N"}
+
+
+@dataclass
+class FRFs:
+    """Measured FRFs: frequency axis [Hz], H (n_freq, n_resp, n_ref) in SI, kind, response/reference DOFs."""
+
+    points: Points
+    frequencies: np.ndarray
+    H: np.ndarray
+    kind: str
+    response: Dofs
+    reference: Dofs
+
+    def __post_init__(self):
+        self.frequencies = np.asarray(self.frequencies, dtype=float).ravel()
+        self.H = np.asarray(self.H, dtype=complex)
+        if self.kind not in FRF_KINDS:
+            raise TestDataError(f"FRF kind '{self.kind}' is not one of {', '.join(FRF_KINDS)}")
+        want = (self.frequencies.size, len(self.response), len(self.reference))
+        if self.H.shape != want:
+            raise TestDataError(f"FRFs: H has shape {self.H.shape}, expected (n_freq, n_resp, n_ref) = {want}")
+
+    @property
+    def units(self) -> str:
+        return FRF_UNITS[self.kind]
+
+    def as_kind(self, kind: str) -> "FRFs":
+        """The same FRFs converted to another kind (multiplying by (i omega)^k)."""
+        if kind not in FRF_KINDS:
+            raise TestDataError(f"FRF kind '{kind}' is not one of {', '.join(FRF_KINDS)}")
+        p = FRF_KINDS[kind] - FRF_KINDS[self.kind]
+        w = 2j * np.pi * self.frequencies
+        with np.errstate(divide="ignore", invalid="ignore"):
+            H = self.H * (w**p)[:, None, None]
+        return FRFs(self.points, self.frequencies, H, kind, self.response, self.reference)
+
+
+@dataclass
+class TestData:
+    """What one test file holds: points, and optionally modes, FRFs; datasets that were skipped."""
+
+    points: Points
+    modes: Modes | None = None
+    frfs: FRFs | None = None
+    skipped: list = field(default_factory=list)
+
+    __test__ = False

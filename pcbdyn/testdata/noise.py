@@ -1,0 +1,68 @@
+"""Measurement noise for simulated tests, the thesis' uniform multiplicative models (eq. 5.72-5.74).
+
+Each value is multiplied by (1 + p/100 * eps) with eps uniform in [-1, 1], drawn independently per
+frequency (eq. 5.72), per shape component (eq. 5.73) or per FRF value (eq. 5.74). p is a percentage.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+def _rng(seed):
+    return seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
+
+
+def _perturb(values, pct, seed, name):
+    if pct < 0:
+        raise ValueError(f"{name} noise level must be a non-negative percentage, got {pct}")
+    v = np.asarray(values)
+    eps = _rng(seed).uniform(-1.0, 1.0, size=v.shape)
+    return (1.0 + pct / 100.0 * eps) * v
+
+
+def noisy_frequencies(f, pct: float, seed=None) -> np.ndarray:
+    """f_i (1 + p/100 eps_i) (thesis eq. 5.72)."""
+    return _perturb(f, pct, seed, "frequency")
+
+
+def noisy_shapes(phi, pct: float, seed=None) -> np.ndarray:
+    """phi_ij (1 + p/100 eps_ij) for every DOF i and mode j (thesis eq. 5.73)."""
+    return _perturb(phi, pct, seed, "mode shape")
+
+
+def noisy_frfs(H, pct: float, seed=None) -> np.ndarray:
+    """H_ij(w_k) (1 + p/100 eps_ijk), eps real, for every FRF and frequency line (thesis eq. 5.74)."""
+    return _perturb(H, pct, seed, "FRF")
+
+
+@dataclass(frozen=True)
+class Noise:
+    """Noise levels in percent for frequencies, mode shapes and FRFs (thesis eq. 5.72-5.74)."""
+
+    frequency_pct: float = 0.0
+    shape_pct: float = 0.0
+    frf_pct: float = 0.0
+
+    @classmethod
+    def parse(cls, text: str) -> "Noise":
+        """From "f=0.5,shape=2,frf=1" or one number for all three (as a CLI option gives it)."""
+        text = str(text).strip()
+        try:
+            if "=" not in text:
+                p = float(text)
+                return cls(p, p, p)
+            names = {"f": "frequency_pct", "freq": "frequency_pct", "frequency": "frequency_pct",
+                     "shape": "shape_pct", "phi": "shape_pct", "frf": "frf_pct", "h": "frf_pct"}
+            kw = {}
+            for item in text.split(","):
+                k, v = item.split("=")
+                kw[names[k.strip().lower()]] = float(v)
+            return cls(**kw)
+        except (KeyError, ValueError):
+            raise ValueError(
+                f"noise '{text}' is not understood: give a percentage for all (e.g. 1) or "
+                "'f=0.5,shape=2,frf=1'"
+            ) from None

@@ -1,0 +1,97 @@
+"""Simulated tests from a model: modes and FRFs read at measurement DOFs, with the thesis' noise.
+
+The model is read at the test DOFs through an interpolation matrix (:mod:`pcbdyn.fe.probe`), so
+points need not be nodes. FRFs are modal sums (:func:`pcbdyn.fe.frf.frf_modal`) over the modes given.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from pcbdyn.fe.frf import frf_modal
+from pcbdyn.fe.modal import Modes as ModelModes
+
+from .data import Dofs, FRFs, Modes, Points, TestData
+from .noise import Noise, noisy_frequencies, noisy_frfs, noisy_shapes
+
+
+def simulate_test(
+    modes: ModelModes,
+    points: Points,
+    dofs: Dofs,
+    read,
+    *,
+    reference: Dofs | None = None,
+    read_reference=None,
+    f_axis=None,
+    zeta=0.01,
+    kind: str = "accelerance",
+    noise: Noise = Noise(),
+    seed=None,
+) -> TestData:
+    """A test as it would be measured on the model.
+
+    ``modes``: the model's modes (mass-normalised); ``read`` (n_dof_test, n_model_dof): interpolation
+    rows giving the model's response at each test DOF in ``dofs``. Modes: frequencies and shapes at
+    the DOFs with noise (eq. 5.72, 5.73) and damping ``zeta``. FRFs (when ``reference`` and
+    ``read_reference`` give the excitation DOFs and ``f_axis`` [Hz] the lines): modal sums with
+    viscous damping ``zeta`` as ``kind``, with noise (eq. 5.74). ``seed`` makes the noise repeatable.
+    """
+    rng = np.random.default_rng(seed)
+    at = np.asarray(read @ modes.shapes)
+    n = modes.frequencies.size
+    z = np.broadcast_to(np.asarray(zeta, dtype=float), (n,)).copy()
+    f = noisy_frequencies(modes.frequencies, noise.frequency_pct, rng)
+    shapes = noisy_shapes(at, noise.shape_pct, rng)
+    test_modes = Modes(points, dofs, f, shapes, z)
+    frfs = None
+    if reference is not None:
+        if read_reference is None or f_axis is None:
+            raise ValueError("FRFs need read_reference (interpolation rows of the excitation) and f_axis")
+        ref_at = np.asarray(read_reference @ modes.shapes)
+        rigid = np.vstack([np.asarray(read @ modes.rigid_shapes), np.asarray(read_reference @ modes.rigid_shapes)])
+        sub = ModelModes(modes.frequencies, np.vstack([at, ref_at]), rigid, None)
+        H = frf_modal(sub, f_axis, np.arange(at.shape[0]), at.shape[0] + np.arange(ref_at.shape[0]), zeta=z, kind=kind)
+        frfs = FRFs(points, f_axis, noisy_frfs(H, noise.frf_pct, rng), kind, dofs, reference)
+    return TestData(points, test_modes, frfs)
+
+
+def simulate_on_model(
+    model,
+    modes: ModelModes,
+    points: Points,
+    dofs: Dofs,
+    *,
+    excite=None,
+    excite_direction=(0.0, 0.0, 1.0),
+    excite_id: int | None = None,
+    f_axis=None,
+    zeta=0.01,
+    kind: str = "accelerance",
+    noise: Noise = Noise(),
+    seed=None,
+    tol=None,
+) -> TestData:
+    """:func:`simulate_test` on a shell model, reading it at the points through the shape functions.
+
+    ``excite`` (x, y, z) [m]: the excitation point (FRFs are written when it and ``f_axis`` are
+    given); it joins the points with id ``excite_id`` (default: one above the largest id) unless a
+    point already sits there.
+    """
+    from pcbdyn.fe.probe import model_probe
+
+    read = model_probe(model, points.xyz[points.index(dofs.point_ids)], dofs.directions, tol=tol).P
+    if excite is None:
+        return simulate_test(modes, points, dofs, read, zeta=zeta, kind=kind, noise=noise, seed=seed)
+    e = np.asarray(excite, dtype=float).ravel()
+    e = np.append(e, 0.0) if e.size == 2 else e
+    same = np.flatnonzero(np.linalg.norm(points.xyz - e, axis=1) < 1e-9)
+    if same.size:
+        pid = int(points.ids[same[0]])
+    else:
+        pid = int(points.ids.max() + 1 if excite_id is None and len(points) else (excite_id or 1))
+        points = Points(np.append(points.ids, pid), np.vstack([points.xyz, e]))
+    ref = Dofs([pid], np.asarray(excite_direction, dtype=float))
+    read_ref = model_probe(model, e[None], ref.directions, tol=tol).P
+    return simulate_test(modes, points, dofs, read, reference=ref, read_reference=read_ref, f_axis=f_axis,
+                         zeta=zeta, kind=kind, noise=noise, seed=seed)

@@ -1,0 +1,247 @@
+"""UFF in and out: exact round trips, files written directly with pyuff, variants other tools write,
+and clear errors on files that cannot be read."""
+
+import os
+
+import numpy as np
+import pytest
+import pyuff
+
+from pcbdyn.correlation import mac
+from pcbdyn.testdata import Dofs, FRFs, Modes, Points, TestData, TestDataError, read_uff, real_modes, write_uff
+
+
+def sample(kind="accelerance", f_axis=None):
+    rng = np.random.default_rng(11)
+    pts = Points(np.arange(101, 113), rng.uniform(0, 0.17, (12, 3)) * [1, 1, 0.01])
+    dofs = Dofs.from_codes(np.r_[pts.ids, [104, 105]], ["+z"] * 12 + ["+x", "+y"])
+    modes = Modes(pts, dofs, [211.123456789012, 302.7, 397.81234567], rng.standard_normal((14, 3)),
+                  [0.0123456789, 0.02, 0.005])
+    f = np.linspace(0.0, 1000.0, 801) if f_axis is None else f_axis
+    H = rng.standard_normal((f.size, 4, 2)) + 1j * rng.standard_normal((f.size, 4, 2))
+    frfs = FRFs(pts, f, 1e-3 * H, kind, Dofs.from_codes([101, 102, 103, 104], [3, 3, 3, -3]),
+                Dofs.from_codes([107, 110], [3, -1]))
+    return TestData(pts, modes, frfs)
+
+
+def physical(modes):
+    """Shapes sorted by (point, axis) with the direction sign applied: the same motion however stored."""
+    codes = modes.dofs.codes()
+    order = np.lexsort((np.abs(codes), modes.dofs.point_ids))
+    return modes.shapes[order] * np.sign(codes[order])[:, None]
+
+
+def rel(a, b):
+    return np.abs(np.asarray(a) - np.asarray(b)).max() / np.abs(b).max()
+
+
+@pytest.mark.parametrize("binary", [None, False, True])
+def test_round_trip_of_points_modes_and_frfs_is_exact_to_1e_9(tmp_path, binary):
+    data = sample()
+    path = tmp_path / "test.uff"
+    write_uff(path, data, binary=binary)
+    back = read_uff(path)
+    assert np.array_equal(back.points.ids, data.points.ids)
+    assert rel(back.points.xyz, data.points.xyz) < 1e-9
+    assert rel(back.modes.frequencies, data.modes.frequencies) < 1e-9
+    assert rel(back.modes.damping, data.modes.damping) < 1e-9
+    assert rel(physical(back.modes), physical(data.modes)) < 1e-9
+    assert np.allclose(back.modes.mpc, 1.0)
+    assert back.frfs.kind == "accelerance" and back.frfs.units == "m/s^2/N"
+    assert rel(back.frfs.frequencies, data.frfs.frequencies) < 1e-9
+    assert rel(back.frfs.H, data.frfs.H) < 1e-9
+    assert back.frfs.response.codes().tolist() == [3, 3, 3, -3]
+    assert back.frfs.reference.point_ids.tolist() == [107, 110]
+    assert back.frfs.reference.codes().tolist() == [3, -1]
+    assert back.skipped == []
+
+
+def test_an_uneven_frequency_axis_survives_the_round_trip(tmp_path):
+    f = np.sort(np.random.default_rng(1).uniform(5, 900, 300))
+    data = sample(kind="mobility", f_axis=f)
+    write_uff(tmp_path / "u.uff", data)  # the axis cannot be stored in the ASCII header: 58b is chosen
+    back = read_uff(tmp_path / "u.uff")
+    assert rel(back.frfs.frequencies, f) < 1e-9 and rel(back.frfs.H, data.frfs.H) < 1e-9
+    assert back.frfs.kind == "mobility"
+
+
+def test_single_precision_55_is_standard_and_read_by_pyuff_too(tmp_path):
+    data = sample()
+    path = tmp_path / "single.uff"
+    write_uff(path, data, precision="single")
+    back = read_uff(path)
+    assert rel(back.modes.frequencies, data.modes.frequencies) < 1e-5
+    assert rel(physical(back.modes), physical(data.modes)) < 1e-5
+    sets = pyuff.UFF(str(path)).read_sets()
+    f55 = [d["freq"] for d in sets if d["type"] == 55]
+    assert np.allclose(f55, data.modes.frequencies, rtol=1e-5)
+
+
+def test_a_file_written_directly_with_pyuff_reads_the_same(tmp_path):
+    """mm units (164), geometry in dataset 15, complex modes (55, analysis type 3), receptance in mm/N."""
+    rng = np.random.default_rng(4)
+    ids = np.arange(1, 21)
+    xyz_mm = np.column_stack([rng.uniform(0, 162, 20), rng.uniform(0, 178, 20), np.zeros(20)]).round(3)
+    phi = rng.standard_normal((20, 2))
+    f = np.array([214.1, 302.7])
+    zeta = np.array([0.01, 0.02])
+    lam = -zeta * 2 * np.pi * f + 1j * 2 * np.pi * f * np.sqrt(1 - zeta**2)
+    sets = [
+        {"type": 164, "units_code": 5, "units_description": "mm/N", "temp_mode": 2, "length": 1000.0,
+         "force": 1.0, "temp": 1.0, "temp_offset": 273.15},
+        {"type": 15, "node_nums": ids, "def_cs": np.zeros(20, int), "disp_cs": np.zeros(20, int),
+         "color": np.zeros(20, int), "x": xyz_mm[:, 0], "y": xyz_mm[:, 1], "z": xyz_mm[:, 2]},
+    ]
+    phases = [0.4, -1.1]
+    for j in range(2):
+        psi = phi[:, j] * np.exp(1j * phases[j])  # a normal mode written as a complex one, phase-rotated
+        sets.append(pyuff.prepare_55(model_type=1, analysis_type=3, data_ch=2, spec_data_type=8, data_type=5,
+                                     n_data_per_node=3, node_nums=ids, load_case=1, mode_n=j + 1, eig=lam[j],
+                                     modal_a=0j, modal_b=0j, r1=0 * psi, r2=0 * psi, r3=psi,
+                                     return_full_dict=True))
+    x = np.arange(0.0, 500.0, 0.5)
+    h_mm = rng.standard_normal(x.size) + 1j * rng.standard_normal(x.size)
+    sets.append({"type": 58, "func_type": 4, "rsp_node": 3, "rsp_dir": 3, "ref_node": 7, "ref_dir": 3,
+                 "x": x, "data": h_mm, "abscissa_spacing": 1, "abscissa_spec_data_type": 18,
+                 "ordinate_spec_data_type": 8, "ordinate_len_unit_exp": 1, "orddenom_spec_data_type": 13,
+                 "orddenom_force_unit_exp": 1, "ordinate_axis_units_lab": "mm", "binary": 0})
+    path = tmp_path / "pyuff_written.unv"
+    pyuff.UFF(str(path)).write_sets(sets, mode="overwrite")
+
+    back = read_uff(path)
+    assert np.allclose(back.points.xyz, xyz_mm / 1000.0, rtol=1e-5, atol=1e-9)
+    assert np.allclose(back.modes.frequencies, f, rtol=1e-5)
+    assert np.allclose(back.modes.damping, zeta, rtol=1e-4)
+    assert np.allclose(back.modes.mpc, 1.0, atol=1e-9)
+    assert back.modes.dofs.codes().tolist() == [3] * 20  # zero x/y columns are not measured DOFs
+    assert np.allclose(np.diag(mac(back.modes.shapes, phi)), 1.0, atol=1e-9)
+    scale = back.modes.shapes / phi
+    assert np.allclose(scale, scale[0], rtol=1e-4)  # each mode recovered up to one real factor
+    assert back.frfs.kind == "receptance"
+    assert rel(back.frfs.H[:, 0, 0], h_mm / 1000.0) < 1e-9  # mm/N -> m/N
+    assert np.allclose(back.frfs.frequencies, x)
+
+
+def write_text(path, text):
+    path.write_text(text)
+    return path
+
+
+HEADER55 = """    -1
+    55
+NONE
+NONE
+NONE
+NONE
+NONE
+         1         2         2         8         2         3
+         2         4         1         1
+{rec8}
+"""
+
+
+def test_dataset_55_with_fields_run_together_and_d_exponents_reads(tmp_path):
+    """Some exporters fill 13-character fields completely ("missing spaces", pyuff issue 84) or write
+    Fortran D exponents (pyuff issue 64)."""
+    rec8 = "  1.50000D+02  0.00000D+00  1.00000D-02  0.00000D+00"
+    body = ("         1\n-1.23456E+00-2.50000E-01 3.00000E+00\n"
+            "         2\n 4.00000D-01-5.00000D-01-6.25000D+00\n    -1\n")
+    path = write_text(tmp_path / "tight.unv", HEADER55.format(rec8=rec8) + body)
+    back = read_uff(path, points=Points([1, 2], np.zeros((2, 3))))
+    assert back.modes.frequencies.tolist() == [150.0]
+    assert back.modes.damping.tolist() == [0.01]
+    got = dict(zip(zip(back.modes.dofs.point_ids.tolist(), back.modes.dofs.codes().tolist()), back.modes.shapes[:, 0]))
+    assert got == {(1, 1): -1.23456, (1, 2): -0.25, (1, 3): 3.0, (2, 1): 0.4, (2, 2): -0.5, (2, 3): -6.25}
+
+
+def test_ascii_58_with_other_field_widths_and_padding_reads(tmp_path):
+    """A 58 whose values are not in pyuff's fixed columns (pyuff issue 52) and whose last line is padded
+    beyond num_pts (pyuff issue 22)."""
+    head = """    -1
+    58
+NONE
+NONE
+NONE
+NONE
+NONE
+    4         0    0         0 NONE               5   3 NONE               9   3
+         6         3         1  1.00000e+01  2.00000e+00  0.00000e+00
+        18    0    0    0 Frequency            Hz
+         8    1    0    0 Displacement         m
+        13    0    1    0 Force                N
+         0    0    0    0 NONE                 NONE
+"""
+    vals = [1.5, -2.25, 3.125, 4.0, -5.5, 6.75, 0.0, 0.0]  # 3 complex values, then padding
+    body = "".join(f"  {v:.9E}  " for v in vals[:4]) + "\n" + "".join(f"  {v:.9E}  " for v in vals[4:]) + "\n    -1\n"
+    path = write_text(tmp_path / "wide.unv", head + body)
+    back = read_uff(path, points=Points([5, 9], np.zeros((2, 3))))
+    assert np.allclose(back.frfs.frequencies, [10.0, 12.0, 14.0])
+    assert np.allclose(back.frfs.H[:, 0, 0], [1.5 - 2.25j, 3.125 + 4.0j, -5.5 + 6.75j])
+
+
+def test_malformed_files_fail_with_a_message_naming_the_file_and_dataset(tmp_path):
+    rec8 = "  1.50000E+02  0.00000E+00  1.00000E-02  0.00000E+00"
+    bad55 = write_text(tmp_path / "short.unv", HEADER55.format(rec8=rec8) + "         1\n 1.0E+00 2.0E+00\n    -1\n")
+    with pytest.raises(TestDataError, match=r"short\.unv: dataset #1 \(type 55\).*node 1"):
+        read_uff(bad55, points=Points([1], np.zeros((1, 3))))
+    good = tmp_path / "good.uff"
+    write_uff(good, sample())
+    text = good.read_text().splitlines(True)
+    i = next(k for k, line in enumerate(text) if line.startswith("    58"))
+    text[i + 8] = "   garbage where the frequency line should be\n"
+    broken = tmp_path / "broken58.uff"
+    broken.write_text("".join(text))
+    with pytest.raises(TestDataError, match=r"broken58\.uff: dataset #\d+ \(type 58\)"):
+        read_uff(broken)
+    with pytest.raises(TestDataError, match="no such file"):
+        read_uff(tmp_path / "missing.uff")
+    empty = write_text(tmp_path / "empty.uff", "not a universal file\n")
+    with pytest.raises(TestDataError, match="no UFF datasets"):
+        read_uff(empty)
+    no_geo = tmp_path / "nogeo.uff"
+    write_uff(no_geo, sample())
+    lines = no_geo.read_text()
+    start = lines.index("    -1\n  2411")
+    end = lines.index("    -1\n", start + 8) + 7
+    (tmp_path / "nogeo2.uff").write_text(lines[:start] + lines[end:])
+    with pytest.raises(TestDataError, match=r"nogeo2\.uff: point ids .* have no coordinates"):
+        read_uff(tmp_path / "nogeo2.uff")
+
+
+def test_a_failed_write_leaves_the_old_file_untouched(tmp_path, monkeypatch):
+    path = tmp_path / "keep.uff"
+    path.write_text("previous results\n")
+
+    def boom(self, *args, **kwargs):
+        raise OSError("disk full")
+
+    monkeypatch.setattr(pyuff.UFF, "write_sets", boom)
+    with pytest.raises(OSError):
+        write_uff(path, sample())
+    assert path.read_text() == "previous results\n"
+    assert os.listdir(tmp_path) == ["keep.uff"]
+
+
+def test_complex_modes_become_real_normal_modes_with_their_phase_collinearity():
+    rng = np.random.default_rng(8)
+    phi = rng.standard_normal((30, 2))
+    psi = phi * np.exp(1j * np.array([0.3, 2.0]))
+    real, mpc = real_modes(psi)
+    assert np.allclose(np.abs(np.sum(real * phi, 0)) / np.linalg.norm(phi, axis=0) ** 2, 1.0)
+    assert np.allclose(mpc, 1.0)
+    wave = phi[:, 0] + 1j * phi[:, 1]  # two shapes in quadrature: far from a normal mode
+    _, mpc = real_modes(wave[:, None])
+    assert mpc[0] < 0.5
+
+
+def test_binary_58b_with_a_stray_line_break_before_the_end_tag_reads(tmp_path):
+    """Test.Lab-style 58b files end their binary data with CRLF before '    -1' (pyuff issues 61, 88)."""
+    data = sample()
+    path = tmp_path / "b.uff"
+    write_uff(path, data, binary=True)
+    raw = path.read_bytes()
+    head = raw.index(b"    58b")
+    end = raw.index(b"    -1", head + 100)
+    path.write_bytes(raw[:end] + b"\r\n" + raw[end:])
+    back = read_uff(path)
+    assert rel(back.frfs.H, data.frfs.H) < 1e-12
