@@ -1,0 +1,44 @@
+"""Sensitivity-based model updating and error localisation on plain matrices (thesis ch. 3-6).
+
+Inputs are K, M (dense or scipy sparse), the parameter derivatives (dK/dp_j, dM/dp_j) and measured
+frequencies, shapes or FRFs as arrays; outputs are weighted equation blocks A x = b (x = dp/p),
+their solutions, localised parameter subsets and the iteration history. Parameters bound to
+board quantities live in the board layer above.
+"""
+
+from .equations import (
+    Block,
+    dynamic_stiffness,
+    fbm_equations,
+    frequency_equations,
+    frf_excitation_equations,
+    frf_receptance_equations,
+    qms_equations,
+)
+from .iteration import Configuration, UpdateResult, build_equations, mac_pairing, update
+from .pbc import condition_number, condition_numbers, stack, svd_reduce
+from .sensitivity import (
+    eigenvalue_derivatives,
+    eigenvector_derivative_nelson,
+    eigenvector_derivatives_modal,
+    frequencies_hz,
+    frequency_derivatives,
+    perturbation_derivatives,
+    solve_modes,
+)
+from .solvers import (
+    RankDeficiencyWarning,
+    Solution,
+    bayes_alpha,
+    choose_rank,
+    condition_curve,
+    frequency_residue,
+    line_search,
+    solve_bayes,
+    solve_bounded,
+    solve_ls,
+    solve_tls,
+)
+from .subset import Subset, qr_basic_solution, svd_qr, threshold_selection, tls_qrf
+from .success import add_noise, success_ratio, success_statistics
+from .weighting import std_row_weights, tls_column_weight, unit_row_weights, weight_rows

@@ -1,0 +1,140 @@
+"""Eigen-solution of plain (K, M) systems and its parameter sensitivities (thesis section 3.2).
+
+Parameters enter through their matrix derivatives dK/dp_j and dM/dp_j (dense or scipy sparse,
+same size as K). Modes are mass-normalised: phi^T M phi = 1, phi^T K phi = lambda = omega^2.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+#: systems up to this size are solved with dense LAPACK
+DENSE_MAX = 1500
+
+
+def as_dense(A) -> np.ndarray:
+    """Dense ndarray view of a dense or scipy-sparse matrix."""
+    return A.toarray() if sp.issparse(A) else np.asarray(A)
+
+
+def solve_modes(K, M, n_modes: int | None = None, shift: float = 0.0):
+    """Lowest ``n_modes`` eigenpairs of K phi = lambda M phi as (lambda, Phi), Phi mass-normalised.
+
+    Dense LAPACK for small systems; ARPACK shift-invert about ``-shift`` for large sparse ones
+    (a singular K, i.e. a free model, gets a small automatic shift). Rigid-body modes of a free
+    model are returned too (lambda ~ 0); pair measured modes with elastic ones only.
+    """
+    n = K.shape[0]
+    if K.shape != M.shape or K.shape[0] != K.shape[1]:
+        raise ValueError(f"K {K.shape} and M {M.shape} must be square and of equal size")
+    k = n if n_modes is None else min(int(n_modes), n)
+    if n <= DENSE_MAX or k >= n - 1:
+        lam, phi = sla.eigh(as_dense(K), as_dense(M), subset_by_index=[0, k - 1])
+    else:
+        Ks, Ms = sp.csc_matrix(K), sp.csc_matrix(M)
+        try:
+            lu = spla.splu((Ks + shift * Ms).tocsc(), permc_spec="MMD_AT_PLUS_A")
+        except RuntimeError:  # singular: a free model; shift far below the first elastic mode
+            shift = 1e-6 * abs(Ks.diagonal().mean() / Ms.diagonal().mean())
+            lu = spla.splu((Ks + shift * Ms).tocsc(), permc_spec="MMD_AT_PLUS_A")
+        op = spla.LinearOperator(K.shape, matvec=lu.solve, dtype=float)
+        lam, phi = spla.eigsh(Ks, k=k, M=Ms, sigma=-shift, OPinv=op, which="LM")
+        order = np.argsort(lam)
+        lam, phi = lam[order], phi[:, order]
+        phi = phi / np.sqrt(np.einsum("ij,ij->j", phi, Ms @ phi))
+    return lam, phi
+
+
+def frequencies_hz(lam) -> np.ndarray:
+    """Natural frequencies [Hz] from eigenvalues lambda = omega^2 (negatives clipped to 0)."""
+    return np.sqrt(np.clip(np.asarray(lam, float), 0.0, None)) / (2 * np.pi)
+
+
+def _check_derivatives(dKs, dMs):
+    if len(dKs) != len(dMs):
+        raise ValueError(f"dKs has {len(dKs)} entries but dMs has {len(dMs)}: give one (dK, dM) pair per parameter")
+
+
+def eigenvalue_derivatives(lam, Phi, dKs, dMs) -> np.ndarray:
+    """d lambda_i / d p_j = phi_i^T (dK_j - lambda_i dM_j) phi_i (thesis eq. 3.6 in lambda form).
+
+    Returns shape (n_modes, n_params).
+    """
+    _check_derivatives(dKs, dMs)
+    lam = np.asarray(lam, float)
+    out = np.empty((lam.size, len(dKs)))
+    for j, (dK, dM) in enumerate(zip(dKs, dMs)):
+        kk = np.einsum("ij,ij->j", Phi, dK @ Phi)
+        mm = np.einsum("ij,ij->j", Phi, dM @ Phi)
+        out[:, j] = kk - lam * mm
+    return out
+
+
+def frequency_derivatives(lam, Phi, dKs, dMs) -> np.ndarray:
+    """d f_i / d p_j [Hz per parameter unit] (thesis eq. 3.6): d lambda / (8 pi^2 f)."""
+    f = frequencies_hz(lam)
+    if np.any(f <= 0):
+        raise ValueError("frequency derivatives need elastic modes (f > 0); drop rigid-body modes first")
+    return eigenvalue_derivatives(lam, Phi, dKs, dMs) / (8 * np.pi**2 * f[:, None])
+
+
+def eigenvector_derivative_nelson(K, M, lam_i, phi_i, dK, dM, dlam=None) -> np.ndarray:
+    """Exact derivative of one mass-normalised eigenvector of a distinct eigenvalue (Nelson's method).
+
+    Solves (K - lambda M) v = -(dK - lambda dM - dlambda M) phi with the largest component of phi
+    held at zero, then adds c phi so that the mass normalisation (thesis eq. 3.13) holds:
+    c = -phi^T M v - phi^T dM phi / 2. Uses the full matrices, so no mode truncation error
+    (unlike the modal sum of eqs. 3.8-3.14).
+    """
+    phi = np.asarray(phi_i, float)
+    if dlam is None:
+        dlam = phi @ (dK @ phi) - lam_i * (phi @ (dM @ phi))
+    rhs = -(dK @ phi - lam_i * (dM @ phi) - dlam * (M @ phi))
+    k = int(np.argmax(np.abs(phi)))
+    Z = sp.lil_matrix(sp.csr_matrix(K) - lam_i * sp.csr_matrix(M))
+    Z[k, :] = 0.0
+    Z[:, k] = 0.0
+    Z[k, k] = 1.0
+    rhs[k] = 0.0
+    v = spla.spsolve(Z.tocsc(), rhs)
+    c = -phi @ (M @ v) - 0.5 * phi @ (dM @ phi)
+    return v + c * phi
+
+
+def eigenvector_derivatives_modal(lam, Phi, i: int, dKs, dMs) -> np.ndarray:
+    """d phi_i / d p_j by modal superposition over the available modes (thesis eqs. 3.8-3.14).
+
+    beta_ik = phi_k^T (dK - lambda_i dM) phi_i / (lambda_i - lambda_k) for k != i and
+    beta_ii = -phi_i^T dM phi_i / 2. Truncated to the modes in Phi, so only approximate unless Phi
+    holds all modes; needs distinct eigenvalues. Returns shape (n_dof, n_params).
+    """
+    _check_derivatives(dKs, dMs)
+    lam = np.asarray(lam, float)
+    gap = lam[i] - lam
+    gap[i] = 1.0
+    if np.any(np.abs(gap) < 1e-10 * max(abs(lam[i]), 1.0)):
+        raise ValueError(f"mode {i} has a repeated eigenvalue: eq. 3.12 is invalid for repeated modes")
+    out = np.empty((Phi.shape[0], len(dKs)))
+    for j, (dK, dM) in enumerate(zip(dKs, dMs)):
+        beta = Phi.T @ (dK @ Phi[:, i] - lam[i] * (dM @ Phi[:, i])) / gap
+        beta[i] = -0.5 * Phi[:, i] @ (dM @ Phi[:, i])
+        out[:, j] = Phi @ beta
+    return out
+
+
+def perturbation_derivatives(build, p, j: int, rel_step: float = 1e-6):
+    """(dK/dp_j, dM/dp_j) by central differences of the matrices (the perturbation method of thesis
+    eq. 4.50, made second-order). ``build(p) -> (K, M)`` should assemble only the few elements
+    parameter j touches: the difference of the rest cancels anyway, but costs time. Exact for
+    parameters that enter linearly (E, density, spring rates); for a shell thickness (membrane ~ t,
+    bending ~ t^3) the error is of order rel_step^2."""
+    p = np.asarray(p, float)
+    h = rel_step * (abs(p[j]) if p[j] != 0 else 1.0)
+    up, dn = p.copy(), p.copy()
+    up[j] += h
+    dn[j] -= h
+    (Ku, Mu), (Kd, Md) = build(up), build(dn)
+    return (Ku - Kd) / (2 * h), (Mu - Md) / (2 * h)
