@@ -1,0 +1,188 @@
+"""Quad-dominant shell meshes of a board with gmsh (OpenCASCADE kernel, in-process, quiet).
+
+The board face is fragmented by every region that must own its own elements (part footprints)
+or whose outline element edges must follow (wedge-lock contact strips), and by the points that
+must be nodes (standoffs, point masses, part centres, measurement points). Triangles are
+recombined into quads (frontal-Delaunay triangles + blossom recombination), which gives an
+all-quad mesh for most layouts (gmsh's "frontal-Delaunay for quads", algorithm 8, folded a few
+elements at small standoff pads, so algorithm 6 is used); when some triangles remain, the board is meshed at twice the size and every cell is
+split into quads (gmsh's all-quad subdivision), so the result is always all-quad at ``size``.
+"""
+
+from __future__ import annotations
+
+import threading
+from dataclasses import dataclass, field
+
+import numpy as np
+
+_LOCK = threading.Lock()  # gmsh is one global state per process
+
+
+@dataclass
+class BoardMesh:
+    """Nodes (n, 3) [m]; cells per region label: {label: {"quad4": (n, 4), "tri3": (n, 3)}};
+    ``point_nodes[i]``: the node at the i-th requested point."""
+
+    nodes: np.ndarray
+    cells: dict = field(default_factory=dict)
+    point_nodes: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+
+    def all_cells(self, etype):
+        arrs = [c[etype] for c in self.cells.values() if etype in c and len(c[etype])]
+        n = 4 if etype == "quad4" else 3
+        return np.concatenate(arrs) if arrs else np.zeros((0, n), dtype=np.int64)
+
+    def edges_on_line(self, axis: int, value: float, tol: float = 1e-7) -> np.ndarray:
+        """Unique element edges (2-node cells) lying on the line x=value (axis 0) or y=value (axis 1)."""
+        on = np.abs(self.nodes[:, axis] - value) < tol
+        edges = []
+        for etype in ("quad4", "tri3"):
+            conn = self.all_cells(etype)
+            if not len(conn):
+                continue
+            e = np.stack([conn, np.roll(conn, -1, axis=1)], axis=-1).reshape(-1, 2)
+            edges.append(e[on[e[:, 0]] & on[e[:, 1]]])
+        e = np.sort(np.concatenate(edges), axis=1) if edges else np.zeros((0, 2), dtype=np.int64)
+        return np.unique(e, axis=0)
+
+
+def _polygon(occ, v):
+    pts = [occ.addPoint(float(x), float(y), 0.0) for x, y in v]
+    lines = [occ.addLine(pts[i], pts[(i + 1) % len(pts)]) for i in range(len(pts))]
+    return occ.addPlaneSurface([occ.addCurveLoop(lines)])
+
+
+def mesh_board(outline, regions, points, size: float, strips=()) -> BoardMesh:
+    """Mesh ``outline`` (vertices + holes) with element size ``size`` [m].
+
+    ``regions``: [(label, polygon (m, 2))] whose elements get that label (first one wins where
+    regions overlap); ``strips``: polygons whose outlines element edges follow but whose elements
+    stay on the board; ``points``: (k, 2) points that become nodes. Elements outside every region
+    are labelled "board".
+    """
+    import gmsh
+
+    points = np.asarray(points, dtype=float).reshape(-1, 2)
+    with _LOCK:
+        gmsh.initialize(readConfigFiles=False, interruptible=False)
+        try:
+            gmsh.option.setNumber("General.Terminal", 0)
+            gmsh.option.setNumber("General.Verbosity", 1)
+            gmsh.model.add("board")
+            occ = gmsh.model.occ
+            board = _polygon(occ, outline.vertices)
+            if outline.holes:
+                cut, _ = occ.cut([(2, board)], [(2, _polygon(occ, h)) for h in outline.holes])
+                board_tags = [t for d, t in cut if d == 2]
+            else:
+                board_tags = [board]
+            tools = [(2, _polygon(occ, poly)) for _, poly in regions]
+            tools += [(2, _polygon(occ, poly)) for poly in strips]
+            tools += [(0, occ.addPoint(float(x), float(y), 0.0)) for x, y in points]
+            objects = [(2, t) for t in board_tags]
+            if tools:
+                _, out_map = occ.fragment(objects, tools)
+            else:
+                out_map = [[o] for o in objects]
+            occ.synchronize()
+            nb = len(objects)
+            on_board = {t for m in out_map[:nb] for d, t in m if d == 2}
+            label_of = {}
+            for i, (label, _) in enumerate(regions):
+                for d, t in out_map[nb + i]:
+                    if d == 2 and t in on_board and t not in label_of:
+                        label_of[t] = label
+            extra = [(2, t) for m in out_map[nb:] for d, t in m if d == 2 and t not in on_board]
+            if extra:
+                gmsh.model.removeEntities(extra, recursive=True)
+            point_tags = [out_map[-len(points) + i] for i in range(len(points))] if len(points) else []
+            gmsh.option.setNumber("Mesh.Algorithm", 6)
+            gmsh.option.setNumber("Mesh.RecombineAll", 1)
+            gmsh.option.setNumber("Mesh.RecombinationAlgorithm", 1)
+            gmsh.option.setNumber("Mesh.MeshSizeMin", 0.0)
+            gmsh.option.setNumber("Mesh.MeshSizeMax", size)
+            gmsh.model.mesh.generate(2)
+            if 2 in gmsh.model.mesh.getElementTypes(2):
+                # blossom left triangles: mesh twice as coarse and split every cell into quads
+                gmsh.model.mesh.clear()
+                gmsh.option.setNumber("Mesh.MeshSizeMax", 2.0 * size)
+                gmsh.option.setNumber("Mesh.SubdivisionAlgorithm", 1)
+                gmsh.model.mesh.generate(2)
+            tags, coords, _ = gmsh.model.mesh.getNodes()
+            xyz = coords.reshape(-1, 3)
+            index = np.full(int(tags.max()) + 1, -1, dtype=np.int64)
+            index[tags.astype(np.int64)] = np.arange(tags.size)
+            cells: dict = {}
+            for t in sorted(on_board):
+                label = label_of.get(t, "board")
+                types, _, enodes = gmsh.model.mesh.getElements(2, t)
+                for et, en in zip(types, enodes):
+                    npc = {2: 3, 3: 4}.get(int(et))
+                    if npc is None:
+                        raise RuntimeError(f"gmsh produced element type {et}; only triangles and quads are expected")
+                    conn = index[np.asarray(en, dtype=np.int64).reshape(-1, npc)]
+                    area = _signed_area(xyz, conn)
+                    if area.min() < 0 < area.max():
+                        raise RuntimeError(
+                            f"gmsh folded {int(min((area < 0).sum(), (area > 0).sum()))} elements of surface {t}; "
+                            "change mesh_size slightly"
+                        )
+                    key = "quad4" if npc == 4 else "tri3"
+                    cells.setdefault(label, {}).setdefault(key, []).append(conn)
+            point_nodes = []
+            for pt in point_tags:
+                ntags = gmsh.model.mesh.getNodes(0, pt[0][1])[0] if pt and pt[0][0] == 0 else []
+                point_nodes.append(int(index[int(ntags[0])]) if len(ntags) else -1)
+        finally:
+            gmsh.finalize()
+    used = np.zeros(len(xyz), dtype=bool)
+    for c in cells.values():
+        for k in c:
+            c[k] = np.concatenate(c[k])
+            used[c[k].ravel()] = True
+    # renumber to the nodes that elements use (gmsh keeps construction points)
+    new = np.cumsum(used) - 1
+    for c in cells.values():
+        for k in c:
+            conn = new[c[k]]
+            c[k] = _counter_clockwise(xyz[used], conn)
+    pn = np.array([new[p] if p >= 0 and used[p] else -1 for p in point_nodes], dtype=np.int64)
+    nodes = xyz[used].copy()
+    nodes[:, 2] = 0.0
+    missing = np.flatnonzero(pn < 0)
+    for i in missing:  # a point gmsh merged into an existing vertex: take the coincident node
+        d = np.linalg.norm(nodes[:, :2] - points[i], axis=1)
+        j = int(np.argmin(d))
+        if d[j] > 1e-7:
+            raise RuntimeError(f"point {points[i]} did not become a mesh node")
+        pn[i] = j
+    return BoardMesh(nodes, cells, pn)
+
+
+def _signed_area(xyz, conn):
+    p = xyz[conn][:, :, :2]
+    q = np.roll(p, -1, axis=1)
+    return 0.5 * np.sum(p[:, :, 0] * q[:, :, 1] - q[:, :, 0] * p[:, :, 1], axis=1)
+
+
+def _counter_clockwise(xyz, conn):
+    """Cells ordered so their normal is +z."""
+    conn = conn.copy()
+    flip = _signed_area(xyz, conn) < 0
+    conn[flip] = conn[flip][:, ::-1]
+    return conn
+
+
+def quality(mesh: BoardMesh) -> dict:
+    """Counts of quads and triangles and the smallest quad corner angle [deg] (a cheap shape check)."""
+    q = mesh.all_cells("quad4")
+    t = mesh.all_cells("tri3")
+    out = {"quads": len(q), "triangles": len(t), "min_quad_angle_deg": None}
+    if len(q):
+        p = mesh.nodes[q][:, :, :2]
+        a = np.roll(p, 1, axis=1) - p
+        b = np.roll(p, -1, axis=1) - p
+        cosang = np.sum(a * b, axis=2) / (np.linalg.norm(a, axis=2) * np.linalg.norm(b, axis=2))
+        out["min_quad_angle_deg"] = float(np.degrees(np.arccos(np.clip(cosang, -1, 1))).min())
+    return out

@@ -1,0 +1,100 @@
+"""``pcbdyn build board.toml``: a board's resonances, mode shapes and effective masses."""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+import click
+
+
+def _step(msg: str):
+    click.echo(f"  {msg} ...", err=True)
+    return time.perf_counter()
+
+
+def _done(t0: float):
+    click.echo(f"    done in {time.perf_counter() - t0:.1f} s", err=True)
+
+
+def analyse(board, config, out: Path | None, pictures: bool = True) -> dict:
+    """Build and solve one configuration; print its table; write CSV/VTU/PNG under ``out``."""
+    from ..board import build_model
+    from ..fe.assembly import assemble
+    from ..fe.modal import solve_modes
+    from ..report.files import write_text
+    from ..report.modes import format_table, mode_table
+
+    label = config or "base"
+    t0 = _step(f"[{label}] meshing and building the model")
+    bm = build_model(board, config)
+    _done(t0)
+    t0 = _step(f"[{label}] solving {bm.model.n_dof} DOFs for {board.analysis.modes} modes")
+    K, M = assemble(bm.model)
+    modes = solve_modes(bm.model, n_modes=board.analysis.modes, f_max=board.analysis.f_max, K=K, M=M)
+    _done(t0)
+    r = __import__("numpy").zeros(M.shape[0])
+    r[2::6] = 1.0
+    mass = float(r @ (M @ r))
+    table = mode_table(bm, modes, M)
+    click.echo(f"\n{board.name} [{label}]: {mass * 1e3:.2f} g, {bm.model.n_dof} DOFs, "
+               f"{sum(len(es.conn) for es in bm.model.sets.values() if es.etype in ('quad4', 'tri3'))} shells"
+               + (f", {modes.n_rigid} rigid-body modes" if modes.n_rigid else ""))
+    click.echo(format_table(table) + "\n")
+    renderer = None
+    if out is not None:
+        stem = f"modes_{label}"
+        write_text(out / f"{stem}.csv", table.to_csv(index=False))
+        from ..report.vtu import write_modes_vtu
+
+        vtu = out / f"{stem}.vtu"
+        write_modes_vtu(vtu, bm.model, modes.frequencies, modes.shapes)
+        if pictures:
+            from ..report.pictures import mode_pictures
+
+            t0 = _step(f"[{label}] rendering {modes.frequencies.size} mode-shape pictures")
+            renderer = mode_pictures(vtu, bm.model, modes.frequencies, modes.shapes, out / "png", prefix=stem)
+            _done(t0)
+            if renderer != "pyvista":
+                click.echo("  note: 3-D rendering failed; the pictures are 2-D contour plots (matplotlib)", err=True)
+    return {
+        "configuration": label,
+        "modes": [{"n": int(row.mode), "frequency_hz": float(row.frequency_hz), "eff_mass_z": float(row.eff_mass_z),
+                   "shape": row.shape} for row in table.itertuples()],
+        "mass_kg": mass,
+        "dofs": int(bm.model.n_dof),
+        "rigid_body_modes": int(modes.n_rigid),
+    }
+
+
+@click.command("build")
+@click.argument("board_toml", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.option("--config", "config", default=None, help="configuration name from [[configurations]]")
+@click.option("--all-configs", is_flag=True, help="the base model and every configuration")
+@click.option("--out", "out", type=click.Path(file_okay=False, path_type=Path), default=None,
+              help="folder for modes CSV, VTU (ParaView) and PNG mode shapes")
+@click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="write frequencies, mass and DOF count as JSON")
+@click.option("--no-pictures", is_flag=True, help="skip the PNG mode-shape pictures")
+def command(board_toml, config, all_configs, out, json_path, no_pictures):
+    """Predict a board's resonances: frequencies, effective masses in z, mode shapes."""
+    from ..board import BoardError, load_board
+    from ..fe import ModelError
+    from ..report.files import write_json
+
+    try:
+        board = load_board(board_toml)
+        if config is not None and all_configs:
+            raise click.UsageError("give --config NAME or --all-configs, not both")
+        configs = [None] + [c.name for c in board.configurations] if all_configs else [config]
+        results = [analyse(board, c, out, pictures=not no_pictures) for c in configs]
+    except (BoardError, ModelError) as exc:
+        click.echo(f"error: {exc}", err=True)
+        sys.exit(2)
+    if json_path is not None:
+        data = dict(results[0]) if len(results) == 1 else {**results[0], "configurations": results}
+        data["board"] = board.name
+        write_json(json_path, data)
+    if out is not None:
+        click.echo(f"results written to {out}/", err=True)

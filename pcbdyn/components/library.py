@@ -1,0 +1,101 @@
+"""The component library: one TOML file per part family in ``library/`` (size, mass, default model,
+equivalent thickness and where those numbers come from).
+
+A board looks for a family first in a ``library/`` folder next to its board.toml, then in the
+project's top-level ``library/`` (or the folders named in the PCBDYN_LIBRARY path variable).
+"""
+
+from __future__ import annotations
+
+import os
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..units import UnitError, to_si
+
+MODELS = ("lumped", "spread", "smeared_local", "equivalent_thickness")
+
+
+class LibraryError(ValueError):
+    """A library file that cannot be read, with the file, the field and the fix."""
+
+
+@dataclass(frozen=True)
+class Package:
+    """One part family: footprint ``size`` (x, y) [m], body ``height`` [m], ``mass`` [kg],
+    ``default_model`` (one of :data:`MODELS`), ``equivalent_thickness`` [m] of the board region under
+    the part (thesis section 7.2.3), and free-text ``provenance``."""
+
+    name: str
+    size: tuple
+    height: float
+    mass: float
+    default_model: str
+    equivalent_thickness: float
+    provenance: str
+    path: Path
+
+
+def search_path(board_dir: Path | None = None) -> list[Path]:
+    """Folders searched for ``<package>.toml``, first match wins."""
+    dirs = []
+    if board_dir is not None:
+        dirs.append(Path(board_dir) / "library")
+    env = os.environ.get("PCBDYN_LIBRARY")
+    if env:
+        dirs.extend(Path(p) for p in env.split(os.pathsep) if p)
+    dirs.append(Path(__file__).resolve().parents[2] / "library")
+    return dirs
+
+
+def available(board_dir: Path | None = None) -> list[str]:
+    names = set()
+    for d in search_path(board_dir):
+        if d.is_dir():
+            names.update(p.stem for p in d.glob("*.toml"))
+    return sorted(names)
+
+
+def read_package(path: Path) -> Package:
+    """Read one library file (table ``[package]``)."""
+    path = Path(path)
+    try:
+        data = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise LibraryError(f"{path}: not valid TOML ({exc})") from None
+    p = data.get("package")
+    if not isinstance(p, dict):
+        raise LibraryError(f"{path}: needs a [package] table with size, height, mass, default_model, equivalent_thickness")
+    where = f"{path.name}: package"
+    try:
+        for key in ("size", "height", "mass", "default_model", "equivalent_thickness"):
+            if key not in p:
+                raise LibraryError(f"{path}: package.{key} is missing; add it")
+        size = p["size"]
+        if not (isinstance(size, list) and len(size) == 2):
+            raise LibraryError(f"{path}: package.size must be two lengths, e.g. [\"40 mm\", \"40 mm\"]")
+        model = p["default_model"]
+        if model not in MODELS:
+            raise LibraryError(f"{path}: package.default_model '{model}' is not one of {', '.join(MODELS)}")
+        return Package(
+            name=str(p.get("name", path.stem)),
+            size=tuple(to_si(s, "mm", f"{where}.size") for s in size),
+            height=to_si(p["height"], "mm", f"{where}.height"),
+            mass=to_si(p["mass"], "g", f"{where}.mass"),
+            default_model=model,
+            equivalent_thickness=to_si(p["equivalent_thickness"], "mm", f"{where}.equivalent_thickness"),
+            provenance=str(p.get("provenance", "")),
+            path=path,
+        )
+    except UnitError as exc:
+        raise LibraryError(str(exc)) from None
+
+
+def find_package(name: str, board_dir: Path | None = None) -> Package | None:
+    """The family ``name`` from the first library folder that has it, or None."""
+    for d in search_path(board_dir):
+        f = d / f"{name}.toml"
+        if f.is_file():
+            return read_package(f)
+    return None

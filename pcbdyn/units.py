@@ -1,0 +1,55 @@
+"""Quantities with units from input files ("2.8 mm", "26 GPa", "1e4 N*m/rad/m") to SI floats.
+
+pint does the parsing; each field states the unit it expects so that a length given where a
+stiffness is wanted is caught with a message that names the file, the field and the fix.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+
+class UnitError(ValueError):
+    """A quantity that is missing its unit, cannot be parsed, or has the wrong dimension."""
+
+
+@lru_cache(maxsize=1)
+def registry():
+    import pint
+
+    return pint.UnitRegistry()
+
+
+@lru_cache(maxsize=64)
+def _dimensionality(unit: str):
+    return registry().Quantity(1.0, unit).dimensionality
+
+
+def to_si(value, unit: str, where: str = "value") -> float:
+    """``value`` (a string such as "2.8 mm") in SI base units, checked against ``unit``.
+
+    ``unit`` is the expected unit written as pint understands it (e.g. "mm", "N*m/rad/m"); any
+    unit of the same dimension is accepted. ``where`` names the field in the messages
+    (e.g. "board.toml: board.thickness"). A bare number is accepted only for dimensionless fields.
+    """
+    ureg = registry()
+    dim = _dimensionality(unit)
+    if isinstance(value, bool) or not isinstance(value, (str, int, float)):
+        raise UnitError(f"{where}: expected a quantity such as \"1 {unit}\", got {value!r}")
+    if isinstance(value, (int, float)):
+        if dim:
+            raise UnitError(f"{where}: {value!r} has no unit; write it with one, e.g. \"{value} {unit}\"")
+        return float(value)
+    try:
+        q = ureg.Quantity(value.strip())
+    except Exception as exc:  # pint raises several unrelated types for bad text
+        raise UnitError(f"{where}: cannot read {value!r} as a quantity ({exc}); write e.g. \"1 {unit}\"") from None
+    if not isinstance(q, ureg.Quantity):
+        q = ureg.Quantity(q)
+    if q.dimensionality != dim:
+        got = f"{q.units:~}" or "no unit"
+        raise UnitError(
+            f"{where}: {value!r} has unit '{got}' ({q.dimensionality}), expected a unit like '{unit}' "
+            f"({dim or 'dimensionless'})"
+        )
+    return float(q.to_base_units().magnitude)

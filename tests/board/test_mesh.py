@@ -1,0 +1,90 @@
+"""Board meshes: all quads, element edges on footprints and strips, nodes at requested points."""
+
+import numpy as np
+import pytest
+from board_helpers import DATA, EXAMPLES
+
+from pcbdyn.board import build_model, load_board
+from pcbdyn.board.mesh import quality
+
+
+def _area(nodes, conn):
+    p = nodes[conn][:, :, :2]
+    q = np.roll(p, -1, axis=1)
+    return 0.5 * np.sum(p[:, :, 0] * q[:, :, 1] - q[:, :, 0] * p[:, :, 1], axis=1)
+
+
+@pytest.fixture(scope="module")
+def bm():
+    return build_model(load_board(DATA / "all_models.toml"), "heavy")
+
+
+def test_all_quads_oriented_up_and_covering_the_board_once(bm):
+    q = quality(bm.mesh)
+    assert q["triangles"] == 0 and q["quads"] > 100
+    assert q["min_quad_angle_deg"] > 20
+    areas = np.concatenate([_area(bm.model.nodes, es.conn) for es in bm.model.sets.values() if es.etype == "quad4"])
+    assert areas.min() > 0
+    assert areas.sum() == pytest.approx(bm.board.outline.area(), rel=1e-12)
+
+
+def test_each_part_owns_exactly_its_footprint(bm):
+    for c in bm.board.components:
+        conn = bm.model.sets[f"components.{c.ref}"].conn
+        assert _area(bm.model.nodes, conn).sum() == pytest.approx(c.area, rel=1e-12)  # rotated U4 too
+
+
+def test_requested_points_are_nodes(bm):
+    """Point masses, configuration masses and measurement points sit on shell nodes."""
+    board = bm.board
+    wanted = {"masses.tx": board.point_mass("tx").at, "configurations.heavy.m1": board.configuration("heavy").masses[0].at,
+              "points.1": board.points[0], "points.2": board.points[1]}
+    shells = np.concatenate([es.conn.ravel() for es in bm.model.sets.values() if es.etype == "quad4"])
+    for name, at in wanted.items():
+        node = bm.point_nodes[name]
+        np.testing.assert_allclose(bm.model.nodes[node, :2], at, atol=1e-12)
+        assert node in shells
+
+
+def test_element_edges_follow_the_wedge_lock_strip(bm):
+    """The 5 mm strip of the left guide: a line of element edges at x = 5 mm spans the board height."""
+    edges = bm.mesh.edges_on_line(0, 0.005)
+    length = np.linalg.norm(np.diff(bm.model.nodes[edges][:, :, 1], axis=1), axis=1).sum()
+    assert length == pytest.approx(0.090, rel=1e-12)
+    sprung = bm.model.sets["fixtures.left"].conn
+    assert np.allclose(bm.model.nodes[sprung][:, :, 0], 0.005)
+
+
+def test_polygon_outline_with_hole(tmp_path):
+    text = '''
+[board]
+outline = { polygon = [["0 mm", "0 mm"], ["80 mm", "0 mm"], ["80 mm", "50 mm"], ["40 mm", "70 mm"], ["0 mm", "50 mm"]], holes = [{ at = ["60 mm", "25 mm"], diameter = "10 mm" }] }
+thickness = "1.6 mm"
+material = { E = "22 GPa", nu = 0.15, rho = "1850 kg/m^3" }
+mesh_size = "5 mm"
+[[fixtures]]
+type = "clamped_edge"
+edge = "y=0"
+'''
+    p = tmp_path / "board.toml"
+    p.write_text(text)
+    board = load_board(p)
+    bm = build_model(board)
+    area = sum(_area(bm.model.nodes, es.conn).sum() for es in bm.model.sets.values() if es.etype == "quad4")
+    assert area == pytest.approx(board.outline.area(), rel=2e-3)  # the hole is a 16-gon in both
+    assert not board.outline.contains([[0.06, 0.025]])[0]
+    held = bm.model.nodes[np.array(sorted(bm.model.fixed)) // 6]
+    assert np.allclose(held[:, 1], 0.0)
+
+
+@pytest.mark.parametrize("path", [pytest.param(EXAMPLES / "six_part_card" / "board.toml", marks=pytest.mark.slow),
+                                  EXAMPLES / "wedge_locked" / "board.toml",
+                                  EXAMPLES / "plain_plate" / "board.toml", DATA / "simulated_pcb.toml"],
+                         ids=["six_part_card", "wedge_locked", "plain_plate", "simulated_pcb"])
+def test_halving_the_mesh_size_changes_the_first_six_frequencies_by_under_1_percent(path):
+    from pcbdyn.fe.modal import solve_modes
+
+    board = load_board(path)
+    f1 = solve_modes(build_model(board).model, n_modes=6).frequencies
+    f2 = solve_modes(build_model(board, mesh_size=board.mesh_size / 2).model, n_modes=6).frequencies
+    assert np.max(np.abs(f2 / f1 - 1)) < 0.01, np.round(100 * (f2 / f1 - 1), 2)

@@ -1,0 +1,36 @@
+import pytest
+
+from pcbdyn.units import UnitError, to_si
+
+
+@pytest.mark.parametrize(
+    "text, unit, si",
+    [
+        ("2.8 mm", "mm", 2.8e-3),
+        ("26 GPa", "Pa", 26e9),
+        ("1e4 N*m/rad/m", "N*m/rad/m", 1e4),
+        ("13 g", "kg", 0.013),
+        ("2640 kg/m^3", "kg/m^3", 2640.0),
+        ("6.309e-6 kg*m^2", "kg*m^2", 6.309e-6),
+        ("90 deg", "rad", 1.5707963267948966),
+        ("0.43 N*m/rad/mm", "N*m/rad/m", 430.0),
+    ],
+)
+def test_quantities_convert_to_si(text, unit, si):
+    assert to_si(text, unit) == pytest.approx(si, rel=1e-12)
+
+
+def test_wrong_dimension_names_field_and_units():
+    with pytest.raises(UnitError, match=r"board.toml: board.thickness: '2.8 GPa'.*expected a unit like 'mm'"):
+        to_si("2.8 GPa", "mm", "board.toml: board.thickness")
+
+
+def test_bare_number_needs_a_unit_unless_dimensionless():
+    with pytest.raises(UnitError, match="has no unit"):
+        to_si(2.8, "mm", "x")
+    assert to_si(0.3, "dimensionless") == 0.3
+
+
+def test_unreadable_quantity():
+    with pytest.raises(UnitError, match="cannot read 'two mm'"):
+        to_si("two mm", "mm", "x")
