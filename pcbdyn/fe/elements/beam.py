@@ -18,6 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..model import ModelError
+from .line_frame import line_axes
 
 _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(4)
 _XI = 0.5 * (_GAUSS_X + 1.0)  # points on [0, 1]
@@ -45,25 +46,11 @@ def _check(prop) -> None:
 def local_frame(xyz: np.ndarray, orientation) -> tuple[np.ndarray, np.ndarray]:
     """Lengths (n,) and rotation matrices (n, 3, 3) whose rows are the local axes x, y, z in global
     coordinates: x from node 1 to node 2, y in the plane of x and ``orientation``, z = x cross y."""
-    d = xyz[:, 1] - xyz[:, 0]
-    L = np.linalg.norm(d, axis=1)
-    if np.any(L <= 0):
-        bad = np.flatnonzero(L <= 0)[:5]
-        raise ModelError(f"beam cells {bad.tolist()} have coincident nodes (zero length)")
-    ex = d / L[:, None]
-    v = np.asarray(orientation, dtype=float)
-    nv = np.linalg.norm(v)
-    ey = v[None, :] - (ex @ v)[:, None] * ex
-    ny = np.linalg.norm(ey, axis=1)
-    if nv == 0 or np.any(ny < 1e-6 * nv):
-        bad = np.flatnonzero(ny < 1e-6 * max(nv, 1e-300))[:5]
-        raise ModelError(
-            f"BeamProperty.orientation {tuple(v)} is parallel to the axis of beam cells {bad.tolist()}: "
-            "give a vector in the plane of the local x-y axes, not along the beam"
-        )
-    ey /= ny[:, None]
-    ez = np.cross(ex, ey)
-    return L, np.stack([ex, ey, ez], axis=1)
+    L, ex, ey = line_axes(
+        xyz, orientation, "beam",
+        "BeamProperty.orientation must be a vector in the plane of the local x-y axes, not along the beam",
+    )
+    return L, np.stack([ex, ey, np.cross(ex, ey)], axis=1)
 
 
 def _bending(L: np.ndarray, EI: float, phi: np.ndarray, rhoA: float, rhoI: float):

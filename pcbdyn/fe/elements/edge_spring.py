@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..model import ModelError
+from .line_frame import line_axes
 
 _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(2)
 _XI = 0.5 * (_GAUSS_X + 1.0)
@@ -23,27 +24,12 @@ _WXI = 0.5 * _GAUSS_W
 
 def edge_frame(xyz: np.ndarray, normal) -> tuple[np.ndarray, np.ndarray]:
     """Lengths (n,) and rotations (n, 3, 3) whose rows are the edge axes 1, 2, 3 in global coordinates."""
-    d = xyz[:, 1] - xyz[:, 0]
-    L = np.linalg.norm(d, axis=1)
-    if np.any(L <= 0):
-        bad = np.flatnonzero(L <= 0)[:5]
-        raise ModelError(f"edge spring cells {bad.tolist()} have coincident nodes (zero length)")
-    e1 = d / L[:, None]
-    v = np.asarray(normal, dtype=float)
-    if v.shape != (3,):
+    if np.shape(normal) != (3,):
         raise ModelError("EdgeSpringProperty.normal must be a 3-vector in global axes")
-    nv = np.linalg.norm(v)
-    e3 = v[None, :] - (e1 @ v)[:, None] * e1
-    n3 = np.linalg.norm(e3, axis=1)
-    if nv == 0 or np.any(n3 < 1e-6 * nv):
-        bad = np.flatnonzero(n3 < 1e-6 * max(nv, 1e-300))[:5]
-        raise ModelError(
-            f"EdgeSpringProperty.normal {tuple(v)} is zero or parallel to edge spring cells {bad.tolist()}: "
-            "give the normal of the shell whose edge is held"
-        )
-    e3 /= n3[:, None]
-    e2 = np.cross(e3, e1)
-    return L, np.stack([e1, e2, e3], axis=1)
+    L, e1, e3 = line_axes(
+        xyz, normal, "edge spring", "EdgeSpringProperty.normal must be the normal of the shell whose edge is held"
+    )
+    return L, np.stack([e1, np.cross(e3, e1), e3], axis=1)
 
 
 def matrices(xyz: np.ndarray, prop):
