@@ -2,39 +2,22 @@
 
 from __future__ import annotations
 
-import sys
-import time
 from pathlib import Path
 
 import click
+import numpy as np
 
-
-def _step(msg: str):
-    click.echo(f"  {msg} ...", err=True)
-    return time.perf_counter()
-
-
-def _done(t0: float):
-    click.echo(f"    done in {time.perf_counter() - t0:.1f} s", err=True)
+from .common import done, fail, solve_board, step
 
 
 def analyse(board, config, out: Path | None, pictures: bool = True) -> dict:
     """Build and solve one configuration; print its table; write CSV/VTU/PNG under ``out``."""
-    from ..board import build_model
-    from ..fe.assembly import assemble
-    from ..fe.modal import solve_modes
     from ..report.files import write_text
     from ..report.modes import format_table, mode_table
 
     label = config or "base"
-    t0 = _step(f"[{label}] meshing and building the model")
-    bm = build_model(board, config)
-    _done(t0)
-    t0 = _step(f"[{label}] solving {bm.model.n_dof} DOFs for {board.analysis.modes} modes")
-    K, M = assemble(bm.model)
-    modes = solve_modes(bm.model, n_modes=board.analysis.modes, f_max=board.analysis.f_max, K=K, M=M)
-    _done(t0)
-    r = __import__("numpy").zeros(M.shape[0])
+    bm, modes, K, M = solve_board(board, config)
+    r = np.zeros(M.shape[0])
     r[2::6] = 1.0
     mass = float(r @ (M @ r))
     table = mode_table(bm, modes, M)
@@ -53,9 +36,9 @@ def analyse(board, config, out: Path | None, pictures: bool = True) -> dict:
         if pictures:
             from ..report.pictures import mode_pictures
 
-            t0 = _step(f"[{label}] rendering {modes.frequencies.size} mode-shape pictures")
+            t0 = step(f"[{label}] rendering {modes.frequencies.size} mode-shape pictures")
             renderer = mode_pictures(vtu, bm.model, modes.frequencies, modes.shapes, out / "png", prefix=stem)
-            _done(t0)
+            done(t0)
             if renderer != "pyvista":
                 click.echo("  note: 3-D rendering failed; the pictures are 2-D contour plots (matplotlib)", err=True)
     return {
@@ -90,8 +73,7 @@ def command(board_toml, config, all_configs, out, json_path, no_pictures):
         configs = [None] + [c.name for c in board.configurations] if all_configs else [config]
         results = [analyse(board, c, out, pictures=not no_pictures) for c in configs]
     except (BoardError, ModelError) as exc:
-        click.echo(f"error: {exc}", err=True)
-        sys.exit(2)
+        fail(str(exc))
     if json_path is not None:
         data = dict(results[0]) if len(results) == 1 else {**results[0], "configurations": results}
         data["board"] = board.name

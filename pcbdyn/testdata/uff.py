@@ -25,10 +25,10 @@ from __future__ import annotations
 
 import os
 import re
-import tempfile
 
 import numpy as np
 
+from ..atomic import atomic_path
 from .data import Dofs, FRFs, Modes, Points, TestData, TestDataError
 
 _NUM = re.compile(rb"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[EeDd][-+]?\d+)?")
@@ -334,17 +334,8 @@ def _assemble_frfs(frf58, geo: Points, L, F, frf_kind) -> FRFs:
 
 def _atomic(path, write):
     """Run ``write(tmp_path)`` then move the finished file onto ``path`` (nothing half-written)."""
-    path = os.fspath(path)
-    folder = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(dir=folder, prefix=".pcbdyn-", suffix=".tmp")
-    os.close(fd)
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-        raise
+    with atomic_path(path) as tmp:
+        write(os.fspath(tmp))
 
 
 def _write55_double(fh, mode_n, freq, zeta, nodes, r):

@@ -1,0 +1,191 @@
+"""Pictures of a test-model correlation (matplotlib, PNG, written atomically).
+
+- MAC matrix (thesis eq. 2.3) with the chosen pairs framed;
+- the 45-degree plot: model against test frequency of each pair, with +-5 % lines;
+- per pair, the model shape (filled contours on the FE mesh, nodal line solid) with the test shape
+  as squares at the measurement points (same colour scale after the modal scale factor, nodal
+  line dashed), on the board outline: a square whose colour differs from its surroundings marks
+  a point where test and model disagree;
+- COMAC per point (thesis eq. 2.4) on the board outline.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from .files import atomic_path
+
+CMAP = "coolwarm"
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _save(fig, path) -> None:
+    plt = _plt()
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format="png", dpi=110, bbox_inches="tight")
+    plt.close(fig)
+
+
+def mac_matrix(path, M, pairs, f_test, f_model) -> None:
+    """The MAC matrix (test modes down, model modes across) with values and the pairs framed."""
+    plt = _plt()
+    from matplotlib.patches import Rectangle
+
+    M = np.asarray(M)
+    nt, na = M.shape
+    fig, ax = plt.subplots(figsize=(1.0 + 0.55 * na, 1.2 + 0.5 * nt))
+    im = ax.imshow(M, vmin=0.0, vmax=1.0, cmap="Blues", origin="upper")
+    for i in range(nt):
+        for j in range(na):
+            ax.text(j, i, f"{M[i, j]:.2f}", ha="center", va="center", fontsize=7,
+                    color="white" if M[i, j] > 0.6 else "black")
+    for p in pairs:
+        ax.add_patch(Rectangle((p.model - 0.5, p.test - 0.5), 1, 1, fill=False, edgecolor="red", linewidth=2))
+    ax.set_xticks(range(na), [f"{j + 1}\n{f:.0f}" for j, f in enumerate(f_model)], fontsize=7)
+    ax.set_yticks(range(nt), [f"{i + 1}: {f:.0f}" for i, f in enumerate(f_test)], fontsize=7)
+    ax.set_xlabel("model mode / frequency [Hz]")
+    ax.set_ylabel("test mode: frequency [Hz]")
+    ax.set_title("MAC (pairs framed in red)")
+    fig.colorbar(im, ax=ax, fraction=0.046, pad=0.04)
+    _save(fig, path)
+
+
+def frequency_plot(path, pairs, band_pct: float = 5.0) -> None:
+    """Model against test frequency of each pair, on the 45-degree line with +-``band_pct`` lines;
+    each point is labelled test/model mode and coloured by its MAC."""
+    plt = _plt()
+    ft = np.array([p.f_test for p in pairs])
+    fa = np.array([p.f_model for p in pairs])
+    macs = np.array([p.mac_combined for p in pairs])
+    top = 1.08 * max(ft.max(), fa.max())
+    fig, ax = plt.subplots(figsize=(5.5, 5.0))
+    line = np.array([0.0, top])
+    ax.plot(line, line, "k-", linewidth=1, label="f_model = f_test")
+    for s in (1 + band_pct / 100, 1 - band_pct / 100):
+        ax.plot(line, s * line, "k:", linewidth=0.8)
+    ax.plot([], [], "k:", linewidth=0.8, label=f"+-{band_pct:g} %")
+    sc = ax.scatter(ft, fa, c=macs, cmap="viridis", vmin=min(0.5, float(macs.min())), vmax=1.0, s=40, zorder=3,
+                    edgecolors="k")
+    for p in pairs:
+        ax.annotate(f"{p.test + 1}/{p.model + 1}", (p.f_test, p.f_model), textcoords="offset points",
+                    xytext=(5, -10), fontsize=7)
+    ax.set_xlim(0, top)
+    ax.set_ylim(0, top)
+    ax.set_aspect("equal")
+    ax.set_xlabel("test frequency [Hz]")
+    ax.set_ylabel("model frequency [Hz]")
+    ax.set_title("paired frequencies (labels: test/model mode)")
+    ax.legend(loc="upper left", fontsize=8)
+    fig.colorbar(sc, ax=ax, fraction=0.046, pad=0.04, label="MAC")
+    _save(fig, path)
+
+
+def _outline(ax, outline) -> None:
+    """Draw the board outline and holes [mm], with a margin so that markers on the edges show whole."""
+    for poly in [outline.vertices, *outline.holes]:
+        v = np.vstack([poly, poly[:1]]) * 1e3
+        ax.plot(v[:, 0], v[:, 1], "k-", linewidth=1.2)
+    lo, hi = (np.asarray(b) * 1e3 for b in outline.bbox)
+    pad = 0.04 * float(np.max(hi - lo))
+    ax.set_xlim(lo[0] - pad, hi[0] + pad)
+    ax.set_ylim(lo[1] - pad, hi[1] + pad)
+
+
+def _shell_triangulation(model):
+    from matplotlib.tri import Triangulation
+
+    tris = []
+    for es in model.sets.values():
+        if es.etype == "quad4":
+            tris += [es.conn[:, [0, 1, 2]], es.conn[:, [0, 2, 3]]]
+        elif es.etype == "tri3":
+            tris.append(es.conn)
+    return Triangulation(model.nodes[:, 0] * 1e3, model.nodes[:, 1] * 1e3, np.concatenate(tris))
+
+
+def _point_triangulation(xy):
+    """Delaunay triangulation of the points, or None when they are too few or collinear."""
+    from matplotlib.tri import TriAnalyzer, Triangulation
+
+    if len(xy) < 3 or np.linalg.matrix_rank(xy - xy.mean(0)) < 2:
+        return None
+    try:
+        tri = Triangulation(xy[:, 0], xy[:, 1])
+    except (ValueError, RuntimeError):
+        return None
+    tri.set_mask(TriAnalyzer(tri).get_flat_tri_mask(min_circle_ratio=0.1))  # slivers along the hull
+    return tri
+
+
+def shape_overlays(out_dir, model, outline, pairs, test_xy, test_w, model_at_test, model_w, prefix="pair"):
+    """One PNG per pair: model shape ``model_w`` (n_nodes, n_pairs: w at the FE nodes) as filled
+    contours, the test shape ``test_w`` (n_points, n_pairs: z components at ``test_xy`` [m]) as
+    coloured markers. The test is scaled by the modal scale factor onto ``model_at_test`` (the
+    model at the test DOFs), then both by the model's largest value at the points, so equal colours
+    mean equal motion. Returns the file names."""
+    plt = _plt()
+    tri = _shell_triangulation(model)
+    xy = np.asarray(test_xy) * 1e3
+    w_abs = np.abs(np.asarray(test_w))
+    moving = w_abs.max(axis=1) > 1e-9 * (w_abs.max() or 1.0)  # points at rest (held edges) bend no nodal line
+    ptri = _point_triangulation(xy[moving])
+    levels = np.linspace(-1.0, 1.0, 21)
+    names = []
+    for k, p in enumerate(pairs):
+        a, x = model_at_test[:, k], test_w[:, k]
+        msf = float(a @ x) / float(x @ x) if x @ x > 0 else 0.0
+        scale = np.max(np.abs(a)) or 1.0
+        xs, ws = msf * x / scale, model_w[:, k] / scale
+        fig, ax = plt.subplots(figsize=(6.0, 5.6))
+        cf = ax.tricontourf(tri, np.clip(ws, -1, 1), levels=levels, cmap=CMAP)
+        ax.tricontour(tri, ws, levels=[0.0], colors="k", linewidths=1.2)
+        if ptri is not None:
+            ax.tricontour(ptri, xs[moving], levels=[0.0], colors="k", linewidths=1.2, linestyles="--")
+        ax.scatter(xy[:, 0], xy[:, 1], c=np.clip(xs, -1, 1), cmap=CMAP, vmin=-1, vmax=1, s=70, marker="s",
+                   edgecolors="k", linewidths=1.0, zorder=3)
+        _outline(ax, outline)
+        ax.plot([], [], "k-", label="model nodal line")
+        ax.plot([], [], "k--", label="test nodal line")
+        ax.scatter([], [], c="w", marker="s", edgecolors="k", label="test points (colour: test)")
+        fig.colorbar(cf, ax=ax, fraction=0.046, pad=0.04, ticks=[-1, -0.5, 0, 0.5, 1],
+                     label="w / largest model |w| at the points")
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=3, fontsize=7, frameon=False)
+        ax.set_aspect("equal")
+        ax.set_xlabel("x [mm]")
+        ax.set_ylabel("y [mm]")
+        combo = f" (+ {', '.join(str(c + 1) for c in p.cluster if c != p.model)})" if len(p.cluster) > 1 else ""
+        ax.set_title(f"test {p.test + 1}: {p.f_test:.1f} Hz  /  model {p.model + 1}{combo}: {p.f_model:.1f} Hz\n"
+                     f"df = {p.df_pct:+.2f} %, MAC = {p.mac_combined:.3f}", fontsize=10)
+        name = f"{prefix}_{k + 1:02d}_test{p.test + 1}_model{p.model + 1}.png"
+        _save(fig, Path(out_dir) / name)
+        names.append(name)
+    return names
+
+
+def comac_map(path, outline, xy, values, labels) -> None:
+    """COMAC per measured DOF at its point on the board outline (low = test and model disagree)."""
+    plt = _plt()
+    xy = np.asarray(xy) * 1e3
+    fig, ax = plt.subplots(figsize=(6.0, 5.6))
+    _outline(ax, outline)
+    lo = min(0.9, float(np.min(values)))  # spread the usual 0.9-1 range over the colours
+    sc = ax.scatter(xy[:, 0], xy[:, 1], c=values, cmap="RdYlGn", vmin=lo, vmax=1.0, s=60, edgecolors="k", zorder=3)
+    worst = np.argsort(values)[: min(5, len(values))]
+    for i in worst:
+        ax.annotate(f"{labels[i]}\n{values[i]:.2f}", xy[i], textcoords="offset points", xytext=(6, 4), fontsize=7)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [mm]")
+    ax.set_ylabel("y [mm]")
+    ax.set_title("COMAC per point over the pairs (five lowest labelled)")
+    fig.colorbar(sc, ax=ax, fraction=0.046, pad=0.04, label="COMAC")
+    _save(fig, path)
