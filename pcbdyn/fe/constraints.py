@@ -23,7 +23,16 @@ class Reduction:
         """Full vectors (n_full, ...) from reduced ones (n_red, ...)."""
         return self.T @ x
 
+    @property
+    def is_selection(self) -> bool:
+        """True when T only drops DOFs (one unit entry per column: no MPC terms survive)."""
+        return self.T.nnz == self.independent.size
+
     def reduce(self, A: sp.spmatrix) -> sp.csc_matrix:
+        """T^T A T as CSC; by row/column selection when T only drops DOFs (cheaper, exact)."""
+        if self.is_selection:
+            idx = self.independent
+            return sp.csr_matrix(A)[idx][:, idx].tocsc()
         return (self.T.T @ A @ self.T).tocsc()
 
 

@@ -77,6 +77,52 @@ class Factorization:
         return spla.LinearOperator(self.shape, matvec=self.solve, matmat=self.solve, dtype=self.dtype)
 
 
+def negative_eigenvalue_count(A) -> int:
+    """How many eigenvalues of the symmetric sparse matrix ``A`` are negative.
+
+    By Sylvester's law of inertia this is the number of negative pivots of A = L D L^T (no
+    pivoting: CHOLMOD's simplicial LDL^T). Applied to K - s M it counts the eigenvalues of the
+    pencil below s (the Sturm sequence property used by shift-invert Lanczos codes to know that
+    no mode was missed). Without CHOLMOD, or on a zero pivot, SuperLU in symmetric mode (diagonal
+    pivots only, so U = D L^T) gives the same count.
+    """
+    A = _canonical_csc(A)
+    if cholesky is not None:
+        try:
+            d = cholesky(A, mode="simplicial").D()
+        except CholmodNotPositiveDefiniteError:
+            d = None
+        if d is not None and np.all(np.isfinite(d)) and np.all(d != 0):
+            return int(np.count_nonzero(d < 0))
+    try:
+        lu = spla.splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options={"SymmetricMode": True})
+    except RuntimeError as exc:
+        raise SingularMatrixError(f"the {A.shape[0]}x{A.shape[0]} matrix is singular ({exc})") from exc
+    if not np.array_equal(lu.perm_r, lu.perm_c):
+        raise SingularMatrixError("no symmetric pivot order gives an LDL^T factorisation: the inertia is unknown")
+    return int(np.count_nonzero(lu.U.diagonal() < 0))
+
+
+def has_no_negative_eigenvalue(A) -> bool:
+    """True when the symmetric sparse ``A`` is positive (semi)definite: a supernodal Cholesky
+    succeeds, about three times faster than the LDL^T of :func:`negative_eigenvalue_count`."""
+    A = _canonical_csc(A)
+    if cholesky is None:
+        return negative_eigenvalue_count(A) == 0
+    try:
+        cholesky(A, mode="supernodal")
+    except CholmodNotPositiveDefiniteError:
+        return False
+    return True
+
+
+def _canonical_csc(A) -> sp.csc_matrix:
+    A = sp.csc_matrix(A)
+    A.sum_duplicates()
+    A.sort_indices()
+    return A
+
+
 def factorize(A, spd: bool = True) -> Factorization:
     """Factorise sparse ``A``; ``spd=True`` tries Cholesky first (falls back to LU if A is not SPD)."""
     return Factorization(A, spd=spd)

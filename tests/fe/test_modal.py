@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import scipy.linalg as sla
+import scipy.sparse as sp
 
 from pcbdyn.fe.assembly import assemble
 from pcbdyn.fe.generate import rectangle
@@ -93,7 +94,7 @@ def uniform_fixed_free(n, k, m):
 
 def test_sparse_path_long_chain_with_f_max_growth():
     """A 1500-mass uniform chain (beyond the dense limit) against its closed-form spectrum; f_max
-    needs more modes than the first eigsh request, so the request has to grow."""
+    holds more modes than a default request of 20, all of which must be found."""
     n, k, m = 1500, 1e6, 0.5
     assert n > DENSE_MAX
     w = uniform_fixed_free(n, k, m)
@@ -274,3 +275,121 @@ def test_massless_mechanism_is_an_error():
     model.free = True
     with pytest.raises(ModelError, match="massless mechanism"):
         solve_modes(model)
+
+
+def _pencil_count(Kr, Mr, lam):
+    """Eigenvalues of the pencil (K, M) below ``lam``, from dense LAPACK."""
+    return int(np.sum(sla.eigh(Kr.toarray(), Mr.toarray(), eigvals_only=True) < lam))
+
+
+@pytest.mark.parametrize("fallback", [False, True])
+def test_sturm_count_matches_dense_spectrum(monkeypatch, fallback):
+    """The number of negative LDL^T pivots of K - s M equals the number of pencil eigenvalues below
+    s (Sylvester's law of inertia), with CHOLMOD and with the SuperLU fallback, at shifts below,
+    between and above the fixed-free chain's eigenvalues."""
+    from pcbdyn.fe import linsolve
+
+    if fallback:
+        monkeypatch.setattr(linsolve, "cholesky", None)
+    n = 80
+    Kd, Md = chain_matrices(np.linspace(1e4, 3e4, n), np.linspace(0.1, 0.3, n))
+    lam = sla.eigh(Kd, Md, eigvals_only=True)
+    K, M = sp.csc_matrix(Kd), sp.csc_matrix(Md)
+    for s in (0.5 * lam[0], 0.5 * (lam[9] + lam[10]), 0.5 * (lam[40] + lam[41]), 2 * lam[-1]):
+        expected = int(np.sum(lam < s))
+        assert linsolve.negative_eigenvalue_count(K - s * M) == expected
+        assert linsolve.has_no_negative_eigenvalue(K - s * M) == (expected == 0)
+
+
+def test_free_flat_plate_membrane_block_asks_only_its_modes_below_the_cut(monkeypatch):
+    """A free flat plate: the membrane block has exactly its three in-plane rigid modes below the
+    n-th bending frequency, so eigsh is asked for exactly three there (not for elastic membrane
+    modes, which may sit in a tight cluster of drilling modes). Frequencies, rigid-mode count and
+    M-orthonormality agree with a dense solve of the whole pencil, for n_modes and for f_max."""
+    pytest.importorskip("pcbdyn.fe.elements.shell_quad4")
+    import pcbdyn.fe.modal as modal
+
+    model = _square_plate(14, 0.0)
+    red, Kr, Mr = reduced_system(model)
+    blocks = uncoupled_blocks(Kr, Mr)
+    assert len(blocks) == 2 and min(b.size for b in blocks) > DENSE_MAX
+    lam = sla.eigh(Kr.toarray(), Mr.toarray(), eigvals_only=True)
+    f_ref = np.sqrt(lam[6:]) / (2 * np.pi)
+    asked = []
+    eigsh = modal.spla.eigsh
+
+    def spy(A, k, **kw):
+        asked.append(k)
+        return eigsh(A, k=k, **kw)
+
+    monkeypatch.setattr(modal.spla, "eigsh", spy)
+    modes = solve_modes(model, n_modes=10)
+    assert modes.n_rigid == 6
+    np.testing.assert_allclose(modes.frequencies, f_ref[:10], rtol=1e-8)
+    assert asked == [16, 3]  # bending: 10 elastic + 6 possibly rigid; membrane: its 3 rigid modes
+    _, M = assemble(model)
+    np.testing.assert_allclose(modes.shapes.T @ (M @ modes.shapes), np.eye(10), atol=1e-10)
+    f_max = 0.5 * (f_ref[13] + f_ref[14])
+    np.testing.assert_allclose(solve_modes(model, f_max=f_max).frequencies, f_ref[:14], rtol=1e-8)
+
+
+def test_clamped_block_with_nothing_below_the_cut_is_skipped(monkeypatch):
+    """A clamped flat plate's membrane block has no eigenvalue below its 8th bending one: a Cholesky
+    of K - s M proves it, so eigsh runs on the bending block only; the frequencies match a dense
+    solve of the whole pencil."""
+    pytest.importorskip("pcbdyn.fe.elements.shell_quad4")
+    import pcbdyn.fe.modal as modal
+
+    nodes, quads = rectangle(0.2, 0.2, 16, 16)
+    model = Model(nodes)
+    model.add("plate", "quad4", quads, ShellProperty(E=210e9, nu=0.3, rho=7850.0, t=2e-3))
+    on_edge = np.isclose(nodes[:, :2], 0).any(axis=1) | np.isclose(nodes[:, :2], 0.2).any(axis=1)
+    model.fix(np.flatnonzero(on_edge))
+    _, Kr, Mr = reduced_system(model)
+    assert [b.size > DENSE_MAX for b in uncoupled_blocks(Kr, Mr)] == [True, True]
+    lam = sla.eigh(Kr.toarray(), Mr.toarray(), eigvals_only=True)
+    asked = []
+    eigsh = modal.spla.eigsh
+
+    def spy(A, k, **kw):
+        asked.append(k)
+        return eigsh(A, k=k, **kw)
+
+    monkeypatch.setattr(modal.spla, "eigsh", spy)
+    modes = solve_modes(model, n_modes=8)
+    np.testing.assert_allclose(modes.omega2, lam[:8], rtol=1e-8)
+    assert asked == [8]
+
+
+def test_assembly_equals_sum_of_element_matrices():
+    """K and M of a mixed model (quads, beams, springs, masses) equal the plain sum of every element
+    matrix at its DOFs (dense reference), with one shared sparsity pattern and int32 indices."""
+    pytest.importorskip("pcbdyn.fe.elements.shell_quad4")
+    pytest.importorskip("pcbdyn.fe.elements.beam")
+    from pcbdyn.fe.assembly import element_matrices
+    from pcbdyn.fe.mesh import element_dofs
+
+    nodes, quads = rectangle(0.1, 0.08, 5, 4)
+    model = Model(nodes)
+    model.add("plate", "quad4", quads, ShellProperty(E=70e9, nu=0.33, rho=2700.0, t=1e-3))
+    model.add("stiffener", "beam2", np.c_[np.arange(5), np.arange(1, 6)],
+              BeamProperty(E=70e9, nu=0.33, rho=2700.0, A=1e-5, Iy=1e-11, Iz=2e-11, J=3e-11, orientation=(0, 0, 1)))
+    model.add("ground", "spring", [[7, 12]], SpringProperty((1e3, 2e3, 3e3, 4.0, 5.0, 6.0)))
+    model.add("lump", "mass", [[9], [20]], MassProperty(0.01))
+    K, M = assemble(model)
+    Kd, Md = np.zeros(K.shape), np.zeros(K.shape)
+    for name, es in model.sets.items():
+        Ke, Me = element_matrices(model, name)
+        for dofs, ke, me in zip(element_dofs(es.conn), Ke, Me):
+            Kd[np.ix_(dofs, dofs)] += ke
+            Md[np.ix_(dofs, dofs)] += me
+    np.testing.assert_allclose(K.toarray(), Kd, rtol=0, atol=1e-12 * np.abs(Kd).max())
+    np.testing.assert_allclose(M.toarray(), Md, rtol=0, atol=1e-12 * np.abs(Md).max())
+    assert np.array_equal(K.indptr, M.indptr) and np.array_equal(K.indices, M.indices)
+    assert K.has_sorted_indices and K.indices.dtype == np.int32
+    sub_K, _ = assemble(model, sets=["stiffener"])
+    Kb = np.zeros(K.shape)
+    Ke, _ = element_matrices(model, "stiffener")
+    for dofs, ke in zip(element_dofs(model.sets["stiffener"].conn), Ke):
+        Kb[np.ix_(dofs, dofs)] += ke
+    np.testing.assert_allclose(sub_K.toarray(), Kb, rtol=0, atol=1e-12 * np.abs(Kb).max())
