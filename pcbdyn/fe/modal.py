@@ -204,7 +204,10 @@ class _Block:
             exhausted = True
         else:
             op = self.solver().operator()
-            _, vec = spla.eigsh(self.K, k=want, M=self.M, sigma=self.sigma, which="LM", OPinv=op, tol=EIGSH_TOL)
+            v0 = np.random.default_rng(0).standard_normal(self.K.shape[0])  # repeatable runs
+            _, vec = spla.eigsh(
+                self.K, k=want, M=self.M, sigma=self.sigma, which="LM", OPinv=op, tol=EIGSH_TOL, v0=v0
+            )
             exhausted = False
         vec = _mass_normalise(vec, self.M)
         lam = np.einsum("ij,ij->j", vec, self.K @ vec)
@@ -243,31 +246,21 @@ class _Block:
         return lam, vec, rigid
 
 
-def solve_modes(model, n_modes: int | None = None, f_max: float | None = None, K=None, M=None) -> Modes:
-    """The first elastic modes of ``model``: ``n_modes`` of them, or all up to ``f_max`` [Hz], or,
-    with both, the first ``n_modes`` of those up to ``f_max`` (default: 10 modes).
+def eigenpairs(Kr, Mr, n_modes: int | None = None, f_max: float | None = None, free: bool = False):
+    """Eigenpairs (lambda, vectors, rigid mask) of constrained matrices (sparse or dense): the first
+    ``n_modes`` elastic modes and/or all up to ``f_max`` [Hz], plus the rigid-body modes met on the
+    way (up to six more are looked for when ``free``). Unsorted across uncoupled DOF groups; vectors
+    are mass-normalised. This is the engine of :func:`solve_modes` for callers that hold plain
+    matrices (updating, studies); it raises nothing for rigid-body modes.
 
-    Rigid-body modes of a free model (``model.free``) are counted and returned apart; a model not
-    declared free that has one raises :class:`ModelError` naming the DOFs that move. Asking for
-    more modes than the model has returns all of them (``len(frequencies)`` tells how many).
-    ``K, M``: already assembled full matrices (skips the assembly). Uncoupled DOF groups (see
-    :func:`uncoupled_blocks`) are solved one by one, the one whose spectrum starts lowest first;
-    after it, a group is asked for exactly its modes below the highest eigenvalue still wanted
-    (Sturm count). With ``f_max``, every group is counted that way, so no request has to grow.
+    Uncoupled DOF groups (see :func:`uncoupled_blocks`) are solved one by one, the one whose
+    spectrum starts lowest first; after it, a group is asked for exactly its modes below the highest
+    eigenvalue still wanted (Sturm count). With ``f_max``, every group is counted that way, so no
+    request has to grow.
     """
-    if n_modes is None and f_max is None:
-        n_modes = 10
-    if n_modes is not None and int(n_modes) < 1:
-        raise ValueError(f"n_modes must be a positive integer, got {n_modes}")
-    if f_max is not None and not f_max > 0:
-        raise ValueError(f"f_max must be a positive frequency in Hz, got {f_max}")
-    red, Kr, Mr = reduced_system(model, K, M)
+    Kr, Mr = sp.csc_matrix(Kr), sp.csc_matrix(Mr)
     n = Kr.shape[0]
-    if n == 0:
-        raise ModelError("the model has no free DOF: every DOF is fixed or untouched by an element")
-    if np.any(Mr.diagonal() < 0):
-        raise ModelError("the mass matrix has negative diagonal terms: check densities and masses")
-    extra = 6 if model.free else 0
+    extra = 6 if free else 0
     lam_cut = (2.0 * np.pi * f_max) ** 2 if f_max is not None else np.inf
     groups = uncoupled_blocks(Kr, Mr)
     if len(groups) == 1:
@@ -282,7 +275,7 @@ def solve_modes(model, n_modes: int | None = None, f_max: float | None = None, K
         if np.isinf(lam_cut):
             lam, v, rigid = block.modes(cap, n_modes)
         else:
-            lam, v, rigid = block.modes_below(lam_cut, cap, rigid_expected=model.free)
+            lam, v, rigid = block.modes_below(lam_cut, cap, rigid_expected=free)
         vec = np.zeros((n, v.shape[1]))
         vec[idx] = v
         lams.append(lam)
@@ -291,7 +284,31 @@ def solve_modes(model, n_modes: int | None = None, f_max: float | None = None, K
         elastic = np.sort(np.concatenate([l[~r] for l, r in zip(lams, rigids)]))
         if n_modes is not None and elastic.size >= n_modes:
             lam_cut = min(lam_cut, elastic[n_modes - 1])
-    lam, vec, rigid = np.concatenate(lams), np.hstack(vecs), np.concatenate(rigids)
+    return np.concatenate(lams), np.hstack(vecs), np.concatenate(rigids)
+
+
+def solve_modes(model, n_modes: int | None = None, f_max: float | None = None, K=None, M=None) -> Modes:
+    """The first elastic modes of ``model``: ``n_modes`` of them, or all up to ``f_max`` [Hz], or,
+    with both, the first ``n_modes`` of those up to ``f_max`` (default: 10 modes).
+
+    Rigid-body modes of a free model (``model.free``) are counted and returned apart; a model not
+    declared free that has one raises :class:`ModelError` naming the DOFs that move. Asking for
+    more modes than the model has returns all of them (``len(frequencies)`` tells how many).
+    ``K, M``: already assembled full matrices (skips the assembly). See :func:`eigenpairs`.
+    """
+    if n_modes is None and f_max is None:
+        n_modes = 10
+    if n_modes is not None and int(n_modes) < 1:
+        raise ValueError(f"n_modes must be a positive integer, got {n_modes}")
+    if f_max is not None and not f_max > 0:
+        raise ValueError(f"f_max must be a positive frequency in Hz, got {f_max}")
+    red, Kr, Mr = reduced_system(model, K, M)
+    n = Kr.shape[0]
+    if n == 0:
+        raise ModelError("the model has no free DOF: every DOF is fixed or untouched by an element")
+    if np.any(Mr.diagonal() < 0):
+        raise ModelError("the mass matrix has negative diagonal terms: check densities and masses")
+    lam, vec, rigid = eigenpairs(Kr, Mr, n_modes, f_max, free=model.free)
     if rigid.any() and not model.free:
         raise ModelError(
             f"the model has {int(rigid.sum())} zero-frequency (rigid-body or mechanism) mode(s) but "

@@ -7,45 +7,28 @@ same size as K). Modes are mass-normalised: phi^T M phi = 1, phi^T K phi = lambd
 from __future__ import annotations
 
 import numpy as np
-import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-#: systems up to this size are solved with dense LAPACK
-DENSE_MAX = 1500
-
+from ..fe.modal import eigenpairs
 
 def as_dense(A) -> np.ndarray:
     """Dense ndarray view of a dense or scipy-sparse matrix."""
     return A.toarray() if sp.issparse(A) else np.asarray(A)
 
 
-def solve_modes(K, M, n_modes: int | None = None, shift: float = 0.0):
-    """Lowest ``n_modes`` eigenpairs of K phi = lambda M phi as (lambda, Phi), Phi mass-normalised.
-
-    Dense LAPACK for small systems; ARPACK shift-invert about ``-shift`` for large sparse ones
-    (a singular K, i.e. a free model, gets a small automatic shift). Rigid-body modes of a free
-    model are returned too (lambda ~ 0); pair measured modes with elastic ones only.
+def solve_modes(K, M, n_modes: int | None = None):
+    """Lowest ``n_modes`` eigenpairs (default: all) of K phi = lambda M phi as (lambda, Phi), sorted,
+    Phi mass-normalised; rigid-body modes of a free system are included (lambda ~ 0), so pair
+    measured modes with elastic ones only. Solved by the FE engine's :func:`pcbdyn.fe.modal.eigenpairs`.
     """
-    n = K.shape[0]
     if K.shape != M.shape or K.shape[0] != K.shape[1]:
         raise ValueError(f"K {K.shape} and M {M.shape} must be square and of equal size")
+    n = K.shape[0]
     k = n if n_modes is None else min(int(n_modes), n)
-    if n <= DENSE_MAX or k >= n - 1:
-        lam, phi = sla.eigh(as_dense(K), as_dense(M), subset_by_index=[0, k - 1])
-    else:
-        Ks, Ms = sp.csc_matrix(K), sp.csc_matrix(M)
-        try:
-            lu = spla.splu((Ks + shift * Ms).tocsc(), permc_spec="MMD_AT_PLUS_A")
-        except RuntimeError:  # singular: a free model; shift far below the first elastic mode
-            shift = 1e-6 * abs(Ks.diagonal().mean() / Ms.diagonal().mean())
-            lu = spla.splu((Ks + shift * Ms).tocsc(), permc_spec="MMD_AT_PLUS_A")
-        op = spla.LinearOperator(K.shape, matvec=lu.solve, dtype=float)
-        lam, phi = spla.eigsh(Ks, k=k, M=Ms, sigma=-shift, OPinv=op, which="LM")
-        order = np.argsort(lam)
-        lam, phi = lam[order], phi[:, order]
-        phi = phi / np.sqrt(np.einsum("ij,ij->j", phi, Ms @ phi))
-    return lam, phi
+    lam, Phi, _ = eigenpairs(K, M, n_modes=k, free=True)
+    order = np.argsort(lam, kind="stable")[:k]
+    return lam[order], Phi[:, order]
 
 
 def frequencies_hz(lam) -> np.ndarray:
