@@ -1,0 +1,219 @@
+"""The catalogue of candidate effects: effects a model may lack, each one scalar parameter whose
+nominal value is zero (issue 7, step 4).
+
+A candidate is a catalogue kind (``point_mass``, ``ground_spring``, ``edge_stiffness``,
+``region_stiffness``, ``stiffener``, ``line_mass``), a place and a parameter. Every kind is a
+plugin module of this package exposing an object (registered in :data:`KINDS`) with
+
+- ``name``, ``report_as`` (the catalogue type reported), ``param`` (what the parameter is),
+  ``unit`` (SI), ``scale`` (a typical magnitude), ``lower`` (the least physical value),
+  ``options`` (names ``generate`` accepts);
+- ``generate(layout, **options) -> [Candidate]``: candidates on a mesh (:mod:`.layout`);
+- ``blocks(model, candidates) -> [Blocks]``: element matrices of dK/dp and dM/dp of all the
+  candidates at once, vectorised over cells;
+- ``apply(model, candidate, value) -> Model``: a copy of the model carrying the effect.
+
+Every effect enters K and M linearly in its parameter, so dK/dp and dM/dp are exact and the
+same at every value, and the first-order eigenvalue sensitivity (thesis eq. 3.11 with k = i)
+d lambda_i / dp = phi_i^T (dK/dp - lambda_i dM/dp) phi_i is a sum of element quadratic forms
+computed for all candidates of a kind in one pass (:func:`eigenvalue_columns`).
+A new kind of effect is one new module plus one line in :data:`KINDS`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from importlib import import_module
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..fe.assembly import scatter
+from ..fe.mesh import element_dofs
+
+#: catalogue name -> (module of this package, plugin object in it). ``point_inertia`` is the
+#: rotary-inertia parameter of a point mass (reported as a ``point_mass``).
+KINDS = {
+    "point_mass": ("point_mass", "MASS"),
+    "point_inertia": ("point_mass", "INERTIA"),
+    "ground_spring": ("ground_spring", "KIND"),
+    "edge_stiffness": ("edge_stiffness", "KIND"),
+    "region_stiffness": ("region_stiffness", "KIND"),
+    "stiffener": ("stiffener", "KIND"),
+    "line_mass": ("line_mass", "KIND"),
+}
+
+
+class CatalogueError(ValueError):
+    """An unknown kind or a bad option, with what to use instead."""
+
+
+@dataclass(frozen=True, eq=False)
+class Candidate:
+    """One candidate effect. ``at`` (x, y) [m] is its representative point (node, segment or
+    path midpoint, region centroid); ``geometry`` holds its extent in metres (``segment``: two end
+    points, ``path``/``polygon``: vertices); ``nodes`` the nodes it touches; ``data`` what its
+    kind needs to build it (edges, cells, weights). ``prime``: a prime suspect (an excitation
+    or response point). The parameter's nominal value is zero."""
+
+    kind: str
+    name: str
+    at: tuple
+    nodes: np.ndarray
+    geometry: dict = field(default_factory=dict)
+    data: dict = field(default_factory=dict)
+    prime: bool = False
+
+    @property
+    def spec(self):
+        return kind(self.kind)
+
+    @property
+    def unit(self) -> str:
+        return self.spec.unit
+
+    @property
+    def nominal(self) -> float:
+        return 0.0
+
+    def describe(self) -> dict:
+        """JSON-ready description in mm (the shape of diagnose's ``effects`` entries)."""
+        d = {"type": self.spec.report_as, "name": self.name, "parameter": self.spec.param,
+             "unit": self.unit, "at_mm": [round(1e3 * float(v), 3) for v in self.at]}
+        for key, pts in self.geometry.items():
+            d[f"{key}_mm"] = (1e3 * np.asarray(pts)).round(3).tolist()
+        return d
+
+
+@dataclass
+class Blocks:
+    """Element matrices of dK/dp, dM/dp at unit parameter: cells ``conn`` (n, npc), ``Ke``/``Me``
+    (n, 6 npc, 6 npc) in global axes, and ``owner`` (n,): the candidate index of each cell."""
+
+    conn: np.ndarray
+    Ke: np.ndarray
+    Me: np.ndarray
+    owner: np.ndarray
+
+
+def kind(name: str):
+    """The plugin object of catalogue kind ``name``."""
+    try:
+        module, attr = KINDS[name]
+    except KeyError:
+        raise CatalogueError(f"unknown effect kind '{name}' (use one of {', '.join(KINDS)})") from None
+    return getattr(import_module(f"{__package__}.{module}"), attr)
+
+
+def copy_model(model):
+    """A shallow copy of an fe.Model whose sets, groups and constraints can be extended freely."""
+    return replace(model, sets=dict(model.sets), node_groups=dict(model.node_groups),
+                   fixed=set(model.fixed), mpcs=list(model.mpcs))
+
+
+def _by_kind(candidates):
+    groups: dict = {}
+    for i, c in enumerate(candidates):
+        groups.setdefault(c.kind, []).append(i)
+    return groups
+
+
+def derivatives(model, candidate):
+    """(dK/dp, dM/dp) of one candidate as full-size CSR matrices (before constraints); exact."""
+    n = model.n_dof
+    K, M = sp.csr_matrix((n, n)), sp.csr_matrix((n, n))
+    for b in candidate.spec.blocks(model, [candidate]):
+        K = K + scatter(n, b.conn, b.Ke)
+        M = M + scatter(n, b.conn, b.Me)
+    return K, M
+
+
+def add_effect(model, candidate, value: float):
+    """A copy of ``model`` carrying ``candidate`` at parameter ``value`` (SI)."""
+    if not np.isfinite(value):
+        raise CatalogueError(f"{candidate.name}: the effect's value must be finite, got {value}")
+    return candidate.spec.apply(model, candidate, float(value))
+
+
+def _quadratic_forms(shapes: np.ndarray, b: Blocks):
+    """phi^T Ke phi and phi^T Me phi per cell and mode, each (n_cells, n_modes)."""
+    dofs = element_dofs(b.conn)
+    ph = shapes[dofs]  # (n_cells, nd, n_modes)
+    qk = np.einsum("cam,cab,cbm->cm", ph, b.Ke, ph, optimize=True)
+    qm = np.einsum("cam,cab,cbm->cm", ph, b.Me, ph, optimize=True)
+    return qk, qm
+
+
+def eigenvalue_columns(model, modes, candidates) -> np.ndarray:
+    """d lambda_i / dp for every mode i (rows) and candidate (columns) [rad^2/s^2 per SI unit],
+    from mass-normalised full-length shapes (``fe.modal.Modes``): sum over the candidate's cells
+    of phi_i^T (Ke - lambda_i Me) phi_i."""
+    lam = modes.omega2
+    out = np.zeros((lam.size, len(candidates)))
+    for name, idx in _by_kind(candidates).items():
+        cands = [candidates[i] for i in idx]
+        for b in kind(name).blocks(model, cands):
+            qk, qm = _quadratic_forms(modes.shapes, b)
+            per_cell = qk - qm * lam
+            S = sp.csr_matrix((np.ones(b.owner.size), (b.owner, np.arange(b.owner.size))),
+                              shape=(len(cands), b.owner.size))
+            out[:, idx] += (S @ per_cell).T
+    return out
+
+
+def frequency_columns(model, modes, candidates) -> np.ndarray:
+    """d f_i / dp [Hz per SI unit], (n_modes, n_candidates): d lambda / dp / (8 pi^2 f_i)."""
+    f = np.asarray(modes.frequencies, dtype=float)
+    return eigenvalue_columns(model, modes, candidates) / (8.0 * np.pi**2 * f)[:, None]
+
+
+def active(model, candidates) -> np.ndarray:
+    """True for candidates that touch at least one DOF the constraints leave free (a spring on
+    a clamped edge changes nothing and is dropped)."""
+    free = np.ones(model.n_dof, dtype=bool)
+    free[list(model.fixed)] = False
+    keep = np.zeros(len(candidates), dtype=bool)
+    for name, idx in _by_kind(candidates).items():
+        for b in kind(name).blocks(model, [candidates[i] for i in idx]):
+            f = free[element_dofs(b.conn)]
+            mask = f[:, :, None] & f[:, None, :]
+            hit = (np.abs(b.Ke) * mask).max(axis=(1, 2)) + (np.abs(b.Me) * mask).max(axis=(1, 2)) > 0
+            keep[np.asarray(idx)[np.unique(b.owner[hit])]] = True
+    return keep
+
+
+def generate(layout, kinds=None, **options) -> list:
+    """Candidates of the given kinds (default: all) on ``layout`` (:mod:`.layout`). ``options`` go
+    to the kinds that accept them (``spacing``, ``segments``, ``patch``, ...). Candidates that
+    cannot act on the constrained model are dropped."""
+    names = list(KINDS) if kinds is None else list(kinds)
+    accepted = {o for name in names for o in kind(name).options}
+    unknown = sorted(set(options) - accepted)
+    if unknown:
+        raise CatalogueError(f"generate: unknown option(s) {', '.join(unknown)} for kinds {', '.join(names)} "
+                             f"(options: {', '.join(sorted(accepted))})")
+    out = []
+    for name in names:
+        k = kind(name)
+        out += k.generate(layout, **{o: v for o, v in options.items() if o in k.options})
+    return [c for c, a in zip(out, active(layout.model, out)) if a] if out else []
+
+
+def node_candidates(kind_name: str, layout, spacing: float | None = None) -> list:
+    """One candidate per grid node (:meth:`Layout.grid_nodes`) plus one at every prime suspect."""
+    prime = {int(n): s for s, n in layout.suspects.items()}
+    nodes = np.union1d(layout.grid_nodes(spacing), np.array(sorted(prime), dtype=np.int64))
+    xy = layout.xy
+    return [Candidate(kind_name, f"{kind_name}@{prime.get(int(n), f'n{n}')}", tuple(xy[n]), np.array([n]),
+                      prime=int(n) in prime) for n in nodes]
+
+
+def chain_candidate(kind_name: str, layout, label: str, chain: np.ndarray, key: str = "segment") -> Candidate:
+    """A candidate along a node chain (a boundary segment or a stiffener path); ``at`` is the
+    point of the chain halfway along its length."""
+    p = layout.xy[chain]
+    s = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))]
+    mid = np.array([np.interp(0.5 * s[-1], s, p[:, 0]), np.interp(0.5 * s[-1], s, p[:, 1])])
+    geometry = {key: p[[0, -1]]} if key == "segment" else {key: p}
+    return Candidate(kind_name, f"{kind_name}@{label}", tuple(mid), chain, geometry,
+                     {"edges": np.column_stack([chain[:-1], chain[1:]]), "length": float(s[-1])})

@@ -1,0 +1,47 @@
+"""``edge_stiffness``: a rotational stiffness kr per unit length about a segment of an edge or
+support line [N m/rad/m] (one card guide, or one part of it, tighter than assumed; a free edge
+touching a frame). It is an edge-spring set on the segment's element edges (consistent
+distribution, thesis section 7.4); K is linear in kr, M does not depend on it.
+
+A positive value only: the edge-spring kernel rejects negative springs, so a guide softer than
+declared needs its declared k_rot split per segment (a board-model parameter), not this effect.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..fe import EdgeSpringProperty
+from ..fe.elements import kernel
+from .catalogue import Blocks, chain_candidate, copy_model
+
+
+def _prop(kr: float) -> EdgeSpringProperty:
+    return EdgeSpringProperty(k=(0.0, 0.0, 0.0, kr, 0.0, 0.0), normal=(0.0, 0.0, 1.0))
+
+
+class _EdgeStiffness:
+    name = report_as = "edge_stiffness"
+    param = "k_rot"
+    unit = "N*m/rad/m"
+    scale = 1e3
+    lower = 0.0
+    options = ("segments",)
+
+    def generate(self, layout, segments: int = 4) -> list:
+        return [chain_candidate(self.name, layout, f"{side}[{i}]", chain)
+                for side, i, chain in layout.segments(segments)]
+
+    def blocks(self, model, candidates) -> list:
+        edges = [c.data["edges"] for c in candidates]
+        conn = np.concatenate(edges)
+        Ke, Me = kernel("edge_spring")(model.nodes[conn], _prop(1.0))
+        return [Blocks(conn, Ke, Me, np.repeat(np.arange(len(edges)), [e.shape[0] for e in edges]))]
+
+    def apply(self, model, candidate, value: float):
+        m = copy_model(model)
+        m.add(f"effects.{candidate.name}", "edge_spring", candidate.data["edges"], _prop(value))
+        return m
+
+
+KIND = _EdgeStiffness()

@@ -1,0 +1,205 @@
+"""Where candidate effects can go on a meshed plate: its shell cells and nodes, its straight
+boundary sides and support lines, prime-suspect points and part footprints.
+
+A :class:`Layout` is made from any ``fe.Model`` (:func:`from_model`) or from a board model
+(:func:`from_board`, which adds the measurement points and declared masses as prime suspects and
+the part footprints as regions). Candidate generators (the catalogue's plugins) only ask it
+geometric questions: grid nodes, boundary segments, cells inside a polygon, node paths.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+from matplotlib.path import Path as PolyPath
+from scipy.sparse.csgraph import dijkstra
+from scipy.spatial import cKDTree
+
+SHELLS = ("quad4", "tri3")
+#: direction change [deg] above which a boundary node is a corner that ends a straight side
+CORNER_DEG = 15.0
+
+
+@dataclass
+class Layout:
+    """``sides``: {name: ordered node chain} of the straight boundary sides and the support lines of
+    edge springs (card guides); ``suspects``: {name: node}; ``footprints``: {name: polygon (m, 2) [m]};
+    ``thickness``: plate thickness [m] (for stiffener offsets)."""
+
+    model: object
+    shell_sets: tuple
+    sides: dict
+    suspects: dict = field(default_factory=dict)
+    footprints: dict = field(default_factory=dict)
+    thickness: float = 0.0
+
+    @property
+    def xy(self) -> np.ndarray:
+        return self.model.nodes[:, :2]
+
+    def cells(self):
+        """[(set name, conn)] of the shell sets."""
+        return [(n, self.model.sets[n].conn) for n in self.shell_sets]
+
+    def shell_nodes(self) -> np.ndarray:
+        return np.unique(np.concatenate([c.ravel() for _, c in self.cells()]))
+
+    def grid_nodes(self, spacing: float | None = None) -> np.ndarray:
+        """Shell nodes nearest to a square grid of pitch ``spacing`` [m] (None: every shell node)."""
+        nodes = self.shell_nodes()
+        if spacing is None:
+            return nodes
+        if not spacing > 0:
+            raise ValueError(f"spacing must be > 0 m or None (every node), got {spacing}")
+        xy = self.xy[nodes]
+        lo, hi = xy.min(axis=0), xy.max(axis=0)
+        gx = np.arange(lo[0] + 0.5 * spacing, hi[0], spacing)
+        gy = np.arange(lo[1] + 0.5 * spacing, hi[1], spacing)
+        g = np.stack(np.meshgrid(gx, gy), axis=-1).reshape(-1, 2)
+        d, near = cKDTree(xy).query(g)
+        return np.unique(nodes[near[d < 0.5 * spacing]])
+
+    def segments(self, n: int) -> list:
+        """[(side name, i, node chain)]: every side cut into ``n`` pieces of about equal length
+        (fewer where the side has too few elements)."""
+        if int(n) != n or n < 1:
+            raise ValueError(f"segments must be an integer >= 1, got {n}")
+        out = []
+        for name, chain in self.sides.items():
+            p = self.xy[chain]
+            s = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))]
+            cuts = np.unique(np.abs(s[:, None] - np.linspace(0.0, s[-1], int(n) + 1)).argmin(axis=0))
+            for i, (a, b) in enumerate(zip(cuts[:-1], cuts[1:])):
+                out.append((name, i, chain[a:b + 1]))
+        return out
+
+    def cells_in(self, polygon) -> list:
+        """[(set name, cell indices)] of the shell cells whose centroid lies in ``polygon`` [m]."""
+        path = PolyPath(np.asarray(polygon, dtype=float))
+        out = []
+        for name, conn in self.cells():
+            inside = np.flatnonzero(path.contains_points(self.xy[conn].mean(axis=1)))
+            if inside.size:
+                out.append((name, inside))
+        return out
+
+    def node_path(self, p0, p1) -> np.ndarray:
+        """The chain of shell nodes from the node nearest ``p0`` to the node nearest ``p1`` that
+        follows the straight line between them (shortest path over element edges, each edge
+        weighted by its length plus four times its midpoint's distance from the line)."""
+        nodes = self.shell_nodes()
+        xy = self.xy
+        a = nodes[np.linalg.norm(xy[nodes] - p0, axis=1).argmin()]
+        b = nodes[np.linalg.norm(xy[nodes] - p1, axis=1).argmin()]
+        e = _edges([c for _, c in self.cells()])
+        u = (xy[b] - xy[a]) / max(np.linalg.norm(xy[b] - xy[a]), 1e-300)
+        mid = 0.5 * (xy[e[:, 0]] + xy[e[:, 1]]) - xy[a]
+        off = np.abs(mid[:, 0] * u[1] - mid[:, 1] * u[0])
+        w = np.linalg.norm(xy[e[:, 0]] - xy[e[:, 1]], axis=1) + 4.0 * off
+        n = xy.shape[0]
+        G = sp.coo_matrix((np.r_[w, w], (np.r_[e[:, 0], e[:, 1]], np.r_[e[:, 1], e[:, 0]])), shape=(n, n)).tocsr()
+        _, pred = dijkstra(G, indices=a, return_predecessors=True)
+        path = [b]
+        while path[-1] != a:
+            if pred[path[-1]] < 0:
+                raise ValueError("no mesh path between the two points (the plate is not connected there)")
+            path.append(pred[path[-1]])
+        return np.array(path[::-1], dtype=np.int64)
+
+
+def _edges(conns) -> np.ndarray:
+    """All element edges (with repeats) as sorted node pairs."""
+    e = [np.stack([c, np.roll(c, -1, axis=1)], axis=-1).reshape(-1, 2) for c in conns]
+    return np.sort(np.concatenate(e), axis=1)
+
+
+def _chains(edges) -> list:
+    """Ordered node chains (open paths first from an end; closed loops repeat their first node)."""
+    adj: dict = {}
+    for a, b in edges:
+        adj.setdefault(int(a), []).append(int(b))
+        adj.setdefault(int(b), []).append(int(a))
+    seen, out = set(), []
+    starts = [n for n, nb in adj.items() if len(nb) == 1] + list(adj)
+    for s in starts:
+        if s in seen:
+            continue
+        chain, prev = [s], None
+        seen.add(s)
+        while True:
+            nxt = [m for m in adj[chain[-1]] if m != prev and (m not in seen or (m == s and len(chain) > 2))]
+            if not nxt:
+                break
+            prev = chain[-1]
+            chain.append(nxt[0])
+            if nxt[0] == s:
+                break
+            seen.add(nxt[0])
+        out.append(np.array(chain, dtype=np.int64))
+    return out
+
+
+def _straight_sides(chain: np.ndarray, xy: np.ndarray) -> list:
+    """A boundary chain cut at its corners into straight sides."""
+    closed = chain.size > 2 and chain[0] == chain[-1]
+    p = xy[chain]
+    d = np.diff(p, axis=0)
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    if closed:
+        turn = np.r_[np.einsum("ij,ij->i", d[-1:], d[:1]), np.einsum("ij,ij->i", d[:-1], d[1:])]
+        corner = np.flatnonzero(turn < np.cos(np.radians(CORNER_DEG)))  # index into chain[:-1]
+        if corner.size == 0:
+            return [chain]
+        ring = chain[:-1]
+        ring = np.r_[ring[corner[0]:], ring[:corner[0]]]
+        cuts = np.r_[corner - corner[0], ring.size]
+        ring = np.r_[ring, ring[0]]
+        return [ring[a:b + 1] for a, b in zip(cuts[:-1], cuts[1:])]
+    turn = np.einsum("ij,ij->i", d[:-1], d[1:])
+    cuts = np.r_[0, 1 + np.flatnonzero(turn < np.cos(np.radians(CORNER_DEG))), chain.size - 1]
+    return [chain[a:b + 1] for a, b in zip(cuts[:-1], cuts[1:])]
+
+
+def _side_name(xy: np.ndarray, i: int) -> str:
+    for axis, label in ((0, "x"), (1, "y")):
+        if np.ptp(xy[:, axis]) < 1e-9:
+            return f"{label}={1e3 * xy[0, axis]:g}mm"
+    return f"side{i}"
+
+
+def _thickness(prop) -> float:
+    """Plate thickness from a shell property: t = sqrt(12 D11 / A11) (exact for a homogeneous plate)."""
+    return float(np.sqrt(12.0 * prop.bending()[0, 0] / prop.membrane()[0, 0]))
+
+
+def from_model(model, suspects=None, footprints=None, thickness: float | None = None) -> Layout:
+    """The layout of the shell sets of any fe.Model; boundary sides from the cell edges used once,
+    support lines from its edge-spring sets."""
+    shells = tuple(n for n, s in model.sets.items() if s.etype in SHELLS and len(s.conn))
+    if not shells:
+        raise ValueError("the model has no shell elements: candidate effects are placed on a plate")
+    e, count = np.unique(_edges([model.sets[n].conn for n in shells]), axis=0, return_counts=True)
+    xy = model.nodes[:, :2]
+    chains = [s for c in _chains(e[count == 1]) for s in _straight_sides(c, xy)]
+    chains += [c for n, s in model.sets.items() if s.etype == "edge_spring" for c in _chains(np.sort(s.conn, axis=1))]
+    sides: dict = {}
+    known: list = []
+    for i, c in enumerate(chains):
+        key = frozenset(c.tolist())
+        if key in known:
+            continue
+        known.append(key)
+        name = _side_name(xy[c], i)
+        sides[name if name not in sides else f"{name}#{i}"] = c
+    t = thickness if thickness is not None else _thickness(model.sets[shells[0]].prop)
+    return Layout(model, shells, sides, dict(suspects or {}), dict(footprints or {}), t)
+
+
+def from_board(bm) -> Layout:
+    """The layout of a :class:`pcbdyn.board.model.BoardModel`: measurement points (``points.*``) and
+    declared point masses (``masses.*``) are the prime suspects, part footprints the regions."""
+    suspects = {n: v for n, v in bm.point_nodes.items() if n.startswith(("points.", "masses."))}
+    footprints = {f"components.{c.ref}": c.corners() for c in bm.board.components}
+    return from_model(bm.model, suspects, footprints, bm.board.thickness)

@@ -1,0 +1,47 @@
+"""``line_mass``: a mass m [kg] spread uniformly along a boundary segment (a connector, a cable
+clamp, a bracket along an edge), lumped at the segment's nodes by tributary length on the three
+translations. M is linear in m (weights summing to one), K does not depend on it."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..fe import MassProperty
+from .catalogue import Blocks, chain_candidate, copy_model
+
+
+def _weights(xy: np.ndarray) -> np.ndarray:
+    """Tributary-length fractions of the nodes of a chain (sum 1)."""
+    L = np.linalg.norm(np.diff(xy, axis=0), axis=1)
+    w = np.r_[L, 0.0] + np.r_[0.0, L]
+    return w / w.sum()
+
+
+class _LineMass:
+    name = report_as = "line_mass"
+    param = "mass"
+    unit = "kg"
+    scale = 1e-2
+    lower = 0.0
+    options = ("segments",)
+
+    def generate(self, layout, segments: int = 4) -> list:
+        return [chain_candidate(self.name, layout, f"{side}[{i}]", chain)
+                for side, i, chain in layout.segments(segments)]
+
+    def blocks(self, model, candidates) -> list:
+        nodes = np.concatenate([c.nodes for c in candidates])
+        w = np.concatenate([_weights(model.nodes[c.nodes, :2]) for c in candidates])
+        Me = np.zeros((nodes.size, 6, 6))
+        Me[:, [0, 1, 2], [0, 1, 2]] = w[:, None]
+        owner = np.repeat(np.arange(len(candidates)), [c.nodes.size for c in candidates])
+        return [Blocks(nodes[:, None], np.zeros_like(Me), Me, owner)]
+
+    def apply(self, model, candidate, value: float):
+        m = copy_model(model)
+        for k, (n, w) in enumerate(zip(candidate.nodes, _weights(model.nodes[candidate.nodes, :2]))):
+            m.add(f"effects.{candidate.name}.{k}", "mass", [[int(n)]], MassProperty(value * w))
+        return m
+
+
+KIND = _LineMass()

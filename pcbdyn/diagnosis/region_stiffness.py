@@ -1,0 +1,164 @@
+"""``region_stiffness``: a relative change s (dimensionless) of the membrane, bending and shear
+stiffness of the shells in a region (a local thickness or modulus error, a part stiffening the
+board, a delamination when s < 0). The region's element stiffness becomes (1 + s) K_e and its mass is
+unchanged, so K is linear in s with dK/ds = the region's element stiffness, dM/ds = 0.
+A thickness change dt corresponds to s of about 3 dt / t in bending.
+
+A candidate holds its cells (node rows), not their properties: dK/ds and the added effect use the
+properties the cells have in the model they are applied to, so a region effect follows the
+declared parameters (board E, part thickness) when both are estimated together, and overlapping
+region effects add up.
+
+Candidates: a coarse grid of square patches of side ``patch`` [m] and every part footprint.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..fe.elements import kernel
+from .catalogue import Blocks, Candidate, copy_model
+
+
+@dataclass(frozen=True)
+class ScaledShell:
+    """A shell property whose stiffness is ``factor`` times that of ``base`` (mass unchanged)."""
+
+    base: object
+    factor: float
+
+    def membrane(self):
+        return self.factor * np.asarray(self.base.membrane())
+
+    def bending(self):
+        return self.factor * np.asarray(self.base.bending())
+
+    def shear(self):
+        return self.factor * np.asarray(self.base.shear())
+
+    def mass_per_area(self):
+        return self.base.mass_per_area()
+
+    def rotary_inertia_per_area(self):
+        return self.base.rotary_inertia_per_area()
+
+
+def _centroid(conns, xy) -> np.ndarray:
+    """Area centroid of a set of polygonal cells (shoelace formula per cell)."""
+    area, moment = 0.0, np.zeros(2)
+    for c in conns:
+        p, q = xy[c], xy[np.roll(c, -1, axis=1)]
+        cross = p[..., 0] * q[..., 1] - q[..., 0] * p[..., 1]
+        area += cross.sum() / 2.0
+        moment += np.einsum("cv,cvk->k", cross, p + q) / 6.0
+    return moment / area
+
+
+def _candidate(layout, label: str, polygon) -> Candidate | None:
+    """The shell cells whose centroid is in ``polygon``, as {etype: conn}."""
+    sets = layout.model.sets
+    found: dict = {}
+    for n, i in layout.cells_in(polygon):
+        found.setdefault(sets[n].etype, []).append(sets[n].conn[i])
+    if not found:
+        return None
+    cells = {etype: np.concatenate(c) for etype, c in found.items()}
+    nodes = np.unique(np.concatenate([c.ravel() for c in cells.values()]))
+    return Candidate("region_stiffness", f"region_stiffness@{label}", tuple(_centroid(list(cells.values()), layout.xy)),
+                     nodes, {"polygon": np.asarray(polygon, dtype=float)}, {"cells": cells})
+
+
+def _rows(a: np.ndarray) -> np.ndarray:
+    """Rows of an integer array as single comparable items."""
+    a = np.ascontiguousarray(a, dtype=np.int64)
+    return a.view(np.dtype((np.void, a.dtype.itemsize * a.shape[1]))).ravel()
+
+
+def _base(prop):
+    """(base property, present stiffness factor) of a set's property."""
+    return (prop.base, prop.factor) if isinstance(prop, ScaledShell) else (prop, 1.0)
+
+
+def _locate(model, etype: str, conn: np.ndarray):
+    """[(set name, mask over the set's cells, mask over ``conn``)] for the sets holding rows of ``conn``."""
+    keys = _rows(conn)
+    out, found = [], np.zeros(len(conn), dtype=bool)
+    for name, es in model.sets.items():
+        if es.etype != etype or not len(es.conn):
+            continue
+        rows = _rows(es.conn)
+        in_set = np.isin(rows, keys)
+        if in_set.any():
+            mine = np.isin(keys, rows[in_set])
+            found |= mine
+            out.append((name, in_set, mine))
+    if not found.all():
+        raise ValueError(f"{len(conn) - found.sum()} cells of a region are not in the model; "
+                         "generate the candidates on this model's mesh")
+    return out
+
+
+class _RegionStiffness:
+    name = report_as = "region_stiffness"
+    param = "stiffness_change"
+    unit = "1"
+    scale = 0.3
+    lower = -0.9
+    options = ("patch",)
+
+    def generate(self, layout, patch: float = 0.02) -> list:
+        if not patch > 0:
+            raise ValueError(f"patch must be > 0 m, got {patch}")
+        xy = layout.xy[layout.shell_nodes()]
+        lo, hi = xy.min(axis=0), xy.max(axis=0)
+        nx, ny = np.maximum(1, np.round((hi - lo) / patch)).astype(int)
+        gx, gy = np.linspace(lo[0], hi[0], nx + 1), np.linspace(lo[1], hi[1], ny + 1)
+        polys = [(f"patch[{i},{j}]", [[gx[i], gy[j]], [gx[i + 1], gy[j]], [gx[i + 1], gy[j + 1]], [gx[i], gy[j + 1]]])
+                 for j in range(ny) for i in range(nx)]
+        polys += list(layout.footprints.items())
+        return [c for label, poly in polys if (c := _candidate(layout, label, poly)) is not None]
+
+    def blocks(self, model, candidates) -> list:
+        """Element stiffness of the regions' cells with their base properties in ``model``; one
+        kernel call per (element type, property) over all candidates."""
+        out = []
+        for etype in {e for c in candidates for e in c.data["cells"]}:
+            parts = [(k, c.data["cells"][etype]) for k, c in enumerate(candidates) if etype in c.data["cells"]]
+            conn = np.concatenate([c for _, c in parts])
+            owner = np.repeat([k for k, _ in parts], [len(c) for _, c in parts])
+            for name, _, mine in _locate(model, etype, conn):
+                Ke, _ = kernel(etype)(model.nodes[conn[mine]], _base(model.sets[name].prop)[0])
+                out.append(Blocks(conn[mine], Ke, np.zeros_like(Ke), owner[mine]))
+        return out
+
+    def apply(self, model, candidate, value: float):
+        """The region's cells move out of their sets into ``effects.<name>...`` sets whose stiffness
+        is (f + value) times that of their base property, f being their present factor (1, or that
+        of an overlapping region effect added before); f + value must stay > 0."""
+        m = copy_model(model)
+        for etype, conn in candidate.data["cells"].items():
+            for name, in_set, _ in _locate(m, etype, conn):
+                es = m.sets[name]
+                base, f = _base(es.prop)
+                if not f + value > 0.0:
+                    raise ValueError(f"{candidate.name}: a stiffness change must leave the stiffness > 0 "
+                                     f"(change > {-f:g}), got {value}")
+                if in_set.all():
+                    del m.sets[name]
+                else:
+                    m.sets[name] = type(es)(es.name, es.etype, es.conn[~in_set], es.prop)
+                m.add(_fresh(m, f"effects.{candidate.name}.{name}"), etype, es.conn[in_set], ScaledShell(base, f + value))
+        return m
+
+
+def _fresh(model, name: str) -> str:
+    """``name``, or ``name#k`` when a set of that name exists."""
+    k, out = 1, name
+    while out in model.sets:
+        out, k = f"{name}#{k}", k + 1
+    return out
+
+
+KIND = _RegionStiffness()

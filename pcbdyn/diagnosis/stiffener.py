@@ -1,0 +1,89 @@
+"""``stiffener``: a rib along a straight path of nodes (a metal bar, a heat sink, a frame member
+bonded to the board), a beam whose axis is offset by (t + h) / 2 above the mid-surface.
+
+The parameter is its bending stiffness EI [N m^2] about the axis parallel to the board. To keep
+K and M linear in it, the rib has a fixed material and height h and only its width b varies
+(EI = E b h^3 / 12): area A = b h, Iy = Iz = b h^3 / 12 (its in-plane bending is negligible next
+to the board's membrane stiffness), J = b h^3 / 3 (thin strip), mass rho b h; every term is
+proportional to b, hence to EI. Defaults: aluminium (70 GPa, 2700 kg/m^3), h = 4 mm.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..fe import BeamProperty
+from ..fe.elements import kernel
+from .catalogue import Blocks, chain_candidate, copy_model
+
+
+@dataclass(frozen=True)
+class RibSection:
+    E: float = 70e9
+    nu: float = 0.33
+    rho: float = 2700.0
+    h: float = 4e-3
+
+    def prop(self, EI: float, plate_thickness: float) -> BeamProperty:
+        b = 12.0 * EI / (self.E * self.h**3)
+        I = b * self.h**3 / 12.0
+        return BeamProperty(self.E, self.nu, self.rho, b * self.h, I, I, 4.0 * I, orientation=(0.0, 0.0, 1.0),
+                            offset=(0.0, 0.0, 0.5 * (plate_thickness + self.h)))
+
+    def mass_per_length(self, EI: float) -> float:
+        return self.rho * 12.0 * EI / (self.E * self.h**2)
+
+
+class _Stiffener:
+    name = report_as = "stiffener"
+    param = "EI"
+    unit = "N*m^2"
+    scale = 1.0
+    lower = 0.0
+    options = ("path_spacing",)
+
+    def __init__(self, section: RibSection = RibSection()):
+        self.section = section
+
+    def generate(self, layout, path_spacing: float = 0.02) -> list:
+        """Full-span rows (along x) and columns (along y) of nodes every ``path_spacing`` [m]."""
+        if not path_spacing > 0:
+            raise ValueError(f"path_spacing must be > 0 m, got {path_spacing}")
+        xy = layout.xy[layout.shell_nodes()]
+        lo, hi = xy.min(axis=0), xy.max(axis=0)
+        out = []
+        for axis, label in ((1, "y"), (0, "x")):
+            n = max(1, int(round((hi[axis] - lo[axis]) / path_spacing)))
+            for v in lo[axis] + (np.arange(n) + 0.5) * (hi[axis] - lo[axis]) / n:
+                p0, p1 = lo.copy(), hi.copy()
+                p0[axis] = p1[axis] = v
+                chain = layout.node_path(p0, p1)
+                if chain.size > 1:
+                    c = chain_candidate(self.name, layout, f"{label}={1e3 * v:.4g}mm", chain, key="path")
+                    c.data["thickness"] = layout.thickness
+                    out.append(c)
+        return out
+
+    def blocks(self, model, candidates) -> list:
+        out = []
+        thick = np.array([c.data["thickness"] for c in candidates])
+        for t in np.unique(thick):  # one kernel call per plate thickness (it sets the offset)
+            ks = np.flatnonzero(thick == t)
+            edges = [candidates[k].data["edges"] for k in ks]
+            conn = np.concatenate(edges)
+            Ke, Me = kernel("beam2")(model.nodes[conn], self.section.prop(1.0, t))
+            out.append(Blocks(conn, Ke, Me, np.repeat(ks, [e.shape[0] for e in edges])))
+        return out
+
+    def apply(self, model, candidate, value: float):
+        if not value > 0:
+            raise ValueError(f"{candidate.name}: a stiffener's EI must be > 0 N m^2, got {value}")
+        m = copy_model(model)
+        m.add(f"effects.{candidate.name}", "beam2", candidate.data["edges"],
+              self.section.prop(value, candidate.data["thickness"]))
+        return m
+
+
+KIND = _Stiffener()

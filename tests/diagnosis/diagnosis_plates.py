@@ -1,0 +1,38 @@
+"""Small models shared by the diagnosis tests."""
+
+import numpy as np
+
+from pcbdyn.fe import Model, ShellProperty
+from pcbdyn.fe.generate import nodes_where, rectangle
+from pcbdyn.fe.modal import solve_modes
+
+A, B = 0.1, 0.08  # plate sides [m]
+PLATE = ShellProperty(E=20e9, nu=0.3, rho=1900.0, t=1.6e-3)
+N_MODES = 6
+
+
+def cantilever(nx=10, ny=8):
+    """A 100 x 80 x 1.6 mm plate clamped along x = 0 (small enough for the dense eigensolver)."""
+    nodes, conn = rectangle(A, B, nx, ny)
+    m = Model(nodes)
+    m.add("plate", "quad4", conn, PLATE)
+    m.fix(nodes_where(nodes, x=0.0))
+    return m
+
+
+def node_at(model, x, y):
+    return int(np.linalg.norm(model.nodes[:, :2] - [x, y], axis=1).argmin())
+
+
+def frequencies(model, n=N_MODES):
+    return solve_modes(model, n_modes=n).frequencies
+
+
+def total_mass(model, dof=2):
+    """r^T M r with r = 1 on one DOF of every node (dof 2: translational mass in z)."""
+    from pcbdyn.fe.assembly import assemble
+
+    _, M = assemble(model)
+    r = np.zeros(model.n_dof)
+    r[dof::6] = 1.0
+    return float(r @ (M @ r))

@@ -1,0 +1,167 @@
+"""The catalogue's effects: exact sensitivity columns, and physically right changes when added."""
+
+import numpy as np
+import pytest
+
+from pcbdyn import diagnosis as dg
+from pcbdyn.diagnosis import region_stiffness
+from pcbdyn.fe.modal import solve_modes
+
+from diagnosis_plates import A, B, N_MODES, cantilever, frequencies, node_at, total_mass
+
+
+@pytest.fixture(scope="module")
+def plate():
+    m = cantilever()
+    layout = dg.from_model(m, suspects={"points.exc": node_at(m, 0.07, 0.06)})
+    cands = dg.generate(layout, segments=3, patch=0.02, path_spacing=0.02)
+    modes = solve_modes(m, n_modes=N_MODES)
+    return m, layout, cands, modes, dg.frequency_columns(m, modes, cands)
+
+
+@pytest.mark.parametrize("kind", list(dg.KINDS))
+def test_frequency_column_equals_finite_difference_of_resolves(plate, kind):
+    """df_i/dp from phi_i^T (dK - lambda_i dM) phi_i (thesis eq. 3.11 with k = i) against re-solved models
+    carrying the effect at h and 2h (Richardson: error O(h^2)); the candidate tested is the one
+    of its kind with the largest column."""
+    m, _, cands, modes, cols = plate
+    idx = [i for i, c in enumerate(cands) if c.kind == kind]
+    assert idx, f"no {kind} candidate generated"
+    i = idx[int(np.argmax(np.linalg.norm(cols[:, idx], axis=0)))]
+    h = 1e-6 * dg.kind(kind).scale
+    f0 = modes.frequencies
+    d1 = frequencies(dg.add_effect(m, cands[i], h)) - f0
+    d2 = frequencies(dg.add_effect(m, cands[i], 2 * h)) - f0
+    fd = (4 * d1 - d2) / (2 * h)
+    assert np.max(np.abs(fd - cols[:, i])) < 1e-4 * np.max(np.abs(cols[:, i]))
+
+
+@pytest.mark.parametrize("kind", list(dg.KINDS))
+def test_derivative_matrices_are_the_added_effect(plate, kind):
+    """K(p) - K(0) = p dK/dp and M(p) - M(0) = p dM/dp exactly (the effects are linear in p)."""
+    from pcbdyn.fe.assembly import assemble
+
+    m, _, cands, _, _ = plate
+    c = next(c for c in cands if c.kind == kind)
+    p = 0.7 * dg.kind(kind).scale
+    K0, M0 = assemble(m)
+    K1, M1 = assemble(dg.add_effect(m, c, p))
+    dK, dM = dg.derivatives(m, c)
+    assert abs(K1 - K0 - p * dK).max() <= 1e-12 * abs(K0).max()
+    assert abs(M1 - M0 - p * dM).max() <= 1e-12 * abs(M0).max()
+    assert abs(dK).max() + abs(dM).max() > 0
+
+
+def test_point_mass_adds_exactly_its_mass_and_lowers_every_frequency(plate):
+    m, _, cands, modes, _ = plate
+    c = next(c for c in cands if c.kind == "point_mass" and c.prime)
+    heavy = dg.add_effect(m, c, 0.013)
+    assert total_mass(heavy) - total_mass(m) == pytest.approx(0.013, rel=1e-10)
+    f = frequencies(heavy)
+    assert np.all(f < modes.frequencies)
+    J = dg.add_effect(m, next(c for c in cands if c.kind == "point_inertia"), 2e-6)
+    assert total_mass(J, dof=3) - total_mass(m, dof=3) == pytest.approx(2e-6, rel=1e-8)
+    assert total_mass(J) == pytest.approx(total_mass(m), rel=1e-14)
+
+
+def test_ground_spring_at_the_antinode_raises_that_mode_and_lowers_none(plate):
+    m, _, cands, modes, _ = plate
+    phi_z = modes.shapes[2::6, 0]
+    node = int(np.argmax(np.abs(phi_z)))
+    c = next(c for c in cands if c.kind == "ground_spring" and c.nodes[0] == node)
+    f = frequencies(dg.add_effect(m, c, 1e4))
+    assert f[0] > 1.2 * modes.frequencies[0]
+    assert np.all(f >= modes.frequencies * (1 - 1e-12))
+
+
+def test_edge_stiffness_on_the_free_edge_tends_to_holding_its_rotation(plate):
+    """kr about the free edge x = a raises the modes; kr -> inf gives the plate whose rotation
+    about y is held along that edge. Candidates on the clamped edge x = 0 cannot act: dropped."""
+    m, layout, cands, modes, _ = plate
+    edge = [c for c in cands if c.kind == "edge_stiffness" and np.allclose(c.geometry["segment"][:, 0], A)]
+    assert len(edge) == 3
+    assert not [c for c in cands if c.kind == "edge_stiffness" and np.allclose(c.geometry["segment"][:, 0], 0.0)]
+    stiff = m
+    for c in edge:
+        stiff = dg.add_effect(stiff, c, 1e9)
+    held = dg.catalogue.copy_model(m)
+    held.fix(np.unique(np.concatenate([c.nodes for c in edge])), ("ry",))
+    f_stiff, f_held = frequencies(stiff), frequencies(held)
+    assert np.all(f_stiff > modes.frequencies)
+    assert np.max(np.abs(f_stiff / f_held - 1)) < 1e-3
+    assert f_held[0] > 1.05 * modes.frequencies[0]
+
+
+def test_region_stiffness_over_the_whole_plate_scales_frequencies_by_sqrt(plate):
+    """Stiffness times 1 + s with the mass unchanged: every frequency times sqrt(1 + s)."""
+    m, layout, _, modes, _ = plate
+    whole = region_stiffness._candidate(layout, "all", [[-1, -1], [1, -1], [1, 1], [-1, 1]])
+    f = frequencies(dg.add_effect(m, whole, 0.44))
+    assert f == pytest.approx(1.2 * modes.frequencies, rel=1e-9)
+    assert total_mass(dg.add_effect(m, whole, 0.44)) == pytest.approx(total_mass(m), rel=1e-14)
+    with pytest.raises(ValueError, match="must leave the stiffness > 0"):
+        dg.add_effect(m, whole, -1.0)
+
+
+def test_stiffener_along_the_span_adds_its_mass_and_stiffens_the_first_bending_mode(plate):
+    m, _, cands, modes, _ = plate
+    c = next(c for c in cands if c.kind == "stiffener" and np.ptp(c.geometry["path"][:, 1]) < 1e-12
+             and abs(c.at[1] - B / 2) < 0.011)
+    assert np.allclose(c.geometry["path"][[0, -1], 0], [0.0, A])
+    EI = 1.0
+    ribbed = dg.add_effect(m, c, EI)
+    mu = dg.kind("stiffener").section.mass_per_length(EI)
+    assert total_mass(ribbed) - total_mass(m) == pytest.approx(mu * A, rel=1e-10)
+    assert frequencies(ribbed)[0] > 1.1 * modes.frequencies[0]
+
+
+def test_line_mass_adds_exactly_its_mass_along_the_segment(plate):
+    m, _, cands, modes, _ = plate
+    c = next(c for c in cands if c.kind == "line_mass" and np.allclose(c.geometry["segment"][:, 0], A))
+    heavy = dg.add_effect(m, c, 0.02)
+    assert total_mass(heavy) - total_mass(m) == pytest.approx(0.02, rel=1e-10)
+    assert total_mass(heavy, dof=0) - total_mass(m, dof=0) == pytest.approx(0.02, rel=1e-10)
+    assert np.all(frequencies(heavy) < modes.frequencies)
+
+
+def test_unknown_kind_is_named():
+    with pytest.raises(dg.CatalogueError, match="unknown effect kind 'pointmass'.*point_mass"):
+        dg.kind("pointmass")
+
+
+def test_overlapping_region_effects_add_up(plate):
+    """A patch inside a stiffened whole plate: its cells get 1 + s_all + s_patch, the others
+    1 + s_all (K is linear in each), so the two effects together equal the sum of their dK."""
+    from pcbdyn.fe.assembly import assemble
+
+    m, layout, cands, _, _ = plate
+    whole = region_stiffness._candidate(layout, "all", [[-1, -1], [1, -1], [1, 1], [-1, 1]])
+    patch = next(c for c in cands if c.kind == "region_stiffness")
+    both = dg.add_effect(dg.add_effect(m, whole, 0.3), patch, -0.5)
+    K0, _ = assemble(m)
+    K2, _ = assemble(both)
+    expected = K0 + 0.3 * dg.derivatives(m, whole)[0] - 0.5 * dg.derivatives(m, patch)[0]
+    assert abs(K2 - expected).max() <= 1e-12 * abs(K0).max()
+    with pytest.raises(ValueError, match="must leave the stiffness > 0"):
+        dg.add_effect(both, patch, -0.9)
+
+
+def test_region_effect_follows_the_properties_of_the_model_it_is_applied_to(plate):
+    """Candidates made on one model act on the present properties of another with the same mesh:
+    a patch stiffened by s on a plate of modulus 2E equals the 2E plate plus s times its dK."""
+    from pcbdyn.fe.assembly import assemble
+
+    m, _, cands, _, _ = plate
+    patch = next(c for c in cands if c.kind == "region_stiffness")
+    stiffer = m.with_property("plate", E=2 * m.sets["plate"].prop.E)
+    K0, _ = assemble(stiffer)
+    K1, _ = assemble(dg.add_effect(stiffer, patch, 0.25))
+    dK_m, dK_stiffer = dg.derivatives(m, patch)[0], dg.derivatives(stiffer, patch)[0]
+    assert abs(K1 - K0 - 0.25 * dK_stiffer).max() <= 1e-12 * abs(K0).max()
+    assert abs(dK_stiffer - 2 * dK_m).max() <= 1e-12 * abs(dK_stiffer).max()
+
+
+def test_unknown_generation_option_is_named(plate):
+    _, layout, _, _, _ = plate
+    with pytest.raises(dg.CatalogueError, match="unknown option.*spacng.*spacing"):
+        dg.generate(layout, kinds=["point_mass"], spacng=0.01)

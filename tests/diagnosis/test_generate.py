@@ -1,0 +1,140 @@
+"""Candidate generation on a board built from board.toml: the right places."""
+
+import numpy as np
+import pytest
+
+from pcbdyn import diagnosis as dg
+from pcbdyn.board import build_model, load_board
+
+W, H = 0.1, 0.08
+BOARD = '''
+points = [["70 mm", "55 mm"], ["20 mm", "20 mm"], ["50 mm", "40 mm"]]
+
+[board]
+name = "diagnosis test card"
+outline = { width = "100 mm", height = "80 mm" }
+thickness = "1.6 mm"
+material = { E = "22 GPa", nu = 0.15, rho = "1850 kg/m^3" }
+mesh_size = "8 mm"
+
+[[components]]
+ref = "U1"
+at = ["35 mm", "40 mm"]
+size = ["24 mm", "16 mm"]
+mass = "6 g"
+model = "equivalent_thickness"
+thickness = "3 mm"
+
+[[fixtures]]
+name = "left"
+type = "wedge_lock"
+edge = "x=0"
+k_rot = "1e3 N*m/rad/m"
+
+[[fixtures]]
+name = "right"
+type = "wedge_lock"
+edge = "x=100 mm"
+width = "5 mm"
+k_rot = "1e3 N*m/rad/m"
+
+[[masses]]
+name = "tx"
+at = ["88 mm", "12 mm"]
+mass = "3 g"
+'''
+
+
+@pytest.fixture(scope="module")
+def board(tmp_path_factory):
+    path = tmp_path_factory.mktemp("b") / "board.toml"
+    path.write_text(BOARD)
+    bm = build_model(load_board(path))
+    layout = dg.from_board(bm)
+    return bm, layout, dg.generate(layout, segments=4, spacing=0.01, patch=0.025, path_spacing=0.02)
+
+
+def of(cands, kind):
+    return [c for c in cands if c.kind == kind]
+
+
+def test_points_and_declared_masses_are_prime_point_mass_candidates(board):
+    bm, layout, cands = board
+    for name in ("points.1", "points.2", "points.3", "masses.tx"):
+        node = bm.point_nodes[name]
+        hits = [c for c in of(cands, "point_mass") if c.nodes[0] == node]
+        assert len(hits) == 1 and hits[0].prime and hits[0].name == f"point_mass@{name}"
+        assert np.allclose(hits[0].at, bm.model.nodes[node, :2])
+    exc = next(c for c in of(cands, "point_mass") if c.name == "point_mass@points.1")
+    assert exc.describe()["at_mm"] == pytest.approx([70.0, 55.0], abs=1e-6)
+    assert exc.describe()["type"] == "point_mass" and exc.describe()["unit"] == "kg"
+
+
+def test_point_grid_covers_the_board_at_the_spacing(board):
+    _, layout, cands = board
+    xy = np.array([c.at for c in of(cands, "ground_spring")])
+    assert len(xy) >= 0.8 * (W / 0.01) * (H / 0.01) * 0.95
+    # the right guide holds the strip x > 95 mm: no candidate acts there
+    probe = np.stack(np.meshgrid(np.linspace(0.005, 0.09, 10), np.linspace(0.005, 0.075, 8)), -1).reshape(-1, 2)
+    assert np.linalg.norm(probe[:, None] - xy[None], axis=2).min(axis=1).max() < 0.01
+
+
+def test_edge_segments_lie_on_the_outline_or_a_support_line_and_cover_each_edge(board):
+    bm, layout, cands = board
+    segs = of(cands, "edge_stiffness")
+    lines = {"x": (0.0, W, W - 0.005), "y": (0.0, H)}
+    for c in segs:
+        xy = bm.model.nodes[c.nodes, :2]
+        on_x = any(np.allclose(xy[:, 0], v, atol=1e-9) for v in lines["x"])
+        on_y = any(np.allclose(xy[:, 1], v, atol=1e-9) for v in lines["y"])
+        assert on_x or on_y, c.name
+        assert c.data["length"] > 0
+    left = [c for c in segs if np.allclose(c.geometry["segment"][:, 0], 0.0)]
+    assert len(left) == 4
+    assert sum(c.data["length"] for c in left) == pytest.approx(H, rel=1e-9)
+    inner = [c for c in segs if np.allclose(c.geometry["segment"][:, 0], W - 0.005)]
+    assert len(inner) == 4  # the right guide acts on the inner line of its 5 mm strip
+    assert not [c for c in segs if np.allclose(c.geometry["segment"][:, 0], W)]  # held strip: dropped
+    free = [c for c in segs if np.allclose(c.geometry["segment"][:, 1], 0.0)]
+    assert len(free) == 4
+    lm = of(cands, "line_mass")
+    assert {c.name.split("@")[1] for c in lm} < {c.name.split("@")[1] for c in segs}
+    # a mass on a guide line whose translations are held does nothing: only free edges remain
+    assert {round(float(c.geometry["segment"][0, 1]), 9) for c in lm} == {0.0, H}
+    assert len(lm) == 8 and all(np.ptp(c.geometry["segment"][:, 1]) == 0 for c in lm)
+
+
+def test_each_part_footprint_is_a_region_candidate(board):
+    bm, layout, cands = board
+    c = next(c for c in of(cands, "region_stiffness") if c.name == "region_stiffness@components.U1")
+    assert c.at == pytest.approx((0.035, 0.04), abs=1e-9)  # area centroid of the footprint's cells
+    cells = c.data["cells"]["quad4"]  # the footprint's cells and only those
+    assert sorted(map(tuple, np.sort(cells, axis=1))) == sorted(map(tuple, np.sort(
+        bm.model.sets["components.U1"].conn, axis=1)))
+    patches = [c for c in of(cands, "region_stiffness") if "patch" in c.name]
+    assert len(patches) == 4 * 3
+
+
+def test_stiffener_paths_follow_rows_and_columns(board):
+    bm, layout, cands = board
+    paths = of(cands, "stiffener")
+    assert len(paths) == 4 + 5
+    for c in paths:
+        p = c.geometry["path"]
+        axis = 1 if "@y=" in c.name else 0
+        assert np.ptp(p[:, axis]) < 0.8 * 0.008 * 2  # within about one element of the line
+        span = (W, H)[1 - axis]
+        assert np.ptp(p[:, 1 - axis]) > span - 0.008
+
+
+def test_columns_of_the_board_candidates_are_finite_and_the_prime_suspect_matters(board):
+    from pcbdyn.fe.modal import solve_modes
+
+    bm, layout, cands = board
+    modes = solve_modes(bm.model, n_modes=6)
+    cols = dg.frequency_columns(bm.model, modes, cands)
+    assert cols.shape == (6, len(cands)) and np.all(np.isfinite(cols))
+    pm = [i for i, c in enumerate(cands) if c.kind == "point_mass"]
+    assert np.all(cols[:, pm] <= 1e-12)  # a mass never raises a frequency
+    gs = [i for i, c in enumerate(cands) if c.kind in ("ground_spring", "edge_stiffness", "region_stiffness")]
+    assert np.all(cols[:, gs] >= -1e-9 * np.abs(cols[:, gs]).max())

@@ -1,0 +1,83 @@
+"""First selection on synthetic data: a hidden effect is found from frequency residuals, and
+noise alone gives none."""
+
+import numpy as np
+import pytest
+
+from pcbdyn import diagnosis as dg
+from pcbdyn.diagnosis.select import forward_select
+from pcbdyn.fe import EdgeSpringProperty, MassProperty, Model, ShellProperty
+from pcbdyn.fe.generate import nodes_where, rectangle
+from pcbdyn.fe.modal import solve_modes
+
+N_MODES, SIGMA = 8, 0.002  # 8 paired modes, 0.2 % frequency noise
+NX, NY = 12, 14  # elements of the 160 x 180 mm card: about 13 mm
+H = np.hypot(0.16 / NX, 0.18 / NY)  # element diagonal [m]
+
+
+def nearest(model, x, y):
+    return int(np.linalg.norm(model.nodes[:, :2] - [x, y], axis=1).argmin())
+
+
+@pytest.fixture(scope="module")
+def card():
+    """A 160 x 180 x 2.8 mm card in two guides (x = 0 and x = 160 mm, kr = 300 N m/rad/m) carrying
+    a declared 30 g mass off-centre (it breaks the mirror symmetries that frequencies alone cannot
+    resolve), with candidates of every kind."""
+    nodes, conn = rectangle(0.16, 0.18, NX, NY)
+    m = Model(nodes)
+    m.add("plate", "quad4", conn, ShellProperty(26e9, 0.3, 2640.0, 2.8e-3))
+    for x in (0.0, 0.16):
+        e = nodes_where(nodes, x=x)
+        m.fix(e, ("ux", "uy", "uz", "rx", "rz"))
+        m.add(f"guide{x}", "edge_spring", np.c_[e[:-1], e[1:]], EdgeSpringProperty(k=(0, 0, 0, 300.0, 0, 0)))
+    m.add("declared", "mass", [[nearest(m, 0.12, 0.05)]], MassProperty(0.03))
+    layout = dg.from_model(m, suspects={"points.exc": nearest(m, 0.04, 0.13)})
+    return m, dg.generate(layout, segments=3, patch=0.04, path_spacing=0.04)
+
+
+def nearest_candidate(cands, kind, xy):
+    return min((c for c in cands if c.kind == kind), key=lambda c: np.hypot(c.at[0] - xy[0], c.at[1] - xy[1]))
+
+
+def measured(model, effect, value, seed):
+    f = solve_modes(dg.add_effect(model, effect, value) if effect else model, n_modes=N_MODES).frequencies
+    return f * (1.0 + SIGMA * np.random.default_rng(seed).standard_normal(f.size))
+
+
+def test_hidden_transducer_mass_at_the_excitation_point_is_found(card):
+    m, cands = card
+    hidden = next(c for c in cands if c.name == "point_mass@points.exc")
+    sel = forward_select(m, cands, measured(m, hidden, 0.013, seed=1), SIGMA)
+    assert [cands[i].name for i in sel.chosen] == ["point_mass@points.exc"]
+    assert sel.values[0] == pytest.approx(0.013, rel=0.05)
+    assert sel.chi2[-1] < 3 * N_MODES  # what remains is noise
+
+
+@pytest.mark.parametrize("kind, xy, value", [
+    ("point_mass", (0.11, 0.15), 0.013),  # a 13 g transducer away from the declared points
+    ("point_mass", (0.07, 0.04), 0.013),
+    ("region_stiffness", (0.06, 0.06), 0.5),  # +50 % stiffness over a 40 mm patch
+    ("stiffener", (0.08, 0.11), 0.5),  # a rib across the card
+    ("line_mass", (0.08, 0.18), 0.02),  # a 20 g connector along the top edge
+])
+def test_hidden_effect_is_found_with_its_kind_place_and_magnitude(card, kind, xy, value):
+    """Right kind, within one element (the issue's 15 mm), magnitude within 30 %. (Ground springs
+    and edge stiffness are not here: from 8 frequencies alone they are placed right only for some
+    noise draws; they need the mode shapes.)"""
+    m, cands = card
+    hidden = nearest_candidate(cands, kind, xy)
+    sel = forward_select(m, cands, measured(m, hidden, value, seed=3), SIGMA)
+    assert len(sel.chosen) == 1
+    found = cands[sel.chosen[0]]
+    assert found.kind == kind
+    assert np.hypot(found.at[0] - hidden.at[0], found.at[1] - hidden.at[1]) <= H * 1.001
+    assert sel.values[0] == pytest.approx(value, rel=0.3)
+    assert sel.chi2[-1] < 3 * N_MODES  # what remains is noise
+
+
+@pytest.mark.parametrize("seed", [4, 5, 6])
+def test_noise_alone_gives_no_effect(card, seed):
+    m, cands = card
+    sel = forward_select(m, cands, measured(m, None, 0.0, seed=seed), SIGMA)
+    assert sel.chosen == []
