@@ -1,0 +1,152 @@
+"""``pcbdyn update board.toml test.uff [c2=test2.uff ...]``: sensitivity-based updating of the board's
+[[parameters]] against one or more test configurations (thesis ch. 3, 4, 6): parameter table,
+before/after correlation, iteration plots, board.updated.toml and JSON.
+
+With ``--frequencies FILE.csv`` (columns configuration, mode, frequency_hz; configuration c1 or
+base = the base configuration, other names = [[configurations]]) only frequencies are used
+(method freq) and test mode n is paired with elastic model mode n (pairing by order).
+With UFF shapes, pairing is by MAC; QMS/FBM equations are built per measured mode on the model
+condensed dynamically onto the measured DOFs at that mode's frequency (see
+:meth:`pcbdyn.updating.board_problem.BoardProblem.mode_configurations`); the before/after tables
+always come from full-model solves.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+import numpy as np
+
+from .common import done, fail, step
+
+BASE_NAMES = ("base", "c1", "")
+#: SI unit of the JSON values for the display units board.toml quantities use (others are SI already)
+SI_UNITS = {"mm": "m", "g": "kg"}
+
+
+def parse_extra(items) -> list:
+    """NAME=FILE pairs -> [(name, Path)]."""
+    out = []
+    for it in items:
+        name, sep, path = it.partition("=")
+        if not sep or not name or not path:
+            raise click.BadParameter(f"'{it}' is not NAME=FILE (e.g. c2=test2.uff)", param_hint="CONFIGS")
+        if not Path(path).exists():
+            raise click.BadParameter(f"'{path}' does not exist", param_hint="CONFIGS")
+        out.append((name, Path(path)))
+    return out
+
+
+def read_frequency_table(path: Path, board) -> list:
+    """[(configuration or None, MeasuredModes)] from a CSV of measured frequencies."""
+    import pandas as pd
+
+    from ..updating.board_problem import MeasuredModes
+
+    df = pd.read_csv(path, comment="#")
+    need = {"configuration", "mode", "frequency_hz"}
+    if not need <= set(df.columns):
+        raise click.BadParameter(f"{path}: needs columns {sorted(need)}, found {list(df.columns)}",
+                                 param_hint="--frequencies")
+    out = []
+    known = [c.name for c in board.configurations]
+    for name, g in df.groupby("configuration", sort=False):
+        cfg = None if str(name) in BASE_NAMES else str(name)
+        if cfg is not None and cfg not in known:
+            raise click.BadParameter(f"{path}: configuration '{name}' is not in {board.path.name} "
+                                     f"(known: base/c1, {', '.join(known) or 'none'})", param_hint="--frequencies")
+        out.append((cfg, MeasuredModes(g["frequency_hz"].to_numpy(float), mode_numbers=g["mode"].to_numpy(int))))
+    return out
+
+
+@click.command("update")
+@click.argument("board_toml", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.argument("test_uff", required=False, type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.argument("configs", nargs=-1)
+@click.option("--frequencies", "freq_csv", type=click.Path(exists=True, dir_okay=False, path_type=Path), default=None,
+              help="CSV of measured frequencies (configuration, mode, frequency_hz) instead of UFF files; "
+                   "pairs by mode order")
+@click.option("--method", type=click.Choice(["freq", "fbm", "qms", "frf-in", "frf-out"]), default="freq",
+              show_default=True)
+@click.option("--solver", type=click.Choice(["ls", "tls", "bayes", "bounded"]), default="bounded", show_default=True)
+@click.option("--params", default=None, help="comma-separated parameter names (default: all [[parameters]])")
+@click.option("--max-iter", type=click.IntRange(min=1), default=20, show_default=True)
+@click.option("--tol", "tol_pct", type=float, default=0.1, show_default=True,
+              help="stop when the max frequency error is below this percentage (eq. 7.2)")
+@click.option("--mesh-size", default=None, help="override board.mesh_size, e.g. '10 mm'")
+@click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=None,
+              help="folder for the iteration plot and tables")
+@click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None)
+def command(board_toml, test_uff, configs, freq_csv, method, solver, params, max_iter, tol_pct, mesh_size, out,
+            json_path):
+    """Update a board model's parameters against modal tests (UFF) or measured frequencies (CSV)."""
+    from ..board import BoardError, load_board
+    from ..report import update_report as rep
+    from ..report.files import write_json, write_text
+    from ..testdata import TestDataError
+    from ..units import to_si
+    from ..updating.board_problem import BoardProblem, MeasuredModes, run
+    from .correlate import load_test_modes
+
+    if method.startswith("frf"):
+        fail(f"--method {method}: FRF-based updating of boards from UFF FRFs is not wired into the command yet; "
+             "use freq, fbm or qms")
+    if (test_uff is None) == (freq_csv is None):
+        fail("give either TEST_UFF (and NAME=FILE for other configurations) or --frequencies FILE.csv")
+    if freq_csv is not None and method != "freq":
+        fail("--frequencies holds no shapes: use --method freq")
+    try:
+        board = load_board(board_toml)
+        ms = to_si(mesh_size, "mm", "--mesh-size") if mesh_size else None
+        t0 = step("building the models")
+        problem = BoardProblem(board, params.split(",") if params else None, mesh_size=ms)
+        if freq_csv is not None:
+            data = read_frequency_table(freq_csv, board)
+            click.echo("frequencies only: test mode n is paired with elastic model mode n (by order)", err=True)
+        else:
+            data = [(None, MeasuredModes.from_test(load_test_modes(test_uff)))]
+            for name, path in parse_extra(configs):
+                if board.configuration(name) is None:
+                    raise BoardError(f"{board_toml.name}: configuration '{name}' (from {name}={path}) is not in "
+                                     "[[configurations]]")
+                data.append((name, MeasuredModes.from_test(load_test_modes(path))))
+            if method == "freq":
+                data = [(c, MeasuredModes(m.frequencies, m.shapes, m.xyz, m.directions)) for c, m in data]
+        check = [problem.configuration(c, m, "freq") for c, m in data]
+        cfgs = check if method == "freq" else [q for c, m in data for q in problem.mode_configurations(c, m, method)]
+        done(t0)
+        t0 = step(f"updating {len(problem.names)} parameter(s) with {method}/{solver} over {len(cfgs)} configuration(s)")
+        res, before, after = run(problem, cfgs, solver, check=check, max_iter=max_iter, tol_freq_pct=tol_pct)
+        done(t0)
+    except (BoardError, TestDataError, KeyError, ValueError) as exc:
+        fail(str(exc))
+    rows = rep.parameter_rows(problem, res.p)
+    click.echo(f"\n{board.name}: {res.reason} after {res.iterations} iteration(s) "
+               f"({'converged' if res.converged else 'not converged'}; best iterate {res.best_iteration})")
+    click.echo(rep.format_parameters(rows))
+    click.echo("")
+    click.echo(rep.format_correlation(before, after))
+    dst = rep.write_updated_board(board_toml, board, problem, res.p)
+    click.echo(f"\nupdated board written to {dst}", err=True)
+    if out is not None:
+        rep.plot_iterations(out / "iterations.png", problem, res)
+        write_text(out / "parameters.txt", rep.format_parameters(rows) + "\n")
+        write_text(out / "correlation.txt", rep.format_correlation(before, after) + "\n")
+    if json_path is not None:
+        def summary(states):
+            return {"max_freq_error_pct": max(s["max_freq_error_pct"] for s in states),
+                    "configurations": states, "pairs": [q for s in states for q in s["pairs"]]}
+
+        write_json(json_path, {
+            "parameters": {r["name"]: {"initial": float(v0), "updated": float(v), "unit": SI_UNITS.get(r["unit"], r["unit"]),
+                                       "display_unit": r["unit"], "change_pct": r["change_pct"],
+                                       "bound_hit": r["bound_hit"]}
+                           for r, v0, v in zip(rows, problem.p0, res.p)},
+            "before": summary(before), "after": summary(after), "iterations": res.iterations,
+            "converged": bool(res.converged), "reason": res.reason, "method": method, "solver": solver,
+            "history": [{"iteration": h["iteration"], "p": np.asarray(h["p"]).tolist(),
+                         "max_freq_error_pct": h["max_freq_error_pct"], "condition_stacked": h["condition_stacked"],
+                         "rank": h.get("rank")} for h in res.history],
+            "updated_board": str(dst),
+        })
