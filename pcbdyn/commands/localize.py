@@ -1,0 +1,157 @@
+"""``pcbdyn localize board.toml test.uff [c2=test2.uff ...] --method tls-qrf [--json PATH]``:
+which of the board's ``[[parameters]]`` carry the model errors (thesis ch. 5).
+
+The measured modes of each test configuration are paired with the model's, the weighted
+updating equations of all configurations are stacked (PBC, eq. 6.4) and a subset of the
+parameters is selected (TLS/QR-F by default, section 5.2.3), with the evidence: selection order,
+residue descending ratios (eq. 5.60), subset solution, the epsilon-condition curve and rank, and
+the section 5.2.3 check whether the parameters can explain the data at all. With ``--out``, the
+evidence figure (as thesis Fig. 5.13) and an FBM map of the base configuration (eq. 5.2) are drawn.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+import numpy as np
+
+from .common import done, fail, step
+
+METHOD_CHOICES = ["tls-qrf", "svd-qr", "qr", "min-norm"]
+
+
+def parse_extra(items) -> list:
+    """'name=path' arguments -> [(configuration name, Path)]."""
+    out = []
+    for item in items:
+        name, sep, path = item.partition("=")
+        if not sep or not name or not path:
+            raise click.BadParameter(f"'{item}' is not name=path.uff (a configuration of board.toml and its test)",
+                                     param_hint="CONFIG_TESTS")
+        if not Path(path).is_file():
+            raise click.BadParameter(f"'{path}' does not exist", param_hint="CONFIG_TESTS")
+        out.append((name, Path(path)))
+    return out
+
+
+def evidence(method, A, b, names, rank=None, alpha=0.8) -> tuple:
+    """(dict for JSON, the TLS/QR-F Subset). The 5.2.3 check, condition curve and rank always come
+    from TLS/QR-F; selection and solution from ``method``."""
+    from ..updating.study import localise
+    from ..updating.subset import tls_qrf
+
+    r = None if rank is None else (rank if rank >= 0 else A.shape[1] + rank)
+    tls = tls_qrf(A, b, rank=r, alpha=alpha)
+    if method == "tls-qrf":
+        sel, order, ratios = tls.selected, tls.order, tls.descending_ratio
+    else:
+        sel, order, ratios = localise(method, A, b, rank), np.zeros(0, int), np.zeros(0)
+    x = np.zeros(A.shape[1])
+    if sel.size:
+        x[sel] = np.linalg.lstsq(A[:, sel], b, rcond=None)[0]
+    data = {
+        "method": method,
+        "selected": [names[i] for i in sel],
+        "order": [names[i] for i in order],
+        "descending_ratio": [float(v) for v in ratios],
+        "solution": {names[i]: float(x[i]) for i in sel},
+        "rank": int(tls.rank),
+        "condition_curve": [float(v) if np.isfinite(v) else None for v in tls.condition_curve],
+        "explains_data": bool(tls.explains_data),
+        "out_of_range_pct": 100.0 * float(tls.out_of_range),
+        "message": tls.message,
+    }
+    return data, tls
+
+
+def fbm_map(path, cfg, state, xy):
+    """FBM residual forces (eq. 5.2) of the base configuration's measured modes: the shapes are
+    expanded to the model (eq. 2.25), the residuals read back at the measured points (the
+    expansion leaves none elsewhere), scaled per mode to a maximum of 1, summed over the modes
+    and drawn over the measured points (as thesis Fig. 5.1, on the board)."""
+    from ..report.localisation_plots import save_map
+    from ..updating import matching
+    from ..updating.indicators import fbm_residuals
+
+    K, M, used = state["K"], state["M"], state["used"]
+    om = 2 * np.pi * np.asarray(cfg.f_x, float)[used]
+    phi = matching.expand(K, M, cfg.P, np.asarray(cfg.phi_x)[:, used], om)
+    res = np.abs(np.asarray(cfg.P @ fbm_residuals(K, M, om, phi)))
+    peak = res.max(axis=0)
+    values = (res / np.where(peak > 0, peak, 1.0)).sum(axis=1)
+    save_map(path, xy, None, values, "FBM residual forces at the test points (eq. 5.2)")
+    return values
+
+
+@click.command("localize")
+@click.argument("board_toml", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.argument("test_uff", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.argument("config_tests", nargs=-1)
+@click.option("--method", type=click.Choice(METHOD_CHOICES), default="tls-qrf", show_default=True,
+              help="subset selection: TLS/QR-F (5.2.3), SVD/QR (5.2.2), QR basic solution, minimum-norm LS")
+@click.option("--equations", "eq_type", type=click.Choice(["qms", "fbm", "freq", "freq-rel"]), default="qms",
+              show_default=True, help="updating equations from the measured modes")
+@click.option("--params", default=None, help="comma-separated parameter names (default: all [[parameters]])")
+@click.option("--rank", type=int, default=None, help="numerical rank (k, or -k = n_params - k); default automatic")
+@click.option("--alpha", type=float, default=0.8, show_default=True, help="backward exclusion factor (eq. 5.62)")
+@click.option("--matching", type=click.Choice(["reduce", "expand"]), default="reduce", show_default=True,
+              help="Guyan-reduce the model to the measured DOFs, or expand the measured shapes")
+@click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=None,
+              help="folder for the evidence figure and the FBM map (PNG)")
+@click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None)
+def command(board_toml, test_uff, config_tests, method, eq_type, params, rank, alpha, matching, out, json_path):
+    """Localise model errors among the board's parameters from one or more modal tests
+    (extra tests as CONFIG=test.uff for configurations of board.toml)."""
+    from ..board import load_board
+    from ..report.files import write_json
+    from ..testdata import TestDataError
+    from ..updating.board_problem import BoardProblem, MeasuredModes, config_pairing
+    from ..updating.iteration import build_equations
+    from .correlate import load_test_modes
+
+    extra = parse_extra(config_tests)
+    try:
+        board = load_board(board_toml)
+        names = [n.strip() for n in params.split(",")] if params else None
+        t0 = step("building the model and its parameter derivatives")
+        problem = BoardProblem(board, names)
+        known = {c.name for c in board.configurations}
+        configs = []
+        for name, path in [(None, test_uff)] + extra:
+            if name is not None and name not in known:
+                raise ValueError(f"configuration '{name}' is not in [[configurations]] of {board_toml.name} "
+                                 f"(known: {', '.join(sorted(known)) or 'none'})")
+            measured = MeasuredModes.from_test(load_test_modes(path))
+            if eq_type in ("qms", "fbm") and measured.shapes is None:
+                raise ValueError(f"{path.name}: --equations {eq_type} needs mode shapes")
+            configs.append(problem.configuration(name, measured, eq_type, matching=matching))
+            if name is None:
+                measured_xy = None if measured.xyz is None else measured.xyz[:, :2]
+        (A, b), _, states = build_equations(configs, problem.p0, config_pairing(configs))
+        done(t0)
+    except (ValueError, KeyError, TestDataError) as exc:
+        fail(str(exc).strip("'\""))
+    data, tls = evidence(method, A, b, problem.names, rank, alpha)
+    data["configurations"] = ["base"] + [n for n, _ in extra]
+    data["equations"] = eq_type
+    click.echo(f"\n{board.name}: {len(problem.names)} parameters, {A.shape[0]} equations ({eq_type}), "
+               f"rank {data['rank']}; method {method}")
+    if data["order"]:
+        click.echo("selection order: " + ", ".join(f"{n} ({r:.1f} %)" for n, r in
+                                                    zip(data["order"], data["descending_ratio"])))
+    click.echo("selected: " + (", ".join(f"{n} {100 * v:+.1f} %" for n, v in data["solution"].items()) or "none"))
+    if not data["explains_data"]:
+        click.echo("warning: " + data["message"])
+    if out is not None:
+        from ..report.localisation_plots import localisation_figure
+
+        out.mkdir(parents=True, exist_ok=True)
+        localisation_figure(out / "localisation.png", tls, problem.names)
+        if eq_type in ("qms", "fbm") and measured_xy is not None:
+            fbm = fbm_map(out / "fbm_map.png", configs[0], states[0], measured_xy)
+            data["fbm_peak_mm"] = [1e3 * float(v) for v in measured_xy[int(np.argmax(fbm))]]
+        drawn = ", fbm_map.png" if "fbm_peak_mm" in data else ""
+        click.echo(f"wrote {out}/localisation.png{drawn}", err=True)
+    if json_path is not None:
+        write_json(json_path, data)

@@ -1,0 +1,140 @@
+"""Pictures of error localisation: indicator maps on the board, the epsilon-condition-number
+curve used to choose the rank (thesis Fig. 5.13a), the selection order and descending ratios
+(Figs. 5.5, 5.6) and success-ratio charts (Fig. 5.14)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _triangles(cells):
+    cells = np.asarray(cells, int)
+    if cells.shape[1] == 3:
+        return cells
+    return np.vstack([cells[:, [0, 1, 2]], cells[:, [0, 2, 3]]])
+
+
+def node_map(ax, xy, cells, values, title: str = "", cmap: str = "viridis"):
+    """Node values over the mesh (quads split in two triangles, Gouraud shading); ``cells`` None
+    triangulates the points (Delaunay), e.g. for test points. xy in m, drawn in mm. Returns the
+    mappable for a colour bar."""
+    import matplotlib.tri as mtri
+
+    xy = np.asarray(xy, float)[:, :2] * 1e3
+    tri = mtri.Triangulation(xy[:, 0], xy[:, 1], None if cells is None else _triangles(cells))
+    m = ax.tripcolor(tri, np.asarray(values, float), shading="gouraud", cmap=cmap)
+    ax.triplot(tri, color="0.6", lw=0.3)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [mm]")
+    ax.set_ylabel("y [mm]")
+    ax.set_title(title)
+    return m
+
+
+def element_map(ax, xy, cells, values, title: str = "", cmap: str = "viridis"):
+    """One value per cell (e.g. a localised thickness change) as filled polygons."""
+    from matplotlib.collections import PolyCollection
+
+    xy = np.asarray(xy, float)[:, :2] * 1e3
+    pc = PolyCollection([xy[c] for c in np.asarray(cells, int)], array=np.asarray(values, float), cmap=cmap,
+                        edgecolors="0.5", linewidths=0.3)
+    ax.add_collection(pc)
+    ax.autoscale_view()
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [mm]")
+    ax.set_ylabel("y [mm]")
+    ax.set_title(title)
+    return pc
+
+
+def save_map(path, xy, cells, values, title: str, per: str = "node") -> Path:
+    """Write one map (``per`` 'node' or 'element') with a colour bar to ``path`` (PNG)."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(5.5, 5))
+    m = (node_map if per == "node" else element_map)(ax, xy, cells, values, title)
+    fig.colorbar(m, ax=ax)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return Path(path)
+
+
+def condition_curve_plot(ax, curve, rank: int | None = None):
+    """Trial epsilon-condition number sigma_1 / sigma_r vs r (thesis eq. 4.21, Fig. 5.13a),
+    with the chosen rank marked."""
+    c = np.asarray(curve, float)
+    r = np.arange(1, c.size + 1)
+    ok = np.isfinite(c)
+    ax.semilogy(r[ok], c[ok], "o-", ms=3)
+    if rank:
+        ax.axvline(rank, color="C3", ls="--", label=f"rank {rank}")
+        ax.legend()
+    ax.set_xlabel("trial rank r")
+    ax.set_ylabel("k2(A) at rank r")
+    ax.set_title("epsilon-condition number")
+
+
+def localisation_figure(path, subset, names) -> Path:
+    """Four panels of one localisation (as thesis Fig. 5.13): condition curve, selection order,
+    residue descending ratios and the subset solution."""
+    plt = _pyplot()
+    fig, axs = plt.subplots(2, 2, figsize=(10, 7))
+    condition_curve_plot(axs[0, 0], subset.condition_curve, subset.rank)
+    order = np.asarray(subset.order)
+    axs[0, 1].plot(np.arange(1, order.size + 1), order + 1, "o")
+    axs[0, 1].set_xlabel("selection order")
+    axs[0, 1].set_ylabel("parameter number")
+    axs[0, 1].set_title("selection order (Fig. 5.5)")
+    if len(subset.descending_ratio):
+        axs[1, 0].bar(np.arange(1, len(subset.descending_ratio) + 1), subset.descending_ratio)
+    axs[1, 0].set_xlabel("selection order")
+    axs[1, 0].set_ylabel("dRr [%]")
+    axs[1, 0].set_title("residue descending ratio (eq. 5.60)")
+    axs[1, 1].bar(np.arange(1, len(subset.x) + 1), subset.x)
+    for i in subset.selected:
+        axs[1, 1].annotate(names[i], (i + 1, subset.x[i]), fontsize=7, ha="center")
+    axs[1, 1].set_xlabel("parameter number")
+    axs[1, 1].set_ylabel("relative change")
+    axs[1, 1].set_title(f"{subset.method} solution")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return Path(path)
+
+
+def success_ratio_figure(path, summary, equations: str | None = None) -> Path:
+    """Mean success ratio (solid) and mean +- one standard deviation (dashed, clipped to
+    0-100 %) vs noise level, one panel per method (thesis Fig. 5.14). ``summary`` is the
+    DataFrame of :func:`pcbdyn.updating.study.summarise`; with several equation types, each
+    gets its own line (or pick one with ``equations``)."""
+    plt = _pyplot()
+    s = summary if equations is None else summary[summary["equations"] == equations]
+    methods = list(dict.fromkeys(s["method"]))
+    fig, axs = plt.subplots(1, len(methods), figsize=(4.2 * len(methods), 3.8), squeeze=False)
+    for ax, method in zip(axs[0], methods):
+        for k, (kind, g) in enumerate(s[s["method"] == method].groupby("equations")):
+            g = g.sort_values("level_pct")
+            lv, mean, std = g["level_pct"], g["mean"], g["std"]
+            ax.plot(lv, mean, "-", color=f"C{k}", label=kind)
+            ax.plot(lv, np.clip(mean + std, 0, 100), "--", color=f"C{k}", lw=0.8)
+            ax.plot(lv, np.clip(mean - std, 0, 100), "--", color=f"C{k}", lw=0.8)
+        ax.set_ylim(0, 105)
+        ax.set_xlabel("measurement error level [%]")
+        ax.set_ylabel("success ratio [%]")
+        ax.set_title(method)
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return Path(path)
