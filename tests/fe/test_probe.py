@@ -102,14 +102,15 @@ def plate(n):
 
 @pytest.fixture(scope="module")
 def plates():
-    fine = plate(48)
-    return {n: (m, solve_modes(m, 4)) for n, m in ((12, plate(12)), (24, plate(24)), (48, fine))}
+    return {n: (m, solve_modes(m, 4)) for n, m in ((n, plate(n)) for n in (12, 24, 48, 96))}
 
 
-def test_a_coarse_plate_read_between_its_nodes_matches_a_fine_mesh_with_nodes_there(plates):
-    fine, fine_modes = plates[48]
+def test_a_plate_read_between_its_nodes_matches_a_finer_mesh_with_nodes_there(plates):
+    """Issue 4: reading through the shape functions is within 0.5 % of a mesh with nodes at the points
+    (48 x 48 model read at the other nodes of a 96 x 96 mesh), MAC > 0.999, and converges as h^2."""
+    fine, fine_modes = plates[96]
     errors = {}
-    for n in (12, 24):
+    for n in (12, 24, 48):
         coarse, modes = plates[n]
         ij = fine.nodes[:, :2] / [A / n, B / n]
         between = ~np.all(np.abs(ij - np.round(ij)) < 1e-9, axis=1)  # fine nodes that are not coarse nodes
@@ -120,12 +121,13 @@ def test_a_coarse_plate_read_between_its_nodes_matches_a_fine_mesh_with_nodes_th
         errors[n] = np.abs(read - ref).max(0) / np.abs(ref).max(0)
         cos2 = np.sum(read * ref, 0) ** 2 / (np.sum(read**2, 0) * np.sum(ref**2, 0))
         assert cos2.min() > 0.999
-        if n == 24:
-            assert errors[n][0] < 0.005  # first mode within 0.5 % of its peak
+        if n == 48:
+            assert errors[n].max() < 0.005  # every mode within 0.5 % of its peak
             near = np.argmin(((fine.nodes[between][:, None, :2] - coarse.nodes[None, :, :2]) ** 2).sum(2), axis=1)
             nearest = modes.shapes[6 * near + 2]
             nearest *= np.sign(np.sum(nearest * ref, axis=0))
             # reading the nearest node instead is several times worse
             assert np.all(np.abs(nearest - ref).max(0) / np.abs(ref).max(0) > 5 * errors[n])
     # the interpolation error falls with the square of the cell size, as bilinear interpolation should
-    assert np.all((errors[12] / errors[24] > 3.2) & (errors[12] / errors[24] < 4.8))
+    for coarse, finer in ((12, 24), (24, 48)):
+        assert np.all((errors[coarse] / errors[finer] > 3.2) & (errors[coarse] / errors[finer] < 4.8))
