@@ -2,6 +2,8 @@
 
 import click
 
+from .commands import build, correlate, localize, simulate_test, study, update
+
 
 @click.group()
 @click.version_option(package_name="pcbdyn")
@@ -10,17 +12,5 @@ def main():
     tests, update them and find what they lack."""
 
 
-def _register():
-    from importlib import import_module
-
-    for name in ("build", "correlate", "simulate_test", "update", "localize", "study", "diagnose"):
-        try:
-            module = import_module(f"pcbdyn.commands.{name}")
-        except ModuleNotFoundError as exc:
-            if exc.name != f"pcbdyn.commands.{name}":
-                raise
-            continue
-        main.add_command(module.command)
-
-
-_register()
+for _module in (build, simulate_test, correlate, update, localize, study):
+    main.add_command(_module.command)

@@ -105,7 +105,7 @@ def read_spec(path: Path) -> dict:
               help="write the summary and every shot's result as JSON")
 @click.option("--quiet", is_flag=True, help="no progress bar")
 def command(study_toml: Path, json_path: Path | None, quiet: bool):
-    """Success ratios (thesis eqs. 5.65-5.66) of localisation methods over noisy random shots."""
+    """Judge localisation methods by their success ratio over noisy random shots (thesis eq. 5.65-5.66)."""
     from ..report.files import write_json, write_text
     from ..testdata import TestDataError
     from ..updating.study import CASES, run_study, summarise
