@@ -6,7 +6,7 @@ Every property is a frozen dataclass; :func:`dataclasses.replace` makes a pertur
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 

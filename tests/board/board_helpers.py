@@ -1,16 +1,13 @@
 """Shared paths and helpers for the board tests."""
 
-import json
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
-REFERENCE = Path("/work/shared/reference")
 EXAMPLES = ROOT / "examples"
 DATA = Path(__file__).resolve().parent / "data"
 
 
-def thesis_case(name):
-    return json.loads((REFERENCE / "thesis_tables.json").read_text())["cases"][name]
+from reference import thesis_case  # noqa: E402,F401  (re-exported for the board tests)
 
 
 def write_board(tmp_path, text, name="board.toml"):

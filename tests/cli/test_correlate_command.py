@@ -16,6 +16,7 @@ from pcbdyn.board import build_model, load_board
 from pcbdyn.cli import main
 from pcbdyn.correlation import mac
 from pcbdyn.fe.assembly import assemble
+from reference import load
 from pcbdyn.fe.modal import solve_modes
 from pcbdyn.testdata import Points, TestData, read_points_csv, read_uff, write_uff
 
@@ -51,7 +52,7 @@ def card(tmp_path_factory):
 
 
 def test_points_are_the_thesis_grid():
-    grid = json.loads(Path("/work/shared/reference/thesis_tables.json").read_text())
+    grid = load("thesis_tables.json")
     lines = grid["cases"]["T7.4_real_pcb_free"]["inputs"]["geometry_mm"]
     pts, dofs = read_points_csv(POINTS)
     X, Y = np.meshgrid(lines["x_lines"], lines["y_lines"])

@@ -1,8 +1,6 @@
 """The 3-D beam element: the thesis cantilever (Table 5.3), rigid-body modes, invariance and mass of a
 free frame, Timoshenko shear against the analytical simply-supported beam, and section offsets."""
 
-import json
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,7 +11,7 @@ from pcbdyn.fe.assembly import assemble
 from pcbdyn.fe.elements.beam import matrices
 from pcbdyn.fe.modal import solve_modes
 
-REFERENCE = Path("/work/shared/reference/thesis_tables.json")
+from reference import thesis_case
 
 
 def _line_model(L, n_el, props, axis=(1.0, 0.0, 0.0)):
@@ -28,7 +26,7 @@ def _line_model(L, n_el, props, axis=(1.0, 0.0, 0.0)):
 
 @pytest.fixture(scope="module")
 def cantilever_case():
-    return json.loads(REFERENCE.read_text())["cases"]["T5.3_cantilever_beam"]
+    return thesis_case("T5.3_cantilever_beam")
 
 
 def _cantilever(case, softened, planar):

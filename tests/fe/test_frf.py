@@ -2,8 +2,6 @@
 single-DOF peaks against their analytical values, the thesis' 10-DOF string receptance H53 and
 the residual flexibility of truncated modes."""
 
-import json
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -14,7 +12,7 @@ from pcbdyn.fe.modal import solve_modes
 from pcbdyn.fe.model import Model
 from pcbdyn.fe.properties import MassProperty, SpringProperty
 
-REF = Path("/work/shared/reference/thesis_tables.json")
+from reference import thesis_case
 
 
 def ux(node):
@@ -40,7 +38,7 @@ def chain(ks, ms, wall=True):
 
 @pytest.fixture(scope="module")
 def string_case():
-    return json.loads(REF.read_text())["cases"]["T5.5_string_10dof"]
+    return thesis_case("T5.5_string_10dof")
 
 
 @pytest.fixture(scope="module")

@@ -1,8 +1,6 @@
 """solve_modes against closed-form spring-mass chains (dense and sparse paths), the thesis' 10-DOF
 string (Table 5.5), rigid-body detection and the errors for under-constrained models."""
 
-import json
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,7 +13,7 @@ from pcbdyn.fe.modal import DENSE_MAX, reduced_system, solve_modes, uncoupled_bl
 from pcbdyn.fe.model import Model, ModelError
 from pcbdyn.fe.properties import BeamProperty, MassProperty, ShellProperty, SpringProperty
 
-REF = Path("/work/shared/reference/thesis_tables.json")
+from reference import thesis_case
 
 
 def chain(ks, ms, wall=True, axes=(0,)):
@@ -52,7 +50,7 @@ def chain_matrices(ks, ms):
 
 @pytest.fixture(scope="module")
 def string_case():
-    return json.loads(REF.read_text())["cases"]["T5.5_string_10dof"]
+    return thesis_case("T5.5_string_10dof")
 
 
 @pytest.mark.parametrize("variant", [("k_pa_MN_per_m", "m_pa_kg", "fa_Hz"), ("k_px_MN_per_m", "m_px_kg", "fx_Hz")])

@@ -1,7 +1,5 @@
 """Flat shell elements against published plate frequencies (shared/reference/plates.json)."""
 
-import json
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -10,7 +8,9 @@ from pcbdyn.fe import Model, ShellProperty
 from pcbdyn.fe.generate import rectangle, rectangle_edges
 from pcbdyn.fe.modal import solve_modes
 
-REF = json.loads(Path("/work/shared/reference/plates.json").read_text())
+from reference import load
+
+REF = load("plates.json")
 NAFEMS = REF["nafems_square_plate"]
 LAMBDA2 = REF["frequency_parameters_lambda2"]
 A = NAFEMS["geometry"]["a_m"]

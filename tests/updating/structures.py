@@ -1,16 +1,14 @@
 """Plain-matrix test structures for the updating tests: the thesis' 10-DOF string (Table 5.5) and
 18-element cantilever (Table 5.3), built in numpy so they are exact and fast."""
 
-import json
-from pathlib import Path
 
 import numpy as np
 
-REF = Path("/work/shared/reference/thesis_tables.json")
+from reference import thesis_case as _thesis_case
 
 
 def load_case(name):
-    return json.loads(REF.read_text())["cases"][name]
+    return _thesis_case(name)
 
 
 def chain_model(n):

@@ -21,7 +21,7 @@ from pcbdyn.updating.sensitivity import eigenvalue_derivatives, solve_modes
 
 ROOT = Path(__file__).resolve().parents[2]
 CARD = ROOT / "examples" / "six_part_card"
-REF = Path("/work/shared/reference/thesis_tables.json")
+from reference import thesis_case
 MESH = "13.5 mm"
 
 SPRING_BOARD = """
@@ -146,7 +146,7 @@ def test_six_part_card_qms_recovers_thicknesses(tmp_path):
 def thesis_table_7_5_rf():
     """The thesis' frequencies of configuration 1 after its RF-based update (Table 7.5), as
     re-constructed in the reference file (f_x (1 - residue))."""
-    case = json.loads(REF.read_text())["cases"]["T7.5_real_pcb_updated_thicknesses"]
+    case = thesis_case("T7.5_real_pcb_updated_thicknesses")
     return np.asarray(case["ours_primary"]["RF"]["thesis_Hz"], float)
 
 

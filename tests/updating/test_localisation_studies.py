@@ -10,7 +10,9 @@ from click.testing import CliRunner
 
 from pcbdyn.updating.study import SimulatedFreePCB, compress, localise, run_study, summarise
 
-REF = json.loads(Path("/work/shared/reference/thesis_tables.json").read_text())["cases"]["T5.11_simulated_pcb"]
+from reference import thesis_case
+
+REF = thesis_case("T5.11_simulated_pcb")
 
 
 @pytest.fixture(scope="module")
