@@ -9,6 +9,17 @@ With UFF shapes, pairing is by MAC; QMS/FBM equations are built per measured mod
 condensed dynamically onto the measured DOFs at that mode's frequency (see
 :meth:`pcbdyn.updating.board_problem.BoardProblem.mode_configurations`); the before/after tables
 always come from full-model solves.
+
+FRF methods (frf-in: excitation residual, eq. 3.34; frf-out: receptance residual, eq. 3.35;
+frf-direct: eq. 3.40) read the FRFs of each UFF file (any kind; converted to receptance), excite
+the model DOF under the reference point (it must be on a mesh node and, for frf-in/frf-out, among
+the responses: a driving-point FRF, since the equations are written on the model condensed
+exactly onto the measured DOFs at each line) and use the updating
+frequencies of ``--frf-freqs`` or, by default, lines away from the resonances where test and
+model FRFs correlate (FDAC, see :func:`pcbdyn.updating.board_problem.choose_frf_frequencies`).
+The before/after tables pair the file's modes (dataset 55) with the model by MAC; a file without
+modes is checked against its FRF peaks, paired by order. Damped data: frf-in with
+``--damping diagonal|proportional|light`` or frf-direct; frf-out assumes little damping.
 """
 
 from __future__ import annotations
@@ -60,6 +71,54 @@ def read_frequency_table(path: Path, board) -> list:
     return out
 
 
+def parse_frf_freqs(text):
+    """'150,230 Hz' or '150,230' -> array [Hz]."""
+    try:
+        vals = np.array([float(v) for v in text.replace("Hz", "").split(",") if v.strip()])
+    except ValueError:
+        raise click.BadParameter(f"'{text}' is not a comma-separated list of frequencies in Hz (e.g. 150,230,410)",
+                                 param_hint="--frf-freqs") from None
+    if vals.size == 0 or np.any(vals <= 0):
+        raise click.BadParameter(f"'{text}': give positive frequencies in Hz (e.g. 150,230,410)", param_hint="--frf-freqs")
+    return vals
+
+
+def frf_data(problem, board, test_uff, configs, method, frf_freqs, damping):
+    """(check, cfgs) for the FRF methods: the frequency configurations of the before/after tables and
+    the FRF configurations of every UFF file (base + NAME=FILE)."""
+    from ..board import BoardError
+    from ..testdata import TestDataError, read_uff
+    from ..updating.board_problem import MeasuredFRFs, MeasuredModes, resonance_lines
+
+    freqs = None if frf_freqs is None else parse_frf_freqs(frf_freqs)
+    files = [(None, test_uff)]
+    for name, path in parse_extra(configs):
+        if board.configuration(name) is None:
+            raise BoardError(f"{board.path.name}: configuration '{name}' (from {name}={path}) is not in [[configurations]]")
+        files.append((name, path))
+    check, cfgs = [], []
+    for name, path in files:
+        td = read_uff(path)
+        if td.frfs is None:
+            raise TestDataError(f"{path}: no FRFs (UFF dataset 58) in the file; --method {method} needs measured FRFs "
+                                "(write them with 'pcbdyn simulate-test' or export them from the test)")
+        meas = MeasuredFRFs.from_test(td.frfs)
+        got, notes = problem.frf_configurations(name, meas, method, freqs=freqs, damping=damping)
+        for note in notes:
+            click.echo(f"note ({path.name}): {note}", err=True)
+        click.echo(f"{path.name}: updating frequencies " + ", ".join(f"{f:.1f}" for f in got[0].frf_hz) + " Hz",
+                   err=True)
+        cfgs += got
+        if td.modes is not None and td.modes.n_modes:
+            check.append(problem.configuration(name, MeasuredModes.from_test(td.modes), "freq"))
+        else:
+            peaks = resonance_lines(meas[0].frequencies, meas[0].H)
+            click.echo(f"{path.name}: no modes in the file; the before/after tables use its FRF peaks paired by order",
+                       err=True)
+            check.append(problem.configuration(name, MeasuredModes(peaks), "freq"))
+    return check, cfgs
+
+
 @click.command("update")
 @click.argument("board_toml", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.argument("test_uff", required=False, type=click.Path(exists=True, dir_okay=False, path_type=Path))
@@ -67,8 +126,14 @@ def read_frequency_table(path: Path, board) -> list:
 @click.option("--frequencies", "freq_csv", type=click.Path(exists=True, dir_okay=False, path_type=Path), default=None,
               help="CSV of measured frequencies (configuration, mode, frequency_hz) instead of UFF files; "
                    "pairs by mode order")
-@click.option("--method", type=click.Choice(["freq", "fbm", "qms", "frf-in", "frf-out"]), default="freq",
-              show_default=True)
+@click.option("--method", type=click.Choice(["freq", "fbm", "qms", "frf-in", "frf-out", "frf-direct"]),
+              default="freq", show_default=True)
+@click.option("--frf-freqs", default=None,
+              help="FRF methods: updating frequencies in Hz, e.g. '150,230,410' (default: chosen automatically "
+                   "away from resonances where the FDAC of test and model is high)")
+@click.option("--damping", type=click.Choice(["undamped", "proportional", "diagonal", "light"]), default="undamped",
+              show_default=True, help="FRF methods: treatment of the unknown damping in the data (thesis appendix A); "
+                                      "frf-out takes undamped or proportional, frf-direct undamped")
 @click.option("--solver", type=click.Choice(["ls", "tls", "bayes", "bounded"]), default="bounded", show_default=True)
 @click.option("--params", default=None, help="comma-separated parameter names (default: all [[parameters]])")
 @click.option("--max-iter", type=click.IntRange(min=1), default=20, show_default=True)
@@ -78,8 +143,8 @@ def read_frequency_table(path: Path, board) -> list:
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=None,
               help="folder for the iteration plot and tables")
 @click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None)
-def command(board_toml, test_uff, configs, freq_csv, method, solver, params, max_iter, tol_pct, mesh_size, out,
-            json_path):
+def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping, solver, params, max_iter, tol_pct,
+            mesh_size, out, json_path):
     """Update a board model's parameters against modal tests (UFF) or measured frequencies (CSV)."""
     from ..board import BoardError, load_board
     from ..report import update_report as rep
@@ -89,9 +154,6 @@ def command(board_toml, test_uff, configs, freq_csv, method, solver, params, max
     from ..updating.board_problem import BoardProblem, MeasuredModes, run
     from .correlate import load_test_modes
 
-    if method.startswith("frf"):
-        fail(f"--method {method}: FRF-based updating of boards from UFF FRFs is not wired into the command yet; "
-             "use freq, fbm or qms")
     if (test_uff is None) == (freq_csv is None):
         fail("give either TEST_UFF (and NAME=FILE for other configurations) or --frequencies FILE.csv")
     if freq_csv is not None and method != "freq":
@@ -101,7 +163,9 @@ def command(board_toml, test_uff, configs, freq_csv, method, solver, params, max
         ms = to_si(mesh_size, "mm", "--mesh-size") if mesh_size else None
         t0 = step("building the models")
         problem = BoardProblem(board, params.split(",") if params else None, mesh_size=ms)
-        if freq_csv is not None:
+        if method.startswith("frf"):
+            check, cfgs = frf_data(problem, board, test_uff, configs, method, frf_freqs, damping)
+        elif freq_csv is not None:
             data = read_frequency_table(freq_csv, board)
             click.echo("frequencies only: test mode n is paired with elastic model mode n (by order)", err=True)
         else:
@@ -113,8 +177,9 @@ def command(board_toml, test_uff, configs, freq_csv, method, solver, params, max
                 data.append((name, MeasuredModes.from_test(load_test_modes(path))))
             if method == "freq":
                 data = [(c, MeasuredModes(m.frequencies, m.shapes, m.xyz, m.directions)) for c, m in data]
-        check = [problem.configuration(c, m, "freq") for c, m in data]
-        cfgs = check if method == "freq" else [q for c, m in data for q in problem.mode_configurations(c, m, method)]
+        if not method.startswith("frf"):
+            check = [problem.configuration(c, m, "freq") for c, m in data]
+            cfgs = check if method == "freq" else [q for c, m in data for q in problem.mode_configurations(c, m, method)]
         done(t0)
         t0 = step(f"updating {len(problem.names)} parameter(s) with {method}/{solver} over {len(cfgs)} configuration(s)")
         res, before, after = run(problem, cfgs, solver, check=check, max_iter=max_iter, tol_freq_pct=tol_pct)

@@ -35,6 +35,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..board import build_model
+from ..correlation.frf import fdac
 from ..correlation.pairing import pair_modes
 from ..fe.assembly import assemble
 from ..fe.constraints import build_reduction
@@ -83,6 +84,83 @@ class MeasuredModes:
                    test_modes.dofs.directions)
 
 
+@dataclass
+class MeasuredFRFs:
+    """Measured receptances of one excitation in SI: ``frequencies`` [Hz] (n_f,), ``H`` (n_f, n_resp)
+    [m/N] at points ``xyz`` (n_resp, 3) along unit ``directions`` (n_resp, 3), for a unit force at
+    ``excite_xyz`` (3,) along ``excite_direction`` (3,)."""
+
+    frequencies: np.ndarray
+    H: np.ndarray
+    xyz: np.ndarray
+    directions: np.ndarray
+    excite_xyz: np.ndarray
+    excite_direction: np.ndarray
+
+    @classmethod
+    def from_test(cls, frfs) -> list:
+        """One MeasuredFRFs per reference DOF of :class:`pcbdyn.testdata.FRFs` (any kind, converted to
+        receptance); the 0 Hz line (no receptance from mobility or accelerance there) and responses
+        with missing (NaN) FRFs are dropped."""
+        rec = frfs.as_kind("receptance")
+        pts = rec.points
+        r_xyz = pts.xyz[pts.index(rec.response.point_ids)]
+        e_xyz = pts.xyz[pts.index(rec.reference.point_ids)]
+        f = np.asarray(rec.frequencies, float)
+        lines = f > 0
+        out = []
+        for k in range(rec.H.shape[2]):
+            H = rec.H[lines, :, k]
+            ok = np.all(np.isfinite(H), axis=0)
+            if not ok.any():
+                continue
+            out.append(cls(f[lines], H[:, ok], r_xyz[ok], rec.response.directions[ok],
+                           e_xyz[k], rec.reference.directions[k]))
+        if not out:
+            raise ValueError("the FRFs hold no complete response column for any reference")
+        return out
+
+
+def resonance_lines(f, H) -> np.ndarray:
+    """Frequencies [Hz] of the local maxima of sum_i |H_i|^2 over the lines (the resonances seen on the
+    sampled FRFs, H (n_f, n_resp))."""
+    s = np.sum(np.abs(H) ** 2, axis=1)
+    k = np.flatnonzero((s[1:-1] > s[:-2]) & (s[1:-1] > s[2:])) + 1
+    return np.asarray(f)[k]
+
+
+def choose_frf_frequencies(f, H_x, H_a, gap: float = 0.1, n_max: int = 8, min_fdac: float = 0.9,
+                           free: bool = False):
+    """Automatic updating frequencies (thesis section 2.2.3): indices of lines of ``f`` [Hz].
+
+    Rule: resonances are the peaks of the measured (``H_x``) and model (``H_a``) FRFs (both (n_f,
+    n_resp)); a line qualifies when it lies more than ``gap`` (relative) from every resonance (the
+    receptance there is not dominated by one mode and a frequency shift between model and test does
+    not flip it) and its FDAC between test and model at that same line (eq. 2.6, diagonal) is at least
+    ``min_fdac``. In each interval between consecutive resonances (and below the first, above the
+    last) the qualifying line with the highest FDAC is taken; of these, the ``n_max`` with the highest
+    FDAC are kept. A ``free`` structure has no lines below its first resonance: there the response
+    is the rigid-body mass line, which no stiffness parameter moves. Returns (indices sorted by frequency, FDAC of every line, note or None); when no
+    line reaches ``min_fdac`` the best-correlated lines are taken and the note says so.
+    """
+    f = np.asarray(f, float)
+    res = np.unique(np.concatenate([resonance_lines(f, H_x), resonance_lines(f, H_a)]))
+    cos = np.diagonal(fdac(H_x, H_a)[0]).copy()
+    away = (f > (res[0] if free and res.size else 0.0)) & np.all(np.abs(f[:, None] / np.where(res > 0, res, np.inf)[None, :] - 1) > gap, axis=1)
+    interval = np.searchsorted(res, f)
+    note = None
+    ok = away & (cos >= min_fdac)
+    if not ok.any():
+        ok = away
+        note = (f"no line away from the resonances has FDAC >= {min_fdac}; the best-correlated ones are used "
+                "(check the pairing of test and model, or give --frf-freqs)")
+    if not ok.any():
+        raise ValueError("no measured line lies away from the resonances; give the updating frequencies (--frf-freqs)")
+    picks = [k[np.argmax(cos[k])] for i in np.unique(interval[ok]) for k in [np.flatnonzero(ok & (interval == i))]]
+    picks = sorted(picks, key=lambda k: -cos[k])[:n_max]
+    return np.sort(np.asarray(picks, int)), cos, note
+
+
 class BoardSystem:
     """One configuration of the board as the driver sees it.
 
@@ -129,6 +207,21 @@ class BoardSystem:
         """P (n_meas, n_independent): the model read at the points along the directions."""
         P = model_probe(self.bm.model, xyz, directions).P
         return sp.csr_matrix(P @ self.reduction.T)
+
+    def excitation_dof(self, xyz, direction):
+        """(independent DOF index, note or None) of a unit force at point ``xyz`` along ``direction``.
+        The FRF equations (3.34, 3.35, 3.40) take one excited DOF: a point on a node along an axis maps
+        to it exactly; otherwise the DOF with the largest interpolation weight is used and the note
+        says so (move the excitation onto a node, e.g. with a mesh size that divides its coordinates)."""
+        row = self.measurement_matrix(np.asarray(xyz, float)[None], np.asarray(direction, float)[None]).toarray()[0]
+        w = np.abs(row)
+        if w.max() == 0:
+            raise ValueError(f"excitation at {np.round(np.asarray(xyz) * 1e3, 2).tolist()} mm moves no free DOF")
+        j = int(np.argmax(w))
+        if np.isclose(row[j], 1.0) and np.sum(w > 1e-9) == 1:
+            return j, None
+        return j, (f"excitation at {np.round(np.asarray(xyz) * 1e3, 2).tolist()} mm is not on a node along an axis: "
+                   "the nearest-weight DOF is excited instead (biased); put the excitation on a mesh node")
 
     def pairing(self, measured: MeasuredModes, min_mac: float = 0.5):
         """The driver's pairing callable: by MAC (:func:`pcbdyn.correlation.pairing.pair_modes`)
@@ -248,9 +341,66 @@ class BoardProblem:
             out.append(cfg)
         return out
 
+    def frf_configurations(self, config, measured: list, method: str = "frf-out", freqs=None,
+                           damping: str = "undamped", n_max: int = 8, **options) -> tuple:
+        """Driver Configurations (one per excitation in ``measured``, a list of :class:`MeasuredFRFs`)
+        for the FRF methods "frf-in" (eq. 3.34), "frf-out" (indirect eq. 3.35) or "frf-direct"
+        (eq. 3.40), and notes for the user.
+
+        ``freqs`` [Hz]: updating frequencies (the nearest measured line of each is used); None picks
+        them with :func:`choose_frf_frequencies` against the model's FRFs at the initial parameters.
+        ``damping``: treatment of the unknown damping in the data (appendix A; see
+        :class:`~pcbdyn.updating.iteration.Configuration`). The measured responses are expanded to
+        the model DOFs at each iteration (matching "expand")."""
+        if not method.startswith("frf"):
+            raise ValueError(f"method={method!r}: frf_configurations builds 'frf-in', 'frf-out' or 'frf-direct'")
+        sysm = self.system(config)
+        cfgs, notes = [], []
+        for k, m in enumerate(measured):
+            P = sysm.measurement_matrix(m.xyz, m.directions)
+            j, note = sysm.excitation_dof(m.excite_xyz, m.excite_direction)
+            notes += [note] if note else []
+            f = np.asarray(m.frequencies, float)
+            if freqs is None:
+                K, M, _, _ = sysm.model(self.p0)
+                H_a = model_receptance(K, M, P, j, 2 * np.pi * f)
+                idx, _, note = choose_frf_frequencies(f, m.H, H_a, n_max=n_max, free=sysm.n_rigid > 0)
+                notes += [note] if note else []
+            else:
+                want = np.atleast_1d(np.asarray(freqs, float))
+                if want.min() < f.min() or want.max() > f.max():
+                    raise ValueError(f"--frf-freqs: {want.tolist()} Hz must lie within the measured lines "
+                                     f"{f.min():g}-{f.max():g} Hz")
+                idx = np.unique(np.argmin(np.abs(f[:, None] - want[None, :]), axis=0))
+            H = m.H[idx].T
+            if np.iscomplexobj(H) and not np.any(H.imag) and damping == "undamped":
+                H = H.real
+            name = f"{config or 'base'}:frf{k + 1}"
+            cfg = Configuration(model=sysm.model, P=P, frf_omegas=2 * np.pi * f[idx], H_x=H, excitation=j,
+                                method=method, damping=damping, name=name, **options)
+            cfg.n_rigid = sysm.n_rigid
+            cfg.pairing = sysm.pairing(MeasuredModes(np.zeros(0)))
+            cfg.frf_hz = f[idx]
+            cfgs.append(cfg)
+        return cfgs, notes
+
     def values(self, p) -> dict:
         """{parameter name: value [SI]}."""
         return dict(zip(self.names, np.asarray(p, float).tolist()))
+
+
+def model_receptance(K, M, P, j: int, omegas) -> np.ndarray:
+    """Undamped model receptances (n_w, n_meas) P H(w) e_j at ``omegas`` [rad/s] by modal
+    superposition (eq. 3.29 with no damping) of every mode up to three times the highest frequency,
+    rigid-body modes included: accurate enough to find resonances and correlated lines, and one
+    eigensolution instead of a factorisation per line."""
+    from ..fe.modal import eigenpairs
+
+    w = np.asarray(omegas, float)
+    lam, Phi, _ = eigenpairs(K, M, f_max=3 * w.max() / (2 * np.pi), free=True)
+    with np.errstate(divide="ignore"):
+        terms = (P @ Phi) * Phi[j]
+        return np.real_if_close(terms @ (1.0 / (lam[:, None] - w[None, :] ** 2))).T
 
 
 def _mac_pairing(min_mac):

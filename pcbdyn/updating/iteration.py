@@ -143,6 +143,8 @@ def _block(cfg: Configuration, st, p) -> eq.Block:
         return eq.frequency_equations(st["lam"], st["Phi"], f_x, dKs, dMs, p, relative_rows=cfg.method == "freq-rel")
     if cfg.method == "frf-direct":
         return eq.frf_receptance_equations(K, M, cfg.frf_omegas, cfg.H_x, cfg.excitation, dKs, dMs, p, "direct", P=cfg.P)
+    if _condensed(cfg):
+        return _condensed_frf_equations(cfg, K, M, dKs, dMs, p)
     shapes = cfg.method in ("fbm", "qms")
     omegas = 2 * np.pi * np.asarray(cfg.f_x, float)[used] if shapes else np.asarray(cfg.frf_omegas, float)
     data = np.asarray(cfg.phi_x)[:, used] if shapes else np.asarray(cfg.H_x)
@@ -162,7 +164,46 @@ def _block(cfg: Configuration, st, p) -> eq.Block:
     return eq.frf_receptance_equations(K, M, omegas, data, j, dKs, dMs, p, "indirect", damping=cfg.damping)
 
 
+def _condensed(cfg) -> bool:
+    return cfg.method in ("frf-in", "frf-out") and cfg.P is not None and cfg.matching == "expand"
+
+
+def _condensed_frf_equations(cfg, K, M, dKs, dMs, p) -> eq.Block:
+    """Eqs. 3.34 (frf-in) and 3.35 (frf-out) on the measured DOFs, the model condensed exactly at each
+    updating frequency; frf-in rows weighted by the noise they carry (eq. 4.28).
+
+    Expanding the data and keeping every model row would bias the input residual: the rows of the
+    unmeasured DOFs have a zero right-hand side by construction of the expansion yet carry
+    derivative terms, and a damping fit (appendix A) would be spread over them. Premultiplying the
+    expanded equations by T(w)^T (T the dynamic map of eq. 2.25) removes them; it equals the
+    equations of the dynamically condensed model Z_r = T^T Z T, exact at w. For frf-out this is the
+    same as the expanded eq. 3.35 (Z_r^-1 T^T = P H_a) and lets the proportional-damping fit see only
+    measured rows. The excitation must be a measured DOF (a driving-point FRF).
+
+    frf-in: a relative error e in the data gives row i the standard deviation
+    e (sum_k |Z_r,ik h_k|^2)^1/2; unit-length rows (eq. 4.42) would blow up the stiff, insensitive
+    ones. Each frequency's weighted rows are scaled to unit mean length, so frequencies weigh alike."""
+    j = matching.measured_rows(cfg.P, cfg.excitation)
+    A_all, b_all = [], []
+    for w, h in zip(np.asarray(cfg.frf_omegas, float), np.asarray(cfg.H_x).T):
+        Kr, Mr, dKr, dMr = matching.reduce_system(K, M, dKs, dMs, cfg.P, omega=w)
+        if cfg.method == "frf-out":
+            A, b = eq.frf_receptance_equations(Kr, Mr, [w], h[:, None], j, dKr, dMr, p, "indirect",
+                                               damping=cfg.damping)
+        else:
+            A, b = eq.frf_excitation_equations(Kr, Mr, [w], h[:, None], j, dKr, dMr, p, damping=cfg.damping)
+            sigma = np.sqrt(np.abs(Kr - w**2 * Mr) ** 2 @ np.abs(h) ** 2)
+            d = np.tile(1.0 / np.maximum(sigma, sigma.max() * 1e-12), A.shape[0] // sigma.size)
+            d /= np.sqrt(np.mean(np.sum((d[:, None] * A) ** 2, axis=1)))
+            A, b = d[:, None] * A, d * b
+        A_all.append(A)
+        b_all.append(b)
+    return eq.Block(np.vstack(A_all), np.concatenate(b_all))
+
+
 def _weighted(cfg, blk):
+    if cfg.sigma is None and cfg.method == "frf-in" and _condensed(cfg):
+        return blk  # weighted by its noise already
     d = unit_row_weights(blk.A) if cfg.sigma is None else std_row_weights(cfg.sigma)
     return eq.Block(*weight_rows(blk.A, blk.b, d))
 

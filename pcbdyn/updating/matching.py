@@ -79,10 +79,15 @@ def expand(K, M, P, u_meas, omegas) -> np.ndarray:
     return out.reshape((K.shape[0],) + U.shape[1:])
 
 
-def measured_rows(P, dof: int) -> int:
-    """Row of P that measures model DOF ``dof`` alone (the driving point of an FRF on a reduced model)."""
-    col = as_dense(sp.csr_matrix(P)[:, dof]).ravel()
-    rows = np.flatnonzero(col)
-    if rows.size != 1 or not np.isclose(col[rows[0]], 1.0) or sp.csr_matrix(P)[rows[0]].nnz != 1:
-        raise ValueError(f"excitation DOF {dof} must be measured directly (one row of P selecting it)")
-    return int(rows[0])
+def measured_rows(P, dof: int, tol: float = 1e-9) -> int:
+    """Row r of P that reads model DOF ``dof`` alone (P[r] = e_dof^T within ``tol``): the driving
+    point of an FRF. The force e_dof = P^T e_r then condenses onto the measured DOFs as e_r, for any
+    T with P T = I."""
+    Pc = sp.csr_matrix(P)
+    for r in np.flatnonzero(as_dense(Pc[:, dof]).ravel()):
+        row = as_dense(Pc[r]).ravel()
+        row[dof] -= 1.0
+        if np.max(np.abs(row)) <= tol:
+            return int(r)
+    raise ValueError(f"excitation DOF {dof} must be measured directly (a row of P reading it alone: "
+                     "a driving-point FRF at a mesh node)")

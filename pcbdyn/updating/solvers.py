@@ -86,7 +86,7 @@ def _svd(A):
     A = np.asarray(A, float)
     if A.ndim != 2 or A.shape[0] == 0:
         raise ValueError(f"A has shape {A.shape}: need a 2-D matrix with at least one equation")
-    U, s, Vt = np.linalg.svd(A, full_matrices=True)
+    U, s, Vt = np.linalg.svd(A, full_matrices=A.shape[0] < A.shape[1])  # square V always; U thin on tall A
     return U, s, Vt.T
 
 

@@ -171,7 +171,8 @@ def tls_qrf(
     s_full = np.zeros(n)
     s_full[: sA.size] = sA[:n]
     t = tls_column_weight(A, b, precision_ratio) if t_b is None else float(t_b)
-    _, sC, VtC = np.linalg.svd(np.column_stack([A, t * b]), full_matrices=True)
+    C = np.column_stack([A, t * b])
+    _, sC, VtC = np.linalg.svd(C, full_matrices=C.shape[0] < C.shape[1])
     W11, W12 = VtC[:n1, :n], VtC[:n1, n]
     order = qrf_forward(W11, W12, n_max=n1)
     S1 = np.zeros(n1)
