@@ -85,17 +85,21 @@ class BoardModel:
         return float(r @ (M @ r))
 
 
-def mesh_points(board: Board, config) -> list:
-    """Named points that must be mesh nodes."""
+def mesh_points(board: Board, config, shared: bool = False) -> list:
+    """Named points that must be mesh nodes; ``shared``: those of every configuration, so that all
+    configurations mesh alike."""
     pts = [(f"masses.{m.name}", m.at) for m in board.masses]
-    if config is not None:
-        pts += [(f"configurations.{config.name}.{m.name}", m.at) for m in config.masses]
+    for c in (board.configurations if shared else [config] if config is not None else []):
+        pts += [(f"configurations.{c.name}.{m.name}", m.at) for m in c.masses]
     pts += [(f"points.{i + 1}", p) for i, p in enumerate(board.points)]
     return pts
 
 
-def build_model(board: Board, config: str | None = None, mesh_size: float | None = None) -> BoardModel:
-    """The FE model of ``board`` in configuration ``config`` (None: the base configuration)."""
+def build_model(board: Board, config: str | None = None, mesh_size: float | None = None,
+                shared_mesh: bool = False) -> BoardModel:
+    """The FE model of ``board`` in configuration ``config`` (None: the base configuration).
+    ``shared_mesh``: every configuration's points are nodes, so that the models of all
+    configurations share one mesh node for node (diagnosis places effects by node)."""
     from .parameters import Parameter
 
     cfg = None
@@ -104,7 +108,7 @@ def build_model(board: Board, config: str | None = None, mesh_size: float | None
         if cfg is None:
             names = ", ".join(c.name for c in board.configurations) or "none defined"
             raise BoardError(f"{board.path.name}: configuration '{config}' does not exist (configurations: {names})")
-    named = mesh_points(board, cfg)
+    named = mesh_points(board, cfg, shared_mesh)
     regions = [(f"components.{c.ref}", c.corners()) for c in board.components] if board.smear == "none" else []
     strips = [s for f in board.fixtures if f.edge is not None
               if (s := supports.strip_polygon(board.outline, f)) is not None]
