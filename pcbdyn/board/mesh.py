@@ -47,19 +47,50 @@ class BoardMesh:
         return np.unique(e, axis=0)
 
 
+    def chain_on_segment(self, p0, p1, tol: float = 1e-7) -> np.ndarray:
+        """The nodes lying on the straight segment p0 -> p1, ordered from p0; consecutive nodes are
+        checked to be element edges (the segment was embedded in the mesh)."""
+        p0, p1 = np.asarray(p0, dtype=float), np.asarray(p1, dtype=float)
+        d = p1 - p0
+        L = float(np.linalg.norm(d))
+        rel = self.nodes[:, :2] - p0
+        s = rel @ d / L
+        off = np.abs(rel[:, 0] * d[1] - rel[:, 1] * d[0]) / L
+        on = np.flatnonzero((off < tol) & (s > -tol) & (s < L + tol))
+        chain = on[np.argsort(s[on])]
+        if chain.size < 2 or abs(s[chain[0]]) > tol or abs(s[chain[-1]] - L) > tol:
+            raise RuntimeError(f"segment {p0.tolist()} -> {p1.tolist()} m is not a line of mesh nodes")
+        known = set()
+        for etype in ("quad4", "tri3"):
+            conn = self.all_cells(etype)
+            if len(conn):
+                e = np.sort(np.stack([conn, np.roll(conn, -1, axis=1)], axis=-1).reshape(-1, 2), axis=1)
+                known.update(map(tuple, e.tolist()))
+        for a, b in zip(chain[:-1], chain[1:]):
+            if (min(a, b), max(a, b)) not in known:
+                raise RuntimeError(f"segment {p0.tolist()} -> {p1.tolist()} m does not follow element edges")
+        return chain
+
+
 def _polygon(occ, v):
     pts = [occ.addPoint(float(x), float(y), 0.0) for x, y in v]
     lines = [occ.addLine(pts[i], pts[(i + 1) % len(pts)]) for i in range(len(pts))]
     return occ.addPlaneSurface([occ.addCurveLoop(lines)])
 
 
-def mesh_board(outline, regions, points, size: float, strips=()) -> BoardMesh:
+def _polyline(occ, v):
+    pts = [occ.addPoint(float(x), float(y), 0.0) for x, y in v]
+    return [occ.addLine(pts[i], pts[i + 1]) for i in range(len(pts) - 1)]
+
+
+def mesh_board(outline, regions, points, size: float, strips=(), lines=()) -> BoardMesh:
     """Mesh ``outline`` (vertices + holes) with element size ``size`` [m].
 
     ``regions``: [(label, polygon (m, 2))] whose elements get that label (first one wins where
     regions overlap); ``strips``: polygons whose outlines element edges follow but whose elements
-    stay on the board; ``points``: (k, 2) points that become nodes. Elements outside every region
-    are labelled "board".
+    stay on the board; ``lines``: open polylines (m, 2) lying on the board that element edges
+    follow (edge springs, line masses, stiffeners); ``points``: (k, 2) points that become nodes.
+    Elements outside every region are labelled "board".
     """
     import gmsh
 
@@ -79,6 +110,7 @@ def mesh_board(outline, regions, points, size: float, strips=()) -> BoardMesh:
                 board_tags = [board]
             tools = [(2, _polygon(occ, poly)) for _, poly in regions]
             tools += [(2, _polygon(occ, poly)) for poly in strips]
+            tools += [(1, t) for line in lines for t in _polyline(occ, line)]
             tools += [(0, occ.addPoint(float(x), float(y), 0.0)) for x, y in points]
             objects = [(2, t) for t in board_tags]
             if tools:

@@ -8,8 +8,10 @@ dK/dp and dM/dp are formed (see :mod:`pcbdyn.board.parameters`).
 
 Element sets: ``board`` (bare board), ``components.<ref>`` (the elements under a part),
 ``components.<ref>.mass`` (lumped part), ``fixtures.<name>`` (wedge-lock springs, standoff
-springs), ``masses.<name>`` and ``configurations.<config>.<name>`` (point masses). Triangles, where
-the mesher leaves any, go to a companion set named ``<set>.tri3``.
+springs, point and edge springs), ``masses.<name>`` and ``configurations.<config>.<name>`` (point
+masses), ``line_masses.<name>.<k>`` (one lumped share per node), ``stiffeners.<name>`` (offset
+beams) and ``regions.<name>.<set>`` (the shells of ``<set>`` inside a region, stiffness scaled).
+Triangles, where the mesher leaves any, go to a companion set named ``<set>.tri3``.
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ import numpy as np
 from ..components import models as parts
 from ..fe import Model
 from ..fixtures import supports
+from . import effects
 from .mesh import BoardMesh, mesh_board
 from .spec import Board, BoardError
 
@@ -92,7 +95,16 @@ def mesh_points(board: Board, config, shared: bool = False) -> list:
     for c in (board.configurations if shared else [config] if config is not None else []):
         pts += [(f"configurations.{c.name}.{m.name}", m.at) for m in c.masses]
     pts += [(f"points.{i + 1}", p) for i, p in enumerate(board.points)]
+    pts += [(f"fixtures.{f.name}", f.at) for f in board.fixtures if f.type == "point_spring"]
     return pts
+
+
+def mesh_lines(board: Board) -> list:
+    """Polylines element edges must follow: edge springs, line masses and stiffener paths."""
+    lines = [np.array(f.segment) for f in board.fixtures if f.type == "edge_spring"]
+    lines += [np.array(e.segment) for e in board.line_masses]
+    lines += [np.array(e.path) for e in board.stiffeners]
+    return lines
 
 
 def build_model(board: Board, config: str | None = None, mesh_size: float | None = None,
@@ -113,8 +125,10 @@ def build_model(board: Board, config: str | None = None, mesh_size: float | None
     strips = [s for f in board.fixtures if f.edge is not None
               if (s := supports.strip_polygon(board.outline, f)) is not None]
     strips += [supports.pad_polygon(f) for f in board.fixtures if f.type == "standoff"]
+    strips += [e.polygon for e in board.regions]
     try:
-        mesh = mesh_board(board.outline, regions, [p for _, p in named], mesh_size or board.mesh_size, strips)
+        mesh = mesh_board(board.outline, regions, [p for _, p in named], mesh_size or board.mesh_size, strips,
+                          mesh_lines(board))
     except RuntimeError as exc:
         raise BoardError(f"{board.path.name}: board.mesh_size: meshing failed ({exc})") from None
     point_nodes = {name: int(n) for (name, _), n in zip(named, mesh.point_nodes)}
@@ -160,10 +174,15 @@ def build_model(board: Board, config: str | None = None, mesh_size: float | None
             for mk in supports.apply_standoff(model, centre, f, q):
                 add(*mk)
             supported = True
+        elif f.type in ("point_spring", "edge_spring"):  # springs to ground that leave rigid motions free
+            for mk in effects.apply_fixture(board, mesh, f, point_nodes, q):
+                add(*mk)
     masses = [(f"masses.{m.name}", m) for m in board.masses]
     masses += [(f"configurations.{cfg.name}.{m.name}", m) for m in (cfg.masses if cfg else [])]
     for name, m in masses:
         add(*supports.point_mass(name, point_nodes[name], m, q))
+    for mk in effects.effect_sets(board, mesh, q, makers):
+        add(*mk)
     model.free = not supported
     for name, mk in makers.items():
         model.add(name, mk.etype, mk.conn, mk.make(q))

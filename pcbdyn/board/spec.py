@@ -20,7 +20,8 @@ from ..components.library import MODELS, LibraryError, Package, available, find_
 from ..units import UnitError, to_si
 from .laminate import MATERIALS, LaminateProperty, Layer, Material
 
-FIXTURE_TYPES = ("free", "clamped_edge", "hinged_edge", "wedge_lock", "standoff")
+FIXTURE_TYPES = ("free", "clamped_edge", "hinged_edge", "wedge_lock", "standoff", "point_spring", "edge_spring")
+MIN_SEGMENT = 1e-4  # [m] shortest segment of an edge spring, line mass or stiffener piece
 GEOM_TOL = 1e-7  # [m] touching footprints or points on an edge are accepted within this
 
 
@@ -105,6 +106,7 @@ class Fixture:
     at: tuple | None = None
     k: float | str | None = None  # N/m or "rigid"
     diameter: float = 0.0  # standoff pad held rigid [m]
+    segment: tuple | None = None  # edge_spring: ((x0, y0), (x1, y1)) [m]
 
 
 @dataclass
@@ -113,6 +115,45 @@ class PointMass:
     at: tuple
     mass: float
     inertia: float = 0.0  # rotary inertia about the in-plane axes [kg m^2]
+
+
+@dataclass
+class LineMass:
+    """A mass [kg] spread uniformly along a straight segment ((x0, y0), (x1, y1)) [m]."""
+
+    name: str
+    segment: tuple
+    mass: float
+
+
+@dataclass
+class RibSection:
+    """A stiffener's fixed material and height; its width follows from EI (defaults: aluminium,
+    4 mm, as the diagnosis ``stiffener`` kind)."""
+
+    E: float = 70e9
+    nu: float = 0.33
+    rho: float = 2700.0
+    h: float = 4e-3
+
+
+@dataclass
+class Stiffener:
+    """A rib of bending stiffness EI [N m^2] along ``path`` ((x, y), ...) [m] of straight pieces."""
+
+    name: str
+    path: tuple
+    EI: float
+    section: RibSection = field(default_factory=RibSection)
+
+
+@dataclass
+class Region:
+    """Shells inside ``polygon`` (m, 2) [m] get ``stiffness_factor`` times their stiffness."""
+
+    name: str
+    polygon: np.ndarray
+    stiffness_factor: float
 
 
 @dataclass
@@ -151,6 +192,9 @@ class Board:
     parameters: list
     analysis: Analysis
     points: list  # measurement points (x, y) [m] to put nodes on
+    line_masses: list = field(default_factory=list)
+    stiffeners: list = field(default_factory=list)
+    regions: list = field(default_factory=list)
 
     @property
     def thickness(self) -> float:
@@ -167,6 +211,10 @@ class Board:
 
     def configuration(self, name):
         return next((c for c in self.configurations if c.name == name), None)
+
+    def entry(self, kind, name):
+        """The ``line_masses``, ``stiffeners`` or ``regions`` entry called ``name`` (or None)."""
+        return next((e for e in getattr(self, kind) if e.name == name), None)
 
     def quantity(self, target: str):
         """(current value in SI, unit) of a parameter target such as ``components.U1.thickness``;
@@ -196,11 +244,19 @@ class Board:
         if kind == "fixtures" and (f := self.fixture(name)) is not None:
             if attr == "k_rot" and f.type == "wedge_lock" and isinstance(f.k_rot, float):
                 return f.k_rot, "N*m/rad/m"
-            if attr == "k" and f.type == "standoff" and isinstance(f.k, float):
+            if attr == "k" and f.type in ("standoff", "point_spring") and isinstance(f.k, float):
                 return f.k, "N/m"
+            if attr == "k_rot" and f.type == "edge_spring":
+                return f.k_rot, "N*m/rad/m"
             return None
         if kind == "masses" and (m := self.point_mass(name)) is not None and attr == "mass":
             return m.mass, "g"
+        if kind == "line_masses" and (e := self.entry(kind, name)) is not None and attr == "mass":
+            return e.mass, "g"
+        if kind == "stiffeners" and (e := self.entry(kind, name)) is not None and attr == "EI":
+            return e.EI, "N*m^2"
+        if kind == "regions" and (e := self.entry(kind, name)) is not None and attr == "stiffness_factor":
+            return e.stiffness_factor, "dimensionless"
         return None
 
 
@@ -275,7 +331,7 @@ def load_board(path) -> Board:
 def parse_board(data: dict, path: Path) -> Board:
     r = _Reader(Path(path))
     r.table(data, "top level", ["board", "components", "fixtures", "masses", "configurations", "parameters",
-                                "analysis", "points"], required=["board"])
+                                "analysis", "points", "line_masses", "stiffeners", "regions"], required=["board"])
     b = r.table(data["board"], "board", ["name", "outline", "thickness", "material", "stackup", "mesh_size",
                                          "smear"], required=["outline"])
     outline = _outline(r, b["outline"])
@@ -294,8 +350,18 @@ def parse_board(data: dict, path: Path) -> Board:
     _check_overlaps(r, board)
     for i, f in enumerate(_list(r, data, "fixtures")):
         board.fixtures.append(_fixture(r, f, f"fixtures[{i}]", board, i))
+    _check_edge_springs(r, board)
     for i, m in enumerate(_list(r, data, "masses")):
         board.masses.append(_mass(r, m, f"masses[{i}]", board, f"m{i + 1}"))
+    _unique(r, [m.name for m in board.masses], "masses", "name")
+    for i, e in enumerate(_list(r, data, "line_masses")):
+        board.line_masses.append(_line_mass(r, e, f"line_masses[{i}]", board))
+    for i, e in enumerate(_list(r, data, "stiffeners")):
+        board.stiffeners.append(_stiffener(r, e, f"stiffeners[{i}]", board))
+    for i, e in enumerate(_list(r, data, "regions")):
+        board.regions.append(_region(r, e, f"regions[{i}]", board))
+    for kind in ("line_masses", "stiffeners", "regions"):
+        _unique(r, [e.name for e in getattr(board, kind)], kind, "name")
     for i, c in enumerate(_list(r, data, "configurations")):
         where = f"configurations[{i}]"
         r.table(c, where, ["name", "masses"], required=["name"])
@@ -544,7 +610,8 @@ def _circle(centre, diameter, n=12) -> np.ndarray:
 
 
 def _fixture(r, f, where, board, i) -> Fixture:
-    r.table(f, where, ["name", "type", "edge", "width", "k_rot", "at", "k", "diameter"], required=["type"])
+    r.table(f, where, ["name", "type", "edge", "width", "k_rot", "at", "k", "diameter", "from", "to"],
+            required=["type"])
     typ = f["type"]
     if typ not in FIXTURE_TYPES:
         close = difflib.get_close_matches(str(typ), FIXTURE_TYPES, n=1)
@@ -575,19 +642,38 @@ def _fixture(r, f, where, board, i) -> Fixture:
         fx.diameter = r.q(f.get("diameter", "6 mm"), "mm", f"{where}.diameter", positive=True)
         if not board.outline.contains(_circle(fx.at, fx.diameter)).all():
             r.fail(f"{where}.diameter", "the standoff's pad reaches off the board; move it or make it smaller")
+    elif typ == "point_spring":
+        if "at" not in f:
+            r.fail(f"{where}.at", "missing; a point spring needs at = [\"x mm\", \"y mm\"]")
+        fx.at = r.point(f["at"], f"{where}.at")
+        if not board.outline.contains(fx.at)[0]:
+            r.fail(f"{where}.at", f"{f['at']} is not on the board; move the point spring inside the outline")
+        if "k" not in f:
+            r.fail(f"{where}.k", "missing; add k = \"1e5 N/m\" (stiffness to ground in z)")
+        fx.k = r.q(f["k"], "N/m", f"{where}.k", positive=True)
+    elif typ == "edge_spring":
+        fx.segment = _segment(r, f, where, board)
+        if "k_rot" not in f:
+            r.fail(f"{where}.k_rot", "missing; add k_rot = \"1e3 N*m/rad/m\" (rotation about the segment)")
+        fx.k_rot = r.q(f["k_rot"], "N*m/rad/m", f"{where}.k_rot", positive=True)
     uses = {"free": (), "clamped_edge": ("edge", "width"), "hinged_edge": ("edge", "width"),
-            "wedge_lock": ("edge", "width", "k_rot"), "standoff": ("at", "k", "diameter")}[typ]
-    for key in ("edge", "width", "k_rot", "at", "k", "diameter"):
+            "wedge_lock": ("edge", "width", "k_rot"), "standoff": ("at", "k", "diameter"),
+            "point_spring": ("at", "k"), "edge_spring": ("from", "to", "k_rot")}[typ]
+    for key in ("edge", "width", "k_rot", "at", "k", "diameter", "from", "to"):
         if key in f and key not in uses:
             r.fail(f"{where}.{key}", f"a {typ} fixture has no {key}; remove it")
     return fx
 
 
 def _mass(r, m, where, board, default_name) -> PointMass:
+    """A point mass; ``inertia`` J is its rotary inertia about the x and y axes (Ixx = Iyy = J,
+    Izz = 0), so mass = "0 g" with an inertia > 0 declares a rotary inertia alone."""
     r.table(m, where, ["name", "at", "mass", "inertia"], required=["at", "mass"])
     pm = PointMass(str(m.get("name", default_name)), r.point(m["at"], f"{where}.at"),
-                   r.q(m["mass"], "g", f"{where}.mass", positive=True),
+                   r.q(m["mass"], "g", f"{where}.mass", nonneg=True),
                    r.q(m.get("inertia", "0 kg*m^2"), "kg*m^2", f"{where}.inertia", nonneg=True))
+    if not pm.mass > 0 and not pm.inertia > 0:
+        r.fail(f"{where}.mass", f"must be positive, got {m['mass']!r} (a zero mass needs an inertia > 0)")
     if not board.outline.contains(pm.at)[0]:
         r.fail(f"{where}.at", f"{m['at']} is not on the board; move the mass inside the outline")
     return pm
@@ -604,7 +690,9 @@ def _parameter(r, p, where, board) -> ParameterSpec:
                                       "(equivalent_thickness parts), components.<ref>.mass, components.<ref>.E/rho "
                                       "(smeared_local parts), board.E, board.rho, board.thickness, "
                                       "fixtures.<name>.k_rot (wedge_lock with a stiffness), fixtures.<name>.k "
-                                      "(standoff spring), masses.<name>.mass")
+                                      "(standoff or point_spring), fixtures.<name>.k_rot (edge_spring), masses.<name>.mass, "
+                                      "line_masses.<name>.mass, stiffeners.<name>.EI, "
+                                      "regions.<name>.stiffness_factor")
         values.append(q[0])
         units.append(q[1])
     if len(set(units)) > 1:
@@ -623,3 +711,133 @@ def _parameter(r, p, where, board) -> ParameterSpec:
         r.fail(f"{where}.bounds", f"the current value {values[0]:g} (SI) lies outside [{lo:g}, {hi:g}]; widen the "
                                   "bounds or change the board")
     return ParameterSpec(str(p["name"]), [str(t) for t in targets], (lo, hi), units[0])
+
+
+# ----------------------------------------------------------------------------- effect entries
+def _name(r, e, where, prefix, i):
+    name = str(e.get("name", f"{prefix}{i + 1}"))
+    if "." in name:
+        r.fail(f"{where}.name", f"'{name}' contains '.', which parameter targets use as a separator; rename it")
+    return name
+
+
+def _index(where):
+    return int(where.rsplit("[", 1)[1].rstrip("]"))
+
+
+def _on_board(outline, p0, p1) -> bool:
+    """The straight segment p0 -> p1 lies on the board (sampled every 0.1 mm at most)."""
+    p0, p1 = np.asarray(p0), np.asarray(p1)
+    n = max(51, int(np.linalg.norm(p1 - p0) / 1e-4) + 1)
+    s = np.linspace(0.0, 1.0, n)[:, None]
+    return bool(outline.contains(p0 + s * (p1 - p0)).all())
+
+
+def _segment(r, e, where, board):
+    """((x0, y0), (x1, y1)) [m] from ``from`` and ``to``, on the board and long enough."""
+    for key in ("from", "to"):
+        if key not in e:
+            r.fail(f"{where}.{key}", f"missing; add {key} = [\"x mm\", \"y mm\"] (the segment's ends)")
+    p0, p1 = r.point(e["from"], f"{where}.from"), r.point(e["to"], f"{where}.to")
+    L = math.dist(p0, p1)
+    if L < MIN_SEGMENT:
+        r.fail(f"{where}.to", f"the segment is too short ({L * 1e3:g} mm); its ends must be at least "
+                              f"{MIN_SEGMENT * 1e3:g} mm apart")
+    if not _on_board(board.outline, p0, p1):
+        r.fail(f"{where}.to", f"the segment {e['from']} -> {e['to']} leaves the board; keep it inside the outline")
+    return p0, p1
+
+
+def _on_line(seg, a, b, tol=GEOM_TOL) -> bool:
+    """Both ends of ``seg`` lie on the straight piece a -> b."""
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    d = b - a
+    L = float(np.linalg.norm(d))
+    for p in seg:
+        rel = np.asarray(p) - a
+        if abs(rel[0] * d[1] - rel[1] * d[0]) / L > tol or not -tol <= rel @ d / L <= L + tol:
+            return False
+    return True
+
+
+def _check_edge_springs(r, board):
+    """An edge spring's segment lies on one straight piece of the outline (or a hole's) or on the
+    support line of an edge fixture."""
+    pieces = []
+    for ring in [board.outline.vertices, *board.outline.holes]:
+        pieces += list(zip(ring, np.roll(ring, -1, axis=0)))
+    from ..fixtures.supports import support_line
+
+    for f in board.fixtures:
+        if f.edge is not None:
+            axis, v, lo, hi = support_line(board.outline, f)
+            a, b = np.zeros(2), np.zeros(2)
+            a[axis] = b[axis] = v
+            a[1 - axis], b[1 - axis] = lo, hi
+            pieces.append((a, b))
+    for i, f in enumerate(board.fixtures):
+        if f.type == "edge_spring" and not any(_on_line(f.segment, a, b) for a, b in pieces):
+            (x0, y0), (x1, y1) = f.segment
+            r.fail(f"fixtures[{i}].from", f"the segment ({x0 * 1e3:g}, {y0 * 1e3:g}) -> ({x1 * 1e3:g}, "
+                                          f"{y1 * 1e3:g}) mm does not lie on the board outline or on an edge "
+                                          "fixture's support line; move its ends onto one straight edge")
+
+
+def _line_mass(r, e, where, board) -> LineMass:
+    r.table(e, where, ["name", "from", "to", "mass"], required=["from", "to", "mass"])
+    name = _name(r, e, where, "line_mass", _index(where))
+    return LineMass(name, _segment(r, e, where, board), r.q(e["mass"], "g", f"{where}.mass", positive=True))
+
+
+def _stiffener(r, e, where, board) -> Stiffener:
+    r.table(e, where, ["name", "path", "EI", "section"], required=["path", "EI"])
+    name = _name(r, e, where, "stiffener", _index(where))
+    pts = e["path"]
+    if not isinstance(pts, list) or len(pts) < 2:
+        r.fail(f"{where}.path", "needs at least two points [[\"x mm\", \"y mm\"], ...]")
+    path = tuple(r.point(p, f"{where}.path[{k}]") for k, p in enumerate(pts))
+    for k, (p0, p1) in enumerate(zip(path[:-1], path[1:])):
+        if math.dist(p0, p1) < MIN_SEGMENT:
+            r.fail(f"{where}.path[{k + 1}]", f"is {math.dist(p0, p1) * 1e3:g} mm from the point before; pieces must "
+                                             f"be at least {MIN_SEGMENT * 1e3:g} mm long")
+        if not _on_board(board.outline, p0, p1):
+            r.fail(f"{where}.path[{k + 1}]", f"the piece {pts[k]} -> {pts[k + 1]} leaves the board; keep the "
+                                             "stiffener inside the outline")
+    sec = RibSection()
+    if "section" in e:
+        s = r.table(e["section"], f"{where}.section", ["E", "nu", "rho", "height"])
+        sec = RibSection(
+            r.q(s["E"], "Pa", f"{where}.section.E", positive=True) if "E" in s else sec.E,
+            r.number(s["nu"], f"{where}.section.nu", -1.0, 0.5) if "nu" in s else sec.nu,
+            r.q(s["rho"], "kg/m^3", f"{where}.section.rho", positive=True) if "rho" in s else sec.rho,
+            r.q(s["height"], "mm", f"{where}.section.height", positive=True) if "height" in s else sec.h)
+    return Stiffener(name, path, r.q(e["EI"], "N*m^2", f"{where}.EI", positive=True), sec)
+
+
+def _region(r, e, where, board) -> Region:
+    r.table(e, where, ["name", "polygon", "rect", "stiffness_factor"], required=["stiffness_factor"])
+    name = _name(r, e, where, "region", _index(where))
+    if ("polygon" in e) == ("rect" in e):
+        r.fail(where, "give polygon = [[\"x mm\", \"y mm\"], ...] or rect = [x0, y0, x1, y1] (one of them)")
+    if "rect" in e:
+        if not (isinstance(e["rect"], list) and len(e["rect"]) == 4):
+            r.fail(f"{where}.rect", "must be [\"x0 mm\", \"y0 mm\", \"x1 mm\", \"y1 mm\"]")
+        x0, y0, x1, y1 = (r.q(v, "mm", f"{where}.rect[{k}]") for k, v in enumerate(e["rect"]))
+        (x0, x1), (y0, y1) = sorted((x0, x1)), sorted((y0, y1))
+        if x1 - x0 < MIN_SEGMENT or y1 - y0 < MIN_SEGMENT:
+            r.fail(f"{where}.rect", "has no area; give two opposite corners")
+        poly = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
+    else:
+        pts = e["polygon"]
+        if not isinstance(pts, list) or len(pts) < 3:
+            r.fail(f"{where}.polygon", "needs at least three points [[\"x mm\", \"y mm\"], ...]")
+        poly = np.array([r.point(p, f"{where}.polygon[{k}]") for k, p in enumerate(pts)])
+    x, y = poly[:, 0], poly[:, 1]
+    if abs(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))) < MIN_SEGMENT**2:
+        r.fail(f"{where}.polygon", "has no area; give its corners in order")
+    if not all(_on_board(board.outline, a, b) for a, b in zip(poly, np.roll(poly, -1, axis=0))):
+        r.fail(f"{where}", "the region reaches off the board (or over a hole); keep it inside the outline")
+    factor = r.number(e["stiffness_factor"], f"{where}.stiffness_factor")
+    if not factor > 0:
+        r.fail(f"{where}.stiffness_factor", f"must be > 0 (1 leaves the stiffness unchanged), got {factor:g}")
+    return Region(name, poly, factor)

@@ -1,0 +1,138 @@
+"""Element sets of the board entries that declare effects a diagnosis can find (issue 7): point and
+edge springs to ground, line masses, stiffeners and regions of scaled stiffness.
+
+Each builds exactly what the diagnosis kind of the same effect adds to an FE model
+(``pcbdyn.diagnosis``: ground_spring, edge_stiffness, line_mass, stiffener, region_stiffness), so
+that a board declaring a diagnosed effect has the same matrices as the diagnosed model:
+
+- point spring: a spring to ground on the node's z translation, k (N/m);
+- edge spring: a rotational spring per unit length about the segment direction (edge-frame
+  axis 1, whatever the segment's direction), distributed consistently on its element edges;
+- line mass: the mass lumped on the segment's nodes by tributary length, on x, y and z;
+- stiffener: a beam of fixed material and height h whose width b follows from EI = E b h^3 / 12,
+  A = b h, Iy = Iz = b h^3 / 12, J = b h^3 / 3, axis offset (t + h) / 2 above the mid-surface;
+- region: the shells whose centroid lies inside the polygon get their stiffness (membrane,
+  bending, shear) multiplied by the factor, mass unchanged (overlapping regions multiply).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from matplotlib.path import Path as PolyPath
+
+from ..fe import BeamProperty, EdgeSpringProperty, MassProperty, SpringProperty
+from .spec import BoardError, RibSection
+
+
+def rib_property(EI: float, plate_thickness: float, section: RibSection = RibSection()) -> BeamProperty:
+    """The stiffener's beam section for bending stiffness ``EI`` [N m^2] on a plate of thickness
+    ``plate_thickness`` (the diagnosis kind's RibSection.prop)."""
+    b = 12.0 * EI / (section.E * section.h**3)
+    inertia = b * section.h**3 / 12.0
+    return BeamProperty(section.E, section.nu, section.rho, b * section.h, inertia, inertia, 4.0 * inertia,
+                        orientation=(0.0, 0.0, 1.0), offset=(0.0, 0.0, 0.5 * (plate_thickness + section.h)))
+
+
+def edge_spring_property(k_rot: float) -> EdgeSpringProperty:
+    """Rotational stiffness per unit length about the edge (the diagnosis edge_stiffness kind)."""
+    return EdgeSpringProperty(k=(0.0, 0.0, 0.0, k_rot, 0.0, 0.0), normal=(0.0, 0.0, 1.0))
+
+
+def tributary_weights(xy: np.ndarray) -> np.ndarray:
+    """Tributary-length fractions of the nodes of a chain (sum 1)."""
+    L = np.linalg.norm(np.diff(xy, axis=0), axis=1)
+    w = np.r_[L, 0.0] + np.r_[0.0, L]
+    return w / w.sum()
+
+
+@dataclass(frozen=True)
+class ScaledShell:
+    """A shell property whose stiffness is ``factor`` times that of ``base`` (mass unchanged)."""
+
+    base: object
+    factor: float
+
+    def membrane(self):
+        return self.factor * np.asarray(self.base.membrane())
+
+    def bending(self):
+        return self.factor * np.asarray(self.base.bending())
+
+    def shear(self):
+        return self.factor * np.asarray(self.base.shear())
+
+    def mass_per_area(self):
+        return self.base.mass_per_area()
+
+    def rotary_inertia_per_area(self):
+        return self.base.rotary_inertia_per_area()
+
+    @property
+    def t(self):
+        return self.base.t
+
+
+def _chain(board, mesh, segment, where) -> np.ndarray:
+    try:
+        return mesh.chain_on_segment(*segment)
+    except RuntimeError as exc:
+        raise BoardError(f"{board.path.name}: {where}: {exc}; change board.mesh_size slightly") from None
+
+
+def _path_edges(board, mesh, path, where) -> np.ndarray:
+    return np.concatenate([np.column_stack([c[:-1], c[1:]]) for c in
+                           (_chain(board, mesh, (a, b), where) for a, b in zip(path[:-1], path[1:]))])
+
+
+def apply_fixture(board, mesh, f, point_nodes: dict, q: dict) -> list:
+    """Makers [(name, etype, conn, deps, make)] of a point_spring or edge_spring fixture."""
+    if f.type == "point_spring":
+        key = f"fixtures.{f.name}.k"
+        q.setdefault(key, float(f.k))
+        return [(f"fixtures.{f.name}", "spring", [[point_nodes[f"fixtures.{f.name}"]]], (key,),
+                 lambda q, key=key: SpringProperty(k=(0.0, 0.0, q[key], 0.0, 0.0, 0.0)))]
+    key = f"fixtures.{f.name}.k_rot"
+    q.setdefault(key, float(f.k_rot))
+    chain = _chain(board, mesh, f.segment, f"fixtures.{f.name}")
+    return [(f"fixtures.{f.name}", "edge_spring", np.column_stack([chain[:-1], chain[1:]]), (key,),
+             lambda q, key=key: edge_spring_property(q[key]))]
+
+
+def effect_sets(board, mesh, q: dict, makers: dict) -> list:
+    """Makers of the line masses and stiffeners; regions re-make the shell makers in ``makers``
+    in place (their cells inside a region move to ``regions.<name>.<set>``)."""
+    out = []
+    for e in board.line_masses:
+        key = f"line_masses.{e.name}.mass"
+        q.setdefault(key, e.mass)
+        chain = _chain(board, mesh, e.segment, f"line_masses.{e.name}")
+        for k, (n, w) in enumerate(zip(chain, tributary_weights(mesh.nodes[chain, :2]))):
+            out.append((f"line_masses.{e.name}.{k}", "mass", [[int(n)]], (key,),
+                        lambda q, key=key, w=w: MassProperty(q[key] * w)))
+    for e in board.stiffeners:
+        key = f"stiffeners.{e.name}.EI"
+        q.setdefault(key, e.EI)
+        edges = _path_edges(board, mesh, e.path, f"stiffeners.{e.name}")
+        out.append((f"stiffeners.{e.name}", "beam2", edges, (key, "board.thickness"),
+                    lambda q, key=key, s=e.section: rib_property(q[key], q.get("board.thickness", board.plate.t), s)))
+    for e in board.regions:
+        key = f"regions.{e.name}.stiffness_factor"
+        q.setdefault(key, e.stiffness_factor)
+        path = PolyPath(e.polygon)
+        for name in list(makers):
+            mk = makers[name]
+            if mk.etype not in ("quad4", "tri3") or not len(mk.conn):
+                continue
+            inside = path.contains_points(mesh.nodes[mk.conn][:, :, :2].mean(axis=1))
+            if not inside.any():
+                continue
+            new = f"regions.{e.name}.{name}"
+            makers[new] = type(mk)(mk.etype, mk.conn[inside], mk.deps + (key,),
+                                   lambda q, key=key, make=mk.make: ScaledShell(make(q), q[key]))
+            if inside.all():
+                del makers[name]
+            else:
+                makers[name] = type(mk)(mk.etype, mk.conn[~inside], mk.deps, mk.make)
+    return out
