@@ -11,10 +11,12 @@ Methods (all see the same noisy equations of a shot):
 - ``tls-qrf``: :func:`~.subset.tls_qrf` (thesis 5.2.3);
 - ``svd-qr``: :func:`~.subset.svd_qr` (5.2.2);
 - ``qr``: :func:`~.subset.qr_basic_solution` with the threshold of eq. 5.64;
-- ``min-norm``: the truncated-SVD minimum-norm LS solution of all parameters at the automatic
-  numerical rank, judged by the same threshold as the others (eq. 5.64: |x_i| above
+- ``min-norm``: the minimum-norm LS solution of all parameters at the full numerical rank (only
+  singular values below RTOL sigma_1 are dropped; no epsilon-condition cut and never the chosen
+  ``rank``: "for minimal 2-norm method, the numerical rank number is always set to 18", thesis
+  5.4.1, QMS), judged by the same threshold as the others (eq. 5.64: |x_i| above
   max(0.01, 0.2 max|x|)). This is how the thesis counts N_det of its "minimal 2-norm" solution
-  (section 5.4.1: 16 of 18 moduli detected) and why it never takes the chosen rank (5.4.1, QMS).
+  (section 5.4.1: 16 of 18 moduli detected).
 """
 
 from __future__ import annotations
@@ -67,7 +69,8 @@ def localise(method: str, A, b, rank: int | None = None) -> np.ndarray:
     if method == "min-norm":
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RankDeficiencyWarning)
-            return threshold_selection(solve_ls(A, b).x)
+            # full numerical rank (thesis 5.4.1): no jump of the epsilon-condition curve is cut
+            return threshold_selection(solve_ls(A, b, jump=np.inf).x)
     raise ValueError(f"method {method!r}: choose one of {', '.join(METHODS)}")
 
 
