@@ -90,3 +90,35 @@ def points_on_board(board, points, source, board_toml) -> None:
             f"{' ...' if off.sum() > 10 else ''}. The board frame runs from ({lo[0] * 1e3:g}, {lo[1] * 1e3:g}) to "
             f"({hi[0] * 1e3:g}, {hi[1] * 1e3:g}) mm; give the points in that frame and state their unit in the "
             "header (e.g. 'x [mm]')")
+
+
+def parse_extra(items) -> list:
+    """NAME=FILE arguments -> [(configuration name, Path)]."""
+    from pathlib import Path
+
+    out = []
+    for it in items:
+        name, sep, path = it.partition("=")
+        if not sep or not name or not path:
+            raise click.BadParameter(f"'{it}' is not NAME=FILE (a configuration of board.toml and its test, "
+                                     "e.g. c2=test2.uff)", param_hint="CONFIGS")
+        if not Path(path).is_file():
+            raise click.BadParameter(f"'{path}' does not exist", param_hint="CONFIGS")
+        out.append((name, Path(path)))
+    return out
+
+
+def measured_configurations(board, test_uff, extras) -> list:
+    """[(configuration name or None, MeasuredModes)] of the base test and every NAME=FILE; a
+    BoardError for a configuration board.toml does not declare."""
+    from ..board import BoardError
+    from ..updating.board_problem import MeasuredModes
+    from .correlate import load_test_modes
+
+    data = [(None, MeasuredModes.from_test(load_test_modes(test_uff)))]
+    for name, path in parse_extra(extras):
+        if board.configuration(name) is None:
+            raise BoardError(f"{board.path.name}: configuration '{name}' (from {name}={path}) is not in "
+                             "[[configurations]]")
+        data.append((name, MeasuredModes.from_test(load_test_modes(path))))
+    return data

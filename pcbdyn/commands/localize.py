@@ -16,23 +16,9 @@ from pathlib import Path
 import click
 import numpy as np
 
-from .common import done, fail, step
+from .common import done, fail, measured_configurations, parse_extra, step
 
 METHOD_CHOICES = ["tls-qrf", "svd-qr", "qr", "min-norm"]
-
-
-def parse_extra(items) -> list:
-    """'name=path' arguments -> [(configuration name, Path)]."""
-    out = []
-    for item in items:
-        name, sep, path = item.partition("=")
-        if not sep or not name or not path:
-            raise click.BadParameter(f"'{item}' is not name=path.uff (a configuration of board.toml and its test)",
-                                     param_hint="CONFIG_TESTS")
-        if not Path(path).is_file():
-            raise click.BadParameter(f"'{path}' does not exist", param_hint="CONFIG_TESTS")
-        out.append((name, Path(path)))
-    return out
 
 
 def evidence(method, A, b, names, rank=None, alpha=0.8) -> tuple:
@@ -106,9 +92,9 @@ def command(board_toml, test_uff, config_tests, method, eq_type, params, rank, a
     from ..board import load_board
     from ..report.files import write_json
     from ..testdata import TestDataError
-    from ..updating.board_problem import BoardProblem, MeasuredModes, config_pairing
+    from ..board import BoardError
+    from ..updating.board_problem import BoardProblem, config_pairing
     from ..updating.iteration import build_equations
-    from .correlate import load_test_modes
 
     extra = parse_extra(config_tests)
     try:
@@ -116,13 +102,9 @@ def command(board_toml, test_uff, config_tests, method, eq_type, params, rank, a
         names = [n.strip() for n in params.split(",")] if params else None
         t0 = step("building the model and its parameter derivatives")
         problem = BoardProblem(board, names)
-        known = {c.name for c in board.configurations}
         configs = []
-        for name, path in [(None, test_uff)] + extra:
-            if name is not None and name not in known:
-                raise ValueError(f"configuration '{name}' is not in [[configurations]] of {board_toml.name} "
-                                 f"(known: {', '.join(sorted(known)) or 'none'})")
-            measured = MeasuredModes.from_test(load_test_modes(path))
+        for (name, measured), (_, path) in zip(measured_configurations(board, test_uff, config_tests),
+                                               [(None, test_uff)] + extra):
             if eq_type in ("qms", "fbm") and measured.shapes is None:
                 raise ValueError(f"{path.name}: --equations {eq_type} needs mode shapes")
             configs.append(problem.configuration(name, measured, eq_type, matching=matching))
@@ -130,7 +112,7 @@ def command(board_toml, test_uff, config_tests, method, eq_type, params, rank, a
                 measured_xy = None if measured.xyz is None else measured.xyz[:, :2]
         (A, b), _, states = build_equations(configs, problem.p0, config_pairing(configs))
         done(t0)
-    except (ValueError, KeyError, TestDataError) as exc:
+    except (ValueError, KeyError, TestDataError, BoardError) as exc:
         fail(str(exc).strip("'\""))
     data, tls = evidence(method, A, b, problem.names, rank, alpha)
     data["configurations"] = ["base"] + [n for n, _ in extra]

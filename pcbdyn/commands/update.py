@@ -29,24 +29,11 @@ from pathlib import Path
 import click
 import numpy as np
 
-from .common import done, fail, step
+from .common import done, fail, measured_configurations, parse_extra, step
 
 BASE_NAMES = ("base", "c1", "")
 #: SI unit of the JSON values for the display units board.toml quantities use (others are SI already)
 SI_UNITS = {"mm": "m", "g": "kg"}
-
-
-def parse_extra(items) -> list:
-    """NAME=FILE pairs -> [(name, Path)]."""
-    out = []
-    for it in items:
-        name, sep, path = it.partition("=")
-        if not sep or not name or not path:
-            raise click.BadParameter(f"'{it}' is not NAME=FILE (e.g. c2=test2.uff)", param_hint="CONFIGS")
-        if not Path(path).exists():
-            raise click.BadParameter(f"'{path}' does not exist", param_hint="CONFIGS")
-        out.append((name, Path(path)))
-    return out
 
 
 def read_frequency_table(path: Path, board) -> list:
@@ -152,7 +139,6 @@ def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping,
     from ..testdata import TestDataError
     from ..units import to_si
     from ..updating.board_problem import BoardProblem, MeasuredModes, run
-    from .correlate import load_test_modes
 
     if (test_uff is None) == (freq_csv is None):
         fail("give either TEST_UFF (and NAME=FILE for other configurations) or --frequencies FILE.csv")
@@ -169,12 +155,7 @@ def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping,
             data = read_frequency_table(freq_csv, board)
             click.echo("frequencies only: test mode n is paired with elastic model mode n (by order)", err=True)
         else:
-            data = [(None, MeasuredModes.from_test(load_test_modes(test_uff)))]
-            for name, path in parse_extra(configs):
-                if board.configuration(name) is None:
-                    raise BoardError(f"{board_toml.name}: configuration '{name}' (from {name}={path}) is not in "
-                                     "[[configurations]]")
-                data.append((name, MeasuredModes.from_test(load_test_modes(path))))
+            data = measured_configurations(board, test_uff, configs)
             if method == "freq":
                 data = [(c, MeasuredModes(m.frequencies, m.shapes, m.xyz, m.directions)) for c, m in data]
         if not method.startswith("frf"):

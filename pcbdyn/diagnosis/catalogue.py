@@ -135,30 +135,33 @@ def add_effect(model, candidate, value: float):
     return candidate.spec.apply(model, candidate, float(value))
 
 
-def _quadratic_forms(shapes: np.ndarray, b: Blocks):
-    """phi^T Ke phi and phi^T Me phi per cell and mode, each (n_cells, n_modes)."""
-    dofs = element_dofs(b.conn)
-    ph = shapes[dofs]  # (n_cells, nd, n_modes)
-    qk = np.einsum("cam,cab,cbm->cm", ph, b.Ke, ph, optimize=True)
-    qm = np.einsum("cam,cab,cbm->cm", ph, b.Me, ph, optimize=True)
-    return qk, qm
+def bilinear_forms(model, basis: np.ndarray, shapes: np.ndarray, candidates):
+    """(BK, BM), each (n_candidates, n_basis, n_shapes): phi_k^T dK/dp phi_i and phi_k^T dM/dp phi_i
+    for full-length ``basis`` columns k and ``shapes`` columns i, summed over each candidate's
+    cells (the terms of the eigenvalue and eigenvector derivatives, thesis eqs. 3.6 and 3.11)."""
+    BK = np.zeros((len(candidates), basis.shape[1], shapes.shape[1]))
+    BM = np.zeros_like(BK)
+    for name, idx in _by_kind(candidates).items():
+        cands = [candidates[i] for i in idx]
+        for b in kind(name).blocks(model, cands):
+            dofs = element_dofs(b.conn)
+            pb, ps = basis[dofs], shapes[dofs]  # (n_cells, nd, n_basis), (n_cells, nd, n_shapes)
+            S = sp.csr_matrix((np.ones(b.owner.size), (b.owner, np.arange(b.owner.size))),
+                              shape=(len(cands), b.owner.size))
+            for E, out in ((b.Ke, BK), (b.Me, BM)):
+                if np.any(E):
+                    per_cell = np.einsum("cak,cab,cbi->cki", pb, E, ps, optimize=True)
+                    out[idx] += (S @ per_cell.reshape(b.owner.size, -1)).reshape(len(cands), *per_cell.shape[1:])
+    return BK, BM
 
 
 def eigenvalue_columns(model, modes, candidates) -> np.ndarray:
     """d lambda_i / dp for every mode i (rows) and candidate (columns) [rad^2/s^2 per SI unit],
     from mass-normalised full-length shapes (``fe.modal.Modes``): sum over the candidate's cells
     of phi_i^T (Ke - lambda_i Me) phi_i."""
-    lam = modes.omega2
-    out = np.zeros((lam.size, len(candidates)))
-    for name, idx in _by_kind(candidates).items():
-        cands = [candidates[i] for i in idx]
-        for b in kind(name).blocks(model, cands):
-            qk, qm = _quadratic_forms(modes.shapes, b)
-            per_cell = qk - qm * lam
-            S = sp.csr_matrix((np.ones(b.owner.size), (b.owner, np.arange(b.owner.size))),
-                              shape=(len(cands), b.owner.size))
-            out[:, idx] += (S @ per_cell).T
-    return out
+    BK, BM = bilinear_forms(model, modes.shapes, modes.shapes, candidates)
+    i = np.arange(modes.shapes.shape[1])
+    return (BK[:, i, i] - BM[:, i, i] * modes.omega2[None, :]).T
 
 
 def frequency_columns(model, modes, candidates) -> np.ndarray:

@@ -1,21 +1,23 @@
-"""First selection of the effects that explain frequency residuals (issue 7, step 5): greedy
-forward selection over the candidates' sensitivity columns, each choice followed by a nonlinear
-estimate of the chosen magnitudes, stopped by an information criterion.
+"""Selection and estimation of the effects that explain a residual (issue 7, step 5): greedy forward
+selection over the candidates' sensitivity columns, each choice confirmed by a nonlinear estimate
+of the chosen magnitudes together with the declared parameters, stopped by an information
+criterion.
 
-Rows are the paired modes, weighted by the frequency noise: r_i = (f_test,i - f_i) / (sigma f_test,i)
-and a_ij = (df_i / dp_j) s_j / (sigma f_test,i) (s_j: the kind's typical magnitude, so that
-columns of different units compare), so that chi^2 = |r|^2 counts residual in units of
-noise. Step k takes the column that removes the most chi^2 once the columns already chosen are
-projected out (the cos^2 criterion of thesis eqs. 5.51-5.54 applied to the residual) among
-those whose estimated value is physical (``lower`` of its kind), confirmed on a shortlist by
-re-estimating all chosen magnitudes by Gauss-Newton with full re-solves, within
-[lower, UPPER * scale] (the effects are linear in K and M, the frequencies are not). A new effect is kept only if it lowers
-    chi^2 + k * max(ln n, q)
-(n modes, k effects), q being the chi^2 (1 degree of freedom) quantile exceeded with probability
-ALPHA / P (P candidates): the best of P noise-only columns removes less than q with probability
-1 - ALPHA (Bonferroni), so noise alone does not make an effect; ln n is BIC's term. After each
-addition an earlier effect that the others make redundant is dropped (backward check).
-Modes are paired by order here; the diagnose command must pair them by MAC first.
+The residual (:class:`.residual.ModalResidual`) is in units of noise, so chi^2 = |r|^2. Step k
+projects out the columns of the declared parameters and of the effects already chosen and scores
+every candidate by the chi^2 its column removes (the cos^2 criterion of thesis eqs. 5.51-5.54
+applied to the residual), among those whose estimated value is physical (``lower`` of its kind).
+The best ``shortlist`` of every kind are re-estimated with full re-solves (a spring's effect on
+the frequencies saturates, so the linear score alone under-rates large ones) and the least chi^2
+wins. Magnitudes stay within [lower, UPPER * scale], declared parameters within their bounds.
+
+A new effect is kept only if its chi^2 drop exceeds the penalty
+    q = max(ln n, chi^2_1 quantile exceeded with probability ALPHA / P)
+(n rows, P candidates: the best of P noise-only columns removes less than q with probability
+1 - ALPHA, Bonferroni; ln n is BIC's term), both in the stated noise units and in units of the
+variance left after the fit, chi^2 / (n - k): noise or model error larger than stated must not
+turn into effects. After each addition an earlier effect that the others make redundant is
+dropped (backward check).
 """
 
 from __future__ import annotations
@@ -23,10 +25,10 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.optimize import lsq_linear
 from scipy.stats import chi2 as chi2_dist
 
-from ..fe.modal import solve_modes
-from .catalogue import add_effect, frequency_columns
+from .catalogue import add_effect
 
 #: magnitudes are bounded by this many times their kind's typical ``scale`` (a 1 kg mass or a
 #: 1e7 N/m spring is no longer an effect a test setup hides; unbounded, a huge mass pins a node)
@@ -39,16 +41,24 @@ RANK_STEPS = 2
 
 @dataclass
 class Selection:
-    """``chosen``: candidate indices in the order found; ``values``: their magnitudes (SI);
-    ``chi2[s]``, ``criterion[s]``: after step s (s = 0: the model as given; a step adds one
-    effect and may drop an earlier one);
-    ``frequencies``: the model's frequencies with the chosen effects."""
+    """``chosen``: candidate indices in the order found; ``values``: their magnitudes (SI) and
+    ``sigma`` their standard deviations (``cov`` their covariance); ``p``: the declared parameters estimated with them;
+    ``chi2[s]``, ``criterion[s]``: after step s (s = 0: the declared parameters alone);
+    ``state``: the final :class:`.residual.State`; ``frequencies``: the paired model frequencies of
+    the first configuration."""
 
     chosen: list = field(default_factory=list)
     values: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    sigma: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    cov: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    p: np.ndarray = field(default_factory=lambda: np.zeros(0))
     chi2: list = field(default_factory=list)
     criterion: list = field(default_factory=list)
-    frequencies: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    state: object = None
+
+    @property
+    def frequencies(self) -> np.ndarray:
+        return self.state.configs[0].f_a
 
 
 def with_effects(model, candidates, values):
@@ -64,83 +74,124 @@ def penalty(n_obs: int, n_candidates: int, alpha: float = ALPHA) -> float:
     return max(np.log(n_obs), float(chi2_dist.isf(alpha / max(n_candidates, 1), 1)))
 
 
-def _residual(model, f_test, sigma, n):
-    modes = solve_modes(model, n_modes=n)
-    f = modes.frequencies[:n]
-    return modes, f, (f_test - f) / (sigma * f_test)
+@dataclass
+class Fit:
+    p: np.ndarray
+    values: np.ndarray
+    state: object
+    cov: np.ndarray
+
+    @property
+    def chi2(self) -> float:
+        return self.state.chi2
 
 
-def _estimate(model, cands, v0, f_test, sigma, n, steps, tol=1e-6):
-    """Gauss-Newton on the magnitudes of ``cands`` (bounded below by their kinds' ``lower``)."""
-    lower = np.array([c.spec.lower for c in cands])
-    upper = UPPER * np.array([c.spec.scale for c in cands])
-    v = np.clip(np.asarray(v0, dtype=float), lower, upper)
+def estimate(res, p0, cands, v0, steps: int, bounds=None, fit_params: bool = True, tol: float = 1e-5) -> Fit:
+    """Gauss-Newton on (ln p, magnitudes) with bounded steps (``bounds`` = (lower, upper) of p),
+    halving a step that raises chi^2; ``cov`` is the covariance of (ln p, magnitudes) from the
+    last Jacobian, scaled by the residual's own variance when larger than stated."""
+    p = np.asarray(p0, float)
+    npar = p.size if fit_params else 0
+    lo_v = np.array([c.spec.lower for c in cands], float)
+    hi_v = UPPER * np.array([c.spec.scale for c in cands], float)
+    scale = np.r_[np.ones(npar), [c.spec.scale for c in cands]]
+    v = np.clip(np.asarray(v0, float), lo_v, hi_v)
+    st = res.evaluate(p, cands, v)
+    lo_p, hi_p = (np.full(p.size, -np.inf), np.full(p.size, np.inf)) if bounds is None else bounds
     for _ in range(steps):
-        current = with_effects(model, cands, v)
-        modes, _, r = _residual(current, f_test, sigma, n)
-        J = frequency_columns(current, modes, cands)[:n] / (sigma * f_test)[:, None]
-        dv = np.linalg.lstsq(J, r, rcond=None)[0]
-        v_new = np.clip(v + dv, lower, upper)
-        done = np.all(np.abs(v_new - v) <= tol * np.maximum(np.abs(v), [c.spec.scale for c in cands]))
-        v = v_new
-        if done:
+        J = _jacobian(res, st, cands, npar) * scale
+        if J.shape[1] == 0:
             break
-    modes, f, r = _residual(with_effects(model, cands, v), f_test, sigma, n)
-    return v, f, float(r @ r), modes
+        lo = np.r_[np.log(lo_p / p)[:npar], (lo_v - v)] / scale
+        hi = np.r_[np.log(hi_p / p)[:npar], (hi_v - v)] / scale
+        dy = lsq_linear(J, st.r, bounds=(np.minimum(lo, 0.0), np.maximum(hi, 0.0))).x * scale
+        for _half in range(4):
+            p_new = p * np.exp(dy[:npar]) if npar else p
+            v_new = np.clip(v + dy[npar:], lo_v, hi_v)
+            try:
+                trial = res.evaluate(p_new, cands, v_new)
+            except (ValueError, ArithmeticError, np.linalg.LinAlgError):
+                trial = None
+            if trial is not None and trial.chi2 <= st.chi2 * (1 + 1e-9):
+                break
+            dy = 0.5 * dy
+        else:
+            break
+        small = np.all(np.abs(dy) <= tol * np.maximum(np.r_[np.ones(npar), np.abs(v)], scale * tol))
+        p, v, st = trial.p, v_new, trial
+        if small:
+            break
+    J = _jacobian(res, st, cands, npar)
+    k = J.shape[1]
+    var = max(1.0, st.chi2 / max(res.n_rows - k, 1))
+    cov = var * np.linalg.pinv(J.T @ J) if k else np.zeros((0, 0))
+    return Fit(p, v, st, cov)
 
 
-def forward_select(model, candidates, f_test, sigma: float, max_effects: int = 3, newton_steps: int = 8,
-                   shortlist: int = 3, alpha: float = ALPHA) -> Selection:
-    """Effects among ``candidates`` explaining measured frequencies ``f_test`` [Hz] (paired in order
-    with the model's first len(f_test) elastic modes), relative noise ``sigma`` (e.g. 0.002).
-    Each step fits the ``shortlist`` best columns of every kind by the linear score with re-solves
-    and keeps the one of least chi^2 (a spring's or an edge's effect on the frequencies saturates, so the linear
-    score alone under-rates large ones)."""
-    f_test = np.asarray(f_test, dtype=float)
-    if not sigma > 0:
-        raise ValueError(f"sigma (relative frequency noise) must be > 0, got {sigma}")
-    n = f_test.size
+def _jacobian(res, st, cands, npar):
+    cols = [res.param_columns(st)[:, :npar]] if npar else []
+    if cands:
+        cols.append(res.effect_columns(st, cands))
+    return np.hstack(cols) if cols else np.zeros((res.n_rows, 0))
+
+
+def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_steps: int = 8, shortlist: int = 3,
+           alpha: float = ALPHA, base: Fit | None = None) -> Selection:
+    """Effects among ``candidates`` that explain the residual ``res`` (:class:`.residual.ModalResidual`)
+    beyond the declared parameters (initial values ``p0``, ``bounds``); ``base``: the fit of the
+    declared parameters alone when already made."""
+    p0 = np.asarray(p0, float)
+    n = res.n_rows
     pen = penalty(n, len(candidates), alpha)
-    modes, f, r = _residual(model, f_test, sigma, n)
-    sel = Selection(chi2=[float(r @ r)], criterion=[float(r @ r)], frequencies=f)
-    current = model
+    fit = base or estimate(res, p0, [], [], newton_steps, bounds)
+    sel = Selection(p=fit.p, chi2=[fit.chi2], criterion=[fit.chi2], state=fit.state)
     kinds = np.array([c.kind for c in candidates])
-    scale = np.array([c.spec.scale for c in candidates])  # columns per typical magnitude: comparable units
+    scale = np.array([c.spec.scale for c in candidates])
+    lower = np.array([c.spec.lower for c in candidates])
     for _ in range(max_effects):
         if sel.chi2[-1] <= pen:  # chi^2 >= 0: one more effect cannot lower the criterion
             break
-        A = frequency_columns(current, modes, candidates)[:n] * scale / (sigma * f_test)[:, None]
-        if sel.chosen:
-            Q, _ = np.linalg.qr(A[:, sel.chosen])
-            A_p, r_p = A - Q @ (Q.T @ A), r - Q @ (Q.T @ r)
-        else:
-            A_p, r_p = A, r
+        st = fit.state
+        A = res.effect_columns(st, candidates) * scale
+        Q = _orth(np.hstack([res.param_columns(st), res.effect_columns(st, [candidates[i] for i in sel.chosen])]))
+        A_p, r_p = A - Q @ (Q.T @ A), st.r - Q @ (Q.T @ st.r)
         norm2 = np.einsum("ij,ij->j", A_p, A_p)
         ok = norm2 > 1e-12 * norm2.max()
         value = np.where(ok, A_p.T @ r_p / np.where(ok, norm2, 1.0), 0.0) * scale
-        gain = np.where(ok, value**2 * norm2, -np.inf)
-        lower = np.array([c.spec.lower for c in candidates])
+        gain = np.where(ok, value**2 * norm2 / scale**2, -np.inf)
         gain[value < lower] = -np.inf  # an effect of unphysical sign cannot be the answer
         gain[sel.chosen] = -np.inf
         order = _shortlist(gain, kinds, shortlist)
         if not order.size:
             break
-        fits = [_estimate(model, [candidates[i] for i in sel.chosen + [j]], np.r_[sel.values, value[j]], f_test, sigma,
-                          n, RANK_STEPS) for j in order]
-        best = int(np.argmin([fit[2] for fit in fits]))
+        fits = [estimate(res, fit.p, [candidates[i] for i in sel.chosen + [j]], np.r_[sel.values, value[j]],
+                         RANK_STEPS, bounds, fit_params=False) for j in order]
+        best = int(np.argmin([f.chi2 for f in fits]))
         idx = sel.chosen + [int(order[best])]
-        v, f_new, chi2, modes_new = _estimate(model, [candidates[i] for i in idx], fits[best][0], f_test, sigma, n,
-                                              newton_steps)
-        if chi2 + len(idx) * pen >= sel.criterion[-1]:
+        new = estimate(res, fit.p, [candidates[i] for i in idx], fits[best].values, newton_steps, bounds)
+        if not _worth(sel.chi2[-1], new.chi2, n, p0.size + len(idx), pen):
             break
-        idx, v, f_new, chi2, modes_new = _prune(model, candidates, idx, v, f_new, chi2, modes_new, f_test, sigma,
-                                                n, newton_steps, pen)
-        sel.chosen, sel.values, sel.frequencies = idx, v, f_new
-        sel.chi2.append(chi2)
-        sel.criterion.append(chi2 + len(idx) * pen)
-        current = with_effects(model, [candidates[i] for i in idx], v)
-        modes, r = modes_new, (f_test - f_new) / (sigma * f_test)
+        idx, new = _prune(res, candidates, idx, new, newton_steps, bounds, pen, p0.size)
+        fit = new
+        sel.chosen, sel.values, sel.p, sel.state = idx, new.values, new.p, new.state
+        sel.cov = new.cov[p0.size:, p0.size:]
+        sel.sigma = np.sqrt(np.clip(np.diag(sel.cov), 0.0, None))
+        sel.chi2.append(new.chi2)
+        sel.criterion.append(new.chi2 + len(idx) * pen)
     return sel
+
+
+def _worth(chi2_before, chi2_after, n, k, pen) -> bool:
+    """The drop exceeds the penalty in stated noise units and in units of the variance left."""
+    drop = chi2_before - chi2_after
+    return drop > pen and drop / max(chi2_after / max(n - k, 1), 1.0) > pen
+
+
+def _orth(A):
+    if A.shape[1] == 0:
+        return np.zeros((A.shape[0], 0))
+    U, s, _ = np.linalg.svd(A, full_matrices=False)
+    return U[:, s > 1e-10 * s[0]] if s.size and s[0] > 0 else np.zeros((A.shape[0], 0))
 
 
 def _shortlist(gain, kinds, per_kind: int) -> np.ndarray:
@@ -152,17 +203,32 @@ def _shortlist(gain, kinds, per_kind: int) -> np.ndarray:
     return np.concatenate(out) if out else np.zeros(0, dtype=np.int64)
 
 
-def _prune(model, candidates, idx, v, f, chi2, modes, f_test, sigma, n, steps, pen):
+def _prune(res, candidates, idx, fit, steps, bounds, pen, n_params):
     """Backward check after each addition: drop an earlier effect whenever the others, re-estimated
     without it, reach a lower criterion (greedy choices made before the right effect was in)."""
     while len(idx) > 1:
         best = None
         for drop in range(len(idx) - 1):
             keep = [i for t, i in enumerate(idx) if t != drop]
-            trial = _estimate(model, [candidates[i] for i in keep], np.delete(v, drop), f_test, sigma, n, steps)
-            if trial[2] + len(keep) * pen < chi2 + len(idx) * pen and (best is None or trial[2] < best[1][2]):
+            trial = estimate(res, fit.p, [candidates[i] for i in keep], np.delete(fit.values, drop), steps, bounds)
+            if trial.chi2 + len(keep) * pen < fit.chi2 + len(idx) * pen and (best is None or trial.chi2 < best[1].chi2):
                 best = (keep, trial)
         if best is None:
             break
-        idx, (v, f, chi2, modes) = best[0], best[1]
-    return idx, v, f, chi2, modes
+        idx, fit = best
+    return idx, fit
+
+
+def forward_select(model, candidates, f_test, sigma: float, max_effects: int = 3, newton_steps: int = 8,
+                   shortlist: int = 3, alpha: float = ALPHA) -> Selection:
+    """:func:`search` on frequencies alone: ``f_test`` [Hz] paired in order with the first
+    len(f_test) elastic modes of ``model``, relative noise ``sigma`` (e.g. 0.002), no declared
+    parameters."""
+    from .residual import ModalResidual, Observation
+
+    f_test = np.asarray(f_test, dtype=float)
+    if not sigma > 0:
+        raise ValueError(f"sigma (relative frequency noise) must be > 0, got {sigma}")
+    res = ModalResidual([Observation(None, f_test, np.full(f_test.size, float(sigma)))], lambda p: [model])
+    return search(res, candidates, max_effects=max_effects, newton_steps=newton_steps, shortlist=shortlist,
+                  alpha=alpha)

@@ -1,0 +1,97 @@
+"""``pcbdyn diagnose board.toml test.uff [c2=test2.uff ...]``: find what the model lacks (issue 7).
+
+Fits the declared [[parameters]], tests whether the residual is noise and, when it is not, searches
+the catalogue of effects (point masses and inertias, ground springs, edge stiffness, region
+stiffness, stiffeners, line masses) for the fewest that explain it, estimated together with the
+parameters (:func:`pcbdyn.diagnosis.pipeline.diagnose`). Prints the effects and the correlation as
+given / parameters only / with the effects; writes ``<board>.diagnosed.toml`` declaring them next
+to the original, the evidence map and tables in ``--out``, and JSON.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from .common import done, fail, measured_configurations, step
+
+
+def parse_noise(text):
+    """'f=0.2,shape=2' -> (frequency %, shape %), None where not given (or 0)."""
+    from ..testdata.noise import Noise
+
+    if text is None:
+        return None, None
+    try:
+        n = Noise.parse(text)
+    except ValueError as exc:
+        raise click.BadParameter(f"{exc}; e.g. --noise f=0.2,shape=2 (percent, uniform bounds)",
+                                 param_hint="--noise") from None
+    return n.frequency_pct or None, n.shape_pct or None
+
+
+@click.command("diagnose")
+@click.argument("board_toml", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.argument("test_uff", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.argument("configs", nargs=-1)
+@click.option("--noise", default=None,
+              help="measurement noise in percent as uniform bounds (thesis eqs. 5.72-5.73), e.g. 'f=0.2,shape=2'; "
+                   "default: frequencies 0.2 %, shapes estimated from the data")
+@click.option("--kinds", default=None, help="comma-separated catalogue kinds to search (default: all)")
+@click.option("--max-effects", type=click.IntRange(min=1), default=3, show_default=True)
+@click.option("--mesh-size", default=None, help="element size, e.g. '5 mm' (default: the board's)")
+@click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=None,
+              help="folder for the evidence map and tables")
+@click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None)
+def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size, out, json_path):
+    """Find the effects a board model lacks from modal tests (UFF with mode shapes)."""
+    from ..board import BoardError, load_board
+    from ..board.enrich import write_enriched
+    from ..diagnosis import KINDS
+    from ..diagnosis.pipeline import diagnose
+    from ..report import diagnosis_report as rep
+    from ..report.files import write_json, write_text
+    from ..testdata import TestDataError
+    from ..units import to_si
+
+    freq_pct, shape_pct = parse_noise(noise)
+    chosen = None
+    if kinds:
+        chosen = [k.strip() for k in kinds.split(",") if k.strip()]
+        bad = [k for k in chosen if k not in KINDS]
+        if bad:
+            raise click.BadParameter(f"unknown kind(s) {bad}; use {', '.join(KINDS)}", param_hint="--kinds")
+    try:
+        board = load_board(board_toml)
+        tests = measured_configurations(board, test_uff, configs)
+        ms = to_si(mesh_size, "mm", "--mesh-size") if mesh_size else None
+        t0 = step("diagnosing")
+        d = diagnose(board, tests, freq_pct, shape_pct, mesh_size=ms, kinds=chosen, max_effects=max_effects,
+                     progress=lambda msg: click.echo(f"    {msg}", err=True))
+        done(t0)
+    except (BoardError, TestDataError, KeyError, ValueError) as exc:
+        fail(str(exc))
+    click.echo(f"\n{board.name}: {d.message}\n")
+    click.echo(rep.format_effects(d.effects))
+    click.echo("")
+    click.echo(rep.format_states(d.before, d.parameters_only, d.after))
+    enriched = None
+    if d.effects:
+        try:
+            enriched = write_enriched(board_toml, rep.enriched_effects(d))
+            click.echo(f"\nboard with the effects declared written to {enriched}", err=True)
+        except BoardError as exc:
+            click.echo(f"\nnote: the enriched board.toml was not written: {exc}", err=True)
+    if out is not None:
+        write_text(out / "effects.txt", rep.format_effects(d.effects) + "\n")
+        write_text(out / "correlation.txt", rep.format_states(d.before, d.parameters_only, d.after) + "\n")
+        if d.evidence:
+            rep.plot_evidence(out / "evidence.png", board, d.evidence, d.effects)
+    if json_path is not None:
+        write_json(json_path, {
+            "effects": d.effects, "noise_only": d.noise_only, "message": d.message,
+            "before": rep.summary(d.before), "parameters_only": rep.summary(d.parameters_only),
+            "after": rep.summary(d.after), "parameters": d.parameters, "statistics": d.statistics,
+            "enriched_board": None if enriched is None else str(enriched),
+        })

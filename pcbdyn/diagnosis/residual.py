@@ -1,0 +1,212 @@
+"""The residual of a model against modal tests, in units of noise, and its first-order sensitivity to
+declared parameters and to candidate effects (issue 7, steps 2 and 5).
+
+Rows, per test configuration: one per measured mode,
+    r_i = (f_x,i - f_a,i) / (sigma_f,i f_x,i),
+and, with measured shapes, one per point and mode,
+    r_ji = (phi_x,ji - s_i u_ji) / (sigma_s,i rms(phi_x,i)),
+u_i being the paired model shape read at the points and s_i its modal scale factor (the
+least-squares fit of u_i to phi_x,i), so that the shape counts and not its scaling. With the right
+sigmas, chi^2 = |r|^2 of a model that lacks nothing is a chi-square variable.
+
+Sensitivities: the eigenvalue derivative (thesis eq. 3.6) for the frequency rows, and for the
+shape rows the modal expansion of the eigenvector derivative over every computed mode, rigid-body
+modes included (eqs. 3.8-3.14): d phi_i = sum_(k != i) phi_k phi_k^T (dK - lambda_i dM) phi_i /
+(lambda_i - lambda_k); the part along phi_i only rescales the shape and drops out with s_i. Both
+need only the bilinear forms phi_k^T dK phi_i, phi_k^T dM phi_i (:func:`.catalogue.bilinear_forms`
+for candidates, sparse products for parameters). The truncated expansion makes the columns
+approximate; every fit is confirmed on full re-solves.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..correlation.pairing import pair_modes
+from ..fe.modal import solve_modes
+from .catalogue import bilinear_forms
+
+
+@dataclass
+class Observation:
+    """One test configuration: measured frequencies ``f`` [Hz] (m,), optionally shapes (n_pts, m)
+    that the model gives as ``read @ u`` (``read`` (n_pts, n_dof), full DOFs); relative standard
+    deviations ``sigma_f`` (m,) of the frequencies and ``sigma_s`` (m,) of a shape component (per
+    RMS of the mode's measured shape); ``xyz``, ``directions``: the measured DOFs [m]. Without
+    shapes the modes pair by order."""
+
+    name: str | None
+    f: np.ndarray
+    sigma_f: np.ndarray
+    shapes: np.ndarray | None = None
+    read: object = None
+    sigma_s: np.ndarray | None = None
+    xyz: np.ndarray | None = None
+    directions: np.ndarray | None = None
+
+    @property
+    def n_rows(self) -> int:
+        return self.f.size * (1 + (0 if self.shapes is None else self.shapes.shape[0]))
+
+
+@dataclass
+class ConfigState:
+    """A configuration's model at one state: ``modes``, ``pairs`` (elastic mode index per measured
+    mode), paired frequencies ``f_a``, ``mac``, the model shapes at the points ``u`` and scale
+    factors ``s``, its rows ``r``."""
+
+    model: object
+    modes: object
+    pairs: np.ndarray
+    f_a: np.ndarray
+    mac: np.ndarray
+    u: np.ndarray | None
+    s: np.ndarray | None
+    r: np.ndarray
+
+
+@dataclass
+class State:
+    """Declared parameter values ``p`` [SI], effects (``candidates``, ``values`` [SI]) and the
+    per-configuration states."""
+
+    p: np.ndarray
+    candidates: list
+    values: np.ndarray
+    configs: list = field(default_factory=list)
+
+    @property
+    def r(self) -> np.ndarray:
+        return np.concatenate([c.r for c in self.configs])
+
+    @property
+    def chi2(self) -> float:
+        r = self.r
+        return float(r @ r)
+
+    def summary(self, observations) -> dict:
+        """Max |frequency error| [%] and mean MAC over all configurations, and per configuration."""
+        per = []
+        for ob, c in zip(observations, self.configs):
+            df = 100.0 * (c.f_a / ob.f - 1.0)
+            per.append({"configuration": ob.name or "base", "max_freq_error_pct": float(np.max(np.abs(df))),
+                        "mean_mac": float(np.mean(c.mac)) if ob.shapes is not None else None,
+                        "modes": [{"test_mode": i + 1, "model_mode": int(c.pairs[i]) + 1, "f_test_hz": float(ob.f[i]),
+                                   "f_model_hz": float(c.f_a[i]), "df_pct": float(df[i]),
+                                   "mac": float(c.mac[i]) if ob.shapes is not None else None}
+                                  for i in range(ob.f.size)]})
+        macs = [q["mean_mac"] for q in per if q["mean_mac"] is not None]
+        return {"max_freq_error_pct": max(q["max_freq_error_pct"] for q in per),
+                "mean_mac": float(np.mean(macs)) if macs else None, "configurations": per}
+
+
+def _mac(a, b):
+    return np.abs(np.sum(a * b, axis=0)) ** 2 / (np.sum(a * a, axis=0) * np.sum(b * b, axis=0))
+
+
+class ModalResidual:
+    """Residual rows of ``observations`` against the models ``build(p)`` (one fe.Model per
+    observation, all on one mesh, so that a candidate's nodes mean the same in each) carrying
+    effects. ``derivatives(p, models)``: per observation, one (dK, dM) pair (full size) per declared
+    parameter, or None when there are none."""
+
+    def __init__(self, observations, build, derivatives=None, n_params: int = 0):
+        self.observations = list(observations)
+        self.build = build
+        self.derivatives = derivatives
+        self.n_params = n_params
+        self.n_rows = sum(o.n_rows for o in self.observations)
+
+    # --- states ----------------------------------------------------------------------------
+    def evaluate(self, p, candidates=(), values=()) -> State:
+        """Full re-solve of every configuration at parameters ``p`` with the effects."""
+        from .select import with_effects
+
+        p = np.asarray(p, float)
+        st = State(p, list(candidates), np.asarray(values, float))
+        for ob, model in zip(self.observations, self.build(p)):
+            st.configs.append(self._config(ob, with_effects(model, candidates, values)))
+        return st
+
+    def _config(self, ob: Observation, model) -> ConfigState:
+        m = ob.f.size
+        modes = solve_modes(model, n_modes=max(2 * m, m + 6))
+        f_all = modes.frequencies
+        if ob.shapes is None:
+            pairs = np.arange(m)
+            u = s = None
+            mac = np.ones(m)
+        else:
+            U = np.asarray(ob.read @ modes.shapes)
+            pairs = -np.ones(m, int)
+            for pr in pair_modes(ob.shapes, U, ob.f, f_all, min_mac=0.3).pairs:
+                pairs[pr.test] = pr.model
+            free = [k for k in range(f_all.size) if k not in set(pairs.tolist())]
+            for i in np.flatnonzero(pairs < 0):  # unpaired: nearest unused frequency keeps the rows defined
+                k = min(free, key=lambda k: abs(f_all[k] / ob.f[i] - 1))
+                pairs[i] = k
+                free.remove(k)
+            u = U[:, pairs]
+            s = np.sum(u * ob.shapes, axis=0) / np.sum(u * u, axis=0)
+            mac = _mac(u, ob.shapes)
+        f_a = f_all[pairs]
+        rows = [(ob.f - f_a) / (ob.sigma_f * ob.f)]
+        if u is not None:
+            rms = np.sqrt(np.mean(ob.shapes**2, axis=0))
+            rows.append(((ob.shapes - s * u) / (ob.sigma_s * rms)).T.ravel())
+        return ConfigState(model, modes, pairs, f_a, mac, u, s, np.concatenate(rows))
+
+    # --- sensitivities ---------------------------------------------------------------------
+    def _columns(self, ob: Observation, cs: ConfigState, BK, BM) -> np.ndarray:
+        """Rows of d(model prediction)/d(parameter) in noise units from bilinear forms
+        BK, BM (n_col, n_basis, m) over the basis [rigid, elastic] and the paired modes."""
+        modes = cs.modes
+        nr = modes.n_rigid
+        lam_b = np.r_[np.zeros(nr), modes.omega2]
+        ib = nr + cs.pairs
+        lam = lam_b[ib]
+        B = BK - BM * lam[None, None, :]
+        dlam = B[:, ib, np.arange(ib.size)]  # (n_col, m)
+        df = dlam / (8.0 * np.pi**2 * cs.f_a)
+        out = [(df / (ob.sigma_f * ob.f)).T]
+        if cs.u is not None:
+            gap = lam[None, :] - lam_b[:, None]  # (n_basis, m)
+            same = np.abs(gap) <= 1e-9 * np.maximum(np.abs(lam)[None, :], 1.0)
+            C = np.where(same[None], 0.0, B / np.where(same, 1.0, gap)[None])
+            Ub = np.asarray(ob.read @ np.column_stack([modes.rigid_shapes, modes.shapes]))
+            dU = np.einsum("pk,cki->pic", Ub, C, optimize=True)  # (n_pts, m, n_col)
+            uh = cs.u / np.linalg.norm(cs.u, axis=0)
+            dU -= uh[:, :, None] * np.einsum("pi,pic->ic", uh, dU)[None]
+            rms = np.sqrt(np.mean(ob.shapes**2, axis=0))
+            dU *= (cs.s / (ob.sigma_s * rms))[None, :, None]
+            out.append(dU.transpose(1, 0, 2).reshape(-1, dU.shape[2]))
+        return np.vstack(out)
+
+    @staticmethod
+    def _basis(cs):
+        return np.column_stack([cs.modes.rigid_shapes, cs.modes.shapes]), cs.modes.shapes[:, cs.pairs]
+
+    def effect_columns(self, st: State, candidates) -> np.ndarray:
+        """(n_rows, n_candidates): d(prediction)/d(magnitude) per SI unit of each candidate."""
+        if not candidates:
+            return np.zeros((self.n_rows, 0))
+        out = []
+        for ob, cs in zip(self.observations, st.configs):
+            basis, paired = self._basis(cs)
+            BK, BM = bilinear_forms(cs.model, basis, paired, candidates)
+            out.append(self._columns(ob, cs, BK, BM))
+        return np.vstack(out)
+
+    def param_columns(self, st: State) -> np.ndarray:
+        """(n_rows, n_params): d(prediction)/d(ln p) of the declared parameters."""
+        if not self.n_params:
+            return np.zeros((self.n_rows, 0))
+        out = []
+        for ob, cs, pairs in zip(self.observations, st.configs, self.derivatives(st.p, [c.model for c in st.configs])):
+            basis, paired = self._basis(cs)
+            BK = np.stack([basis.T @ (dK @ paired) for dK, _ in pairs])
+            BM = np.stack([basis.T @ (dM @ paired) for _, dM in pairs])
+            out.append(self._columns(ob, cs, BK, BM) * st.p[None, :])
+        return np.vstack(out)

@@ -1,0 +1,81 @@
+"""Tables, the evidence map and the enriched board of ``pcbdyn diagnose`` (issue 7, step 6)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+#: SI unit of an effect -> (display unit, factor from SI)
+DISPLAY = {"kg": ("g", 1e3), "kg*m^2": ("kg*mm^2", 1e6), "N/m": ("N/mm", 1e-3), "N*m/rad/m": ("N*m/rad/m", 1.0),
+           "N*m^2": ("N*m^2", 1.0), "1": ("%", 100.0)}
+
+
+def shown(value: float, unit: str) -> tuple:
+    """(value in the display unit, display unit)."""
+    u, k = DISPLAY.get(unit, (unit, 1.0))
+    return value * k, u
+
+
+def format_effects(effects) -> str:
+    if not effects:
+        return "no effect found"
+    rows = [f"{'type':>16} {'parameter':>16} {'at [mm]':>18} {'magnitude':>12} {'+-':>10} unit"]
+    for e in effects:
+        v, u = shown(e["magnitude"], e["unit"])
+        s, _ = shown(e["uncertainty"], e["unit"])
+        at = f"({e['at_mm'][0]:.1f}, {e['at_mm'][1]:.1f})"
+        rows.append(f"{e['type']:>16} {e['parameter']:>16} {at:>18} {v:>12.4g} {s:>10.2g} {u}")
+    return "\n".join(rows)
+
+
+def format_states(before, params_only, after) -> str:
+    """Per configuration and mode: frequency error [%] and MAC of the model as given, with the
+    declared parameters fitted, and with the effects."""
+    out = []
+    for b, p, a in zip(before["configurations"], params_only["configurations"], after["configurations"]):
+        out.append(f"[{b['configuration']}] max |df| [%]: as given {b['max_freq_error_pct']:.2f}, parameters only "
+                   f"{p['max_freq_error_pct']:.2f}, with effects {a['max_freq_error_pct']:.2f}")
+        out.append(f"{'mode':>5} {'f_test [Hz]':>12} {'df given':>9} {'df params':>9} {'df after':>9} "
+                   f"{'MAC given':>9} {'MAC after':>9}")
+        for qb, qp, qa in zip(b["modes"], p["modes"], a["modes"]):
+            mac = "" if qb["mac"] is None else f"{qb['mac']:>9.3f} {qa['mac']:>9.3f}"
+            out.append(f"{qb['test_mode']:>5} {qb['f_test_hz']:>12.2f} {qb['df_pct']:>+9.2f} {qp['df_pct']:>+9.2f} "
+                       f"{qa['df_pct']:>+9.2f} {mac}")
+    return "\n".join(out)
+
+
+def summary(state) -> dict:
+    """The JSON ``before``/``after`` entry."""
+    return {"max_freq_error_pct": state["max_freq_error_pct"], "mean_mac": state["mean_mac"],
+            "configurations": state["configurations"]}
+
+
+def plot_evidence(path, board, evidence, effects) -> None:
+    """Where the residual points: the chi^2 a point mass (and a ground spring) at each node would
+    remove once the declared parameters are fitted, with the effects found marked."""
+    from .correlation_plots import _plt, _save
+
+    kinds = list(evidence)
+    fig, axes = _plt().subplots(1, max(len(kinds), 1), figsize=(5.5 * max(len(kinds), 1), 5.0), squeeze=False)
+    outline = np.vstack([board.outline.vertices, board.outline.vertices[:1]]) * 1e3
+    for ax, kind in zip(axes[0], kinds):
+        xy, gain = evidence[kind]
+        ax.plot(outline[:, 0], outline[:, 1], "k-", lw=1)
+        sc = ax.scatter(xy[:, 0] * 1e3, xy[:, 1] * 1e3, c=gain, s=18, cmap="viridis")
+        fig.colorbar(sc, ax=ax, label="chi^2 removed")
+        for e in effects:
+            ax.plot(*e["at_mm"], "r*", ms=14, mec="w")
+            ax.annotate(e["type"], e["at_mm"], color="r", xytext=(4, 4), textcoords="offset points")
+        ax.set(title=f"evidence for a {kind.replace('_', ' ')}", xlabel="x [mm]", ylabel="y [mm]", aspect="equal")
+    _save(fig, path)
+
+
+def enriched_effects(diagnosis) -> list:
+    """The effects in the form :func:`pcbdyn.board.enrich.write_enriched` takes (SI)."""
+    out = []
+    for e in diagnosis.effects:
+        d = {"type": e["kind"], "name": e["name"], "value": e["magnitude"], "at": tuple(np.asarray(e["at_mm"]) / 1e3)}
+        for key in ("segment", "path", "polygon"):
+            if f"{key}_mm" in e:
+                d[key] = (np.asarray(e[f"{key}_mm"]) / 1e3).tolist()
+        out.append(d)
+    return out
