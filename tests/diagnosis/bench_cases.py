@@ -1,0 +1,349 @@
+"""The diagnosis test bench (issue 7 acceptance): simulated modal tests of boards that carry an
+effect the board.toml handed to ``pcbdyn diagnose`` does not declare.
+
+Every case is a :class:`Case`: the board handed to diagnose (the six-part card of
+examples/six_part_card, free, or the same card in wedge-lock guides of examples/wedge_locked, with
+their declared [[parameters]]), the TRUE structure (the same board with its declared parameters at
+true values a little off the nominal ones, plus the hidden :class:`Effect`, added at FE level with
+:func:`pcbdyn.diagnosis.add_effect` on a candidate built on the truth mesh at the wanted place),
+the configurations tested, the truth mesh size (the model's, or finer: discretisation error
+present too) and the noise. :func:`make_case` writes the handed board.toml, one UFF test per
+configuration (modes below 1 kHz, z at a 10 x 10 grid of points + the excitation point, 0.2 %
+frequency and 2 % shape noise, fixed seeds, FRFs at the shaker point) and ``truth.json``.
+
+    python tests/diagnosis/bench_cases.py [--cases a,b] [--calibrate]
+
+writes every case under out/diagnosis_bench/ and, with ``--calibrate``, prints the
+parameters-only update's max frequency error per case (what the effect leaves to diagnose).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import re
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[2]
+CARD = ROOT / "examples" / "six_part_card" / "board.toml"
+WEDGE = ROOT / "examples" / "wedge_locked" / "board.toml"
+F_MAX = 1000.0
+MODEL_MESH = 6.75e-3  # the mesh of both example boards
+FINE_MESH = 3.375e-3  # half of it
+SHAKER = (0.135, 0.06357)  # the card's shaker point (its 13 g force transducer)
+
+
+# ----------------------------------------------------------------------------------------- cases
+@dataclass(frozen=True)
+class Effect:
+    """A hidden effect: catalogue ``kind`` (point_mass, point_inertia, ground_spring,
+    edge_stiffness, region_stiffness, stiffener, line_mass) at ``at`` (x, y) [m] (point kinds), or
+    along ``segment`` (two end points on a boundary side) or ``path`` (two end points across the
+    plate), or over ``polygon`` [m]; ``value`` in SI (kg, kg m^2, N/m, N m/rad/m, 1, N m^2, kg).
+    ``required``: diagnose must find it (False: reported or not, not judged; e.g. a rotary inertia
+    too small to show above the noise)."""
+
+    kind: str
+    value: float
+    at: tuple | None = None
+    segment: tuple | None = None
+    path: tuple | None = None
+    polygon: tuple | None = None
+    required: bool = True
+
+    @property
+    def report_as(self) -> str:
+        return "point_mass" if self.kind == "point_inertia" else self.kind
+
+
+@dataclass(frozen=True)
+class Case:
+    """``base``: "card" (free six-part card, parameters t_PGA, t_JLCC, t_CQFP, E_board) or "wedge"
+    (the card in two wedge-lock guides, parameters k_guides, E_board). ``drop_transducer``: the 13 g
+    transducer is left out of the handed board (the truth keeps it). ``true_values``: the truth's
+    declared parameters {name: SI value}; ``handed_values``: nominal values of the handed board
+    that differ from the example's (k_guides). ``configs``: tested configurations (None: base).
+    ``truth_mesh``: mesh of the truth model [m] (None: the model's)."""
+
+    name: str
+    base: str
+    effects: tuple = ()
+    configs: tuple = (None,)
+    truth_mesh: float | None = None
+    drop_transducer: bool = False
+    true_values: dict = field(default_factory=dict)
+    handed_values: dict = field(default_factory=dict)
+    noise: tuple = (0.2, 2.0)  # (frequency %, shape %)
+    seed: int = 0
+    note: str = ""
+
+    @property
+    def noise_only(self) -> bool:
+        return not self.effects
+
+    def __hash__(self):
+        return hash(self.name)
+
+
+CARD_TRUE = {"t_PGA": 4.0e-3, "t_JLCC": 3.2e-3, "t_CQFP": 3.9e-3, "E_board": 27.0e9}
+WEDGE_TRUE = {"k_guides": 2.5e4, "E_board": 26.8e9}
+LOOSE, LOOSE_TRUE = {"k_guides": 1e3}, {"k_guides": 600.0, "E_board": 26.8e9}
+C23 = (None, "c2", "c3")
+
+CASES = [
+    Case("pm_transducer", "card", (Effect("point_mass", 13e-3, at=SHAKER),), drop_transducer=True,
+         true_values=CARD_TRUE, note="the 13 g force transducer left out of the model"),
+    Case("pm_transducer_cfg_fine", "card", (Effect("point_mass", 13e-3, at=SHAKER),), configs=C23,
+         truth_mesh=FINE_MESH, drop_transducer=True, true_values=CARD_TRUE, seed=1,
+         note="transducer left out; three configurations (53.2 g at c2, c3); truth mesh halved"),
+    Case("pm_inertia", "card", (Effect("point_mass", 25e-3, at=(0.140, 0.150)),
+                                Effect("point_inertia", 1.5e-5, at=(0.140, 0.150), required=False)),
+         true_values=CARD_TRUE, seed=2, note="a 25 g part with rotary inertia (a relay) away from the points"),
+    Case("gs_standoff", "card", (Effect("ground_spring", 1.5e5, at=(0.081, 0.113)),), true_values=CARD_TRUE,
+         seed=3, note="a standoff touching the middle of the free card"),
+    Case("gs_standoff_wedge_fine", "wedge", (Effect("ground_spring", 2e5, at=(0.135, 0.113)),),
+         truth_mesh=FINE_MESH, true_values=WEDGE_TRUE, seed=4, note="a standoff under the guided card; truth mesh halved"),
+    # guides near clamped (k_rot >> D / L) hide any extra edge stiffness: these cards sit in loose
+    # guides (handed nominal 1e3, true 600 N m/rad/m) of which one half is tight
+    Case("edge_top_guide_mid", "wedge", (Effect("edge_stiffness", 1e4, segment=((0.0405, 0.178), (0.1215, 0.178))),),
+         true_values=LOOSE_TRUE, handed_values=LOOSE, seed=5, note="loose guides; the middle half of the top guide tight"),
+    Case("edge_bottom_guide_fine", "wedge", (Effect("edge_stiffness", 2e4, segment=((0.0405, 0.0), (0.1215, 0.0))),),
+         truth_mesh=FINE_MESH, true_values=LOOSE_TRUE, handed_values=LOOSE, seed=6,
+         note="loose guides; the middle half of the bottom guide tight; truth mesh halved"),
+    Case("region_bare_wedge_fine", "wedge", (Effect("region_stiffness", 3.0, polygon=((0.118, 0.093), (0.158, 0.093),
+                                                                               (0.158, 0.133), (0.118, 0.133))),),
+         truth_mesh=FINE_MESH, true_values=WEDGE_TRUE, seed=7, note="a 40 mm square of the bare board 4 x stiffer (a bonded spreader); truth mesh halved"),
+    Case("region_U5_wedge", "wedge", (Effect("region_stiffness", 3.0, polygon=((0.0795, 0.074), (0.1095, 0.074),
+                                                                            (0.1095, 0.104), (0.0795, 0.104))),),
+         true_values=WEDGE_TRUE, seed=8, note="U5 4 x stiffer than modelled (a bonded heat sink)"),
+    Case("stiffener_row", "card", (Effect("stiffener", 1.0, path=((0.0, 0.112), (0.162, 0.112))),),
+         true_values=CARD_TRUE, seed=9, note="a rib across the card at y = 112 mm"),
+    Case("stiffener_col_wedge_fine", "wedge", (Effect("stiffener", 1.0, path=((0.135, 0.0), (0.135, 0.178))),),
+         truth_mesh=FINE_MESH, true_values=WEDGE_TRUE, seed=10, note="a rib from guide to guide at x = 135 mm; truth mesh halved"),
+    Case("line_mass_top_cfg", "card", (Effect("line_mass", 20e-3, segment=((0.040, 0.178), (0.081, 0.178))),),
+         configs=(None, "c2"), true_values=CARD_TRUE, seed=11, note="a 20 g connector along the top edge; two configurations"),
+    Case("line_mass_free_edge_fine", "wedge", (Effect("line_mass", 25e-3, segment=((0.0, 0.050), (0.0, 0.100))),),
+         truth_mesh=FINE_MESH, true_values=WEDGE_TRUE, seed=12, note="a 25 g connector along the free left edge; truth mesh halved"),
+    Case("noise_card", "card", true_values=CARD_TRUE, seed=13, note="no hidden effect"),
+    Case("noise_card_cfg", "card", configs=C23, true_values=CARD_TRUE, seed=14, note="no hidden effect; three configurations"),
+    Case("noise_wedge_fine", "wedge", truth_mesh=FINE_MESH, true_values=WEDGE_TRUE, seed=15,
+         note="no hidden effect; truth mesh halved"),
+]
+BY_NAME = {c.name: c for c in CASES}
+
+
+# ---------------------------------------------------------------------------------------- boards
+TRANSDUCER = re.compile(r'\[\[masses\]\]\nname = "transducer"\nat = \[[^\]]*\]\nmass = "13 g"\n\n?')
+WEDGE_E = '\n[[parameters]]\nname = "E_board"\ntarget = "board.E"\nbounds = ["15 GPa", "35 GPa"]\n'
+
+
+def handed_text(case: Case) -> str:
+    """The board.toml handed to diagnose: the example board as it is, its transducer left out when
+    ``drop_transducer``; the wedge board gets an E_board parameter (as the card has), so that a
+    finer truth mesh's stiffer discretisation has a declared parameter to go to."""
+    text = (CARD if case.base == "card" else WEDGE).read_text()
+    if case.drop_transducer:
+        text, n = TRANSDUCER.subn("", text)
+        assert n == 1, "the transducer block of the example board was not found"
+    if case.base == "wedge":
+        text = text.replace("\n[analysis]", WEDGE_E + "\n[analysis]")
+    if "k_guides" in case.handed_values:
+        text, n = re.subn(r'k_rot = "1e4 N\*m/rad/m"', f'k_rot = "{case.handed_values["k_guides"]:.6g} N*m/rad/m"', text)
+        assert n == 2
+    return text
+
+
+def truth_text(case: Case) -> str:
+    """The true board: the example board with its transducer and its declared parameters at the
+    case's true values (the hidden effect is added at FE level)."""
+    text = (CARD if case.base == "card" else WEDGE).read_text()
+    tv = case.true_values
+    if "E_board" in tv:
+        text, n = re.subn(r'E = "26 GPa"', f'E = "{tv["E_board"] / 1e9:.6g} GPa"', text)
+        assert n == 1
+    for pkg in ("PGA", "JLCC", "CQFP"):
+        if f"t_{pkg}" in tv:
+            text = text.replace(f'package = "{pkg}"\n', f'package = "{pkg}"\nthickness = "{tv[f"t_{pkg}"] * 1e3:.6g} mm"\n')
+    if "k_guides" in tv:
+        text, n = re.subn(r'k_rot = "1e4 N\*m/rad/m"', f'k_rot = "{tv["k_guides"]:.6g} N*m/rad/m"', text)
+        assert n == 2
+    return text
+
+
+def points_grid(width: float, height: float, n: int = 10, inset: float = 5e-3):
+    """(Points, Dofs): an n x n grid of +z points inset from the outline (ids 1..n^2)."""
+    from pcbdyn.testdata.data import Dofs, Points
+
+    xs, ys = np.linspace(inset, width - inset, n), np.linspace(inset, height - inset, n)
+    xy = np.stack(np.meshgrid(xs, ys), -1).reshape(-1, 2)
+    ids = np.arange(1, xy.shape[0] + 1)
+    return Points(ids, np.column_stack([xy, np.zeros(len(xy))])), Dofs(ids, np.tile([0.0, 0.0, 1.0], (len(ids), 1)))
+
+
+def write_points_csv(path: Path, points) -> None:
+    rows = ["point,x [mm],y [mm],dir"] + [f"{i},{1e3 * x:.4f},{1e3 * y:.4f},+z" for i, (x, y, _) in zip(points.ids, points.xyz)]
+    path.write_text("\n".join(rows) + "\n")
+
+
+# --------------------------------------------------------------------------------------- effects
+def _nearest(layout, xy) -> int:
+    nodes = layout.shell_nodes()
+    return int(nodes[np.linalg.norm(layout.xy[nodes] - np.asarray(xy), axis=1).argmin()])
+
+
+def candidate(layout, effect: Effect):
+    """The candidate of ``effect`` on ``layout`` (the truth mesh)."""
+    from pcbdyn.diagnosis.catalogue import Candidate, chain_candidate
+
+    k = effect.kind
+    if k in ("point_mass", "point_inertia", "ground_spring"):
+        n = _nearest(layout, effect.at)
+        return Candidate(k, f"{k}@hidden", tuple(layout.xy[n]), np.array([n]))
+    if k in ("edge_stiffness", "line_mass"):
+        a, b = (np.asarray(p) for p in effect.segment)
+        best = None
+        for side, chain in layout.sides.items():
+            p = layout.xy[chain]
+            da, db = np.linalg.norm(p - a, axis=1), np.linalg.norm(p - b, axis=1)
+            score = da.min() + db.min()
+            if best is None or score < best[0]:
+                i, j = sorted((int(da.argmin()), int(db.argmin())))
+                best = (score, side, chain[i:j + 1])
+        score, side, chain = best
+        assert score < 0.01 and chain.size > 1, f"{k}: segment {effect.segment} is not along a side"
+        return chain_candidate(k, layout, f"{side}[hidden]", chain)
+    if k == "stiffener":
+        chain = layout.node_path(np.asarray(effect.path[0]), np.asarray(effect.path[1]))
+        c = chain_candidate(k, layout, "hidden", chain, key="path")
+        c.data["thickness"] = layout.thickness
+        return c
+    if k == "region_stiffness":
+        from pcbdyn.diagnosis.region_stiffness import _candidate
+
+        c = _candidate(layout, "hidden", [list(p) for p in effect.polygon])
+        assert c is not None, "the region holds no cell centroid"
+        return c
+    raise ValueError(f"unknown effect kind {k}")
+
+
+def expected(case: Case, cands) -> list:
+    """What diagnose must report per hidden effect: type, parameter, location (mm), magnitude."""
+    out = []
+    for e, c in zip(case.effects, cands):
+        d = c.describe()
+        d.update({"kind": e.kind, "magnitude": e.value, "required": e.required})
+        out.append(d)
+    return out
+
+
+# ------------------------------------------------------------------------------------ generation
+def case_key(case: Case) -> str:
+    return hashlib.sha1(repr(asdict(case)).encode() + (CARD.read_bytes() + WEDGE.read_bytes())).hexdigest()[:16]
+
+
+def make_case(case: Case, folder) -> tuple:
+    """Write the case into ``folder``: board.toml (handed to diagnose), test_<config>.uff per
+    configuration, points.csv and truth/ (truth board, truth.json). Returns (board_toml_path,
+    [uff paths in the order of ``case.configs``], truth dict). Reuses a folder made for the same case."""
+    from pcbdyn import diagnosis as dg
+    from pcbdyn.board import build_model, load_board
+    from pcbdyn.fe.modal import solve_modes
+    from pcbdyn.testdata.noise import Noise
+    from pcbdyn.testdata.simulate import simulate_on_model
+    from pcbdyn.testdata.uff import write_uff
+
+    folder = Path(folder)
+    (folder / "truth").mkdir(parents=True, exist_ok=True)
+    board_path = folder / "board.toml"
+    uffs = [folder / f"test_{c or 'base'}.uff" for c in case.configs]
+    tj = folder / "truth" / "truth.json"
+    key = case_key(case)
+    if tj.exists() and board_path.exists() and all(u.exists() for u in uffs):
+        truth = json.loads(tj.read_text())
+        if truth.get("key") == key:
+            return board_path, uffs, truth
+    board_path.write_text(handed_text(case))
+    truth_path = folder / "truth" / "truth.toml"
+    truth_path.write_text(truth_text(case))
+    tb = load_board(truth_path)
+    points, dofs = points_grid(0.162, 0.178)
+    write_points_csv(folder / "points.csv", points)
+    mesh = case.truth_mesh
+    base = build_model(tb, None, mesh, shared_mesh=True)
+    layout = dg.from_board(base)
+    cands = [candidate(layout, e) for e in case.effects]
+    freqs = {}
+    for k, cfg in enumerate(case.configs):
+        bm = base if cfg is None else build_model(tb, cfg, mesh, shared_mesh=True)
+        assert bm.model.nodes.shape == base.model.nodes.shape and np.allclose(bm.model.nodes, base.model.nodes)
+        model = bm.model
+        for e, c in zip(case.effects, cands):
+            model = dg.add_effect(model, c, e.value)
+        modes = solve_modes(model, f_max=F_MAX)
+        f_axis = np.arange(0.0, 1200.0 + 1e-9, 1.0)
+        data = simulate_on_model(model, modes, points, dofs, excite=(*SHAKER, 0.0), f_axis=f_axis, zeta=0.01,
+                                 noise=Noise(frequency_pct=case.noise[0], shape_pct=case.noise[1], frf_pct=1.0),
+                                 seed=1000 * case.seed + k)
+        write_uff(uffs[k], data)
+        freqs[cfg or "base"] = {"exact_hz": [float(f) for f in modes.frequencies],
+                                "noisy_hz": [float(f) for f in data.modes.frequencies]}
+    truth = {"key": key, "case": case.name, "note": case.note, "base": case.base, "noise_only": case.noise_only,
+             "configs": [c or "base" for c in case.configs], "truth_mesh_m": mesh or tb.mesh_size,
+             "model_mesh_m": MODEL_MESH, "true_values": case.true_values, "effects": expected(case, cands),
+             "frequencies": freqs, "noise_pct": {"frequency": case.noise[0], "shape": case.noise[1]}}
+    tj.write_text(json.dumps(truth, indent=1))
+    return board_path, uffs, truth
+
+
+def cli_tests(case: Case, uffs) -> list:
+    """The test arguments of ``pcbdyn diagnose``: the base test, then ``cfg=path``."""
+    return [str(u) if c is None else f"{c}={u}" for c, u in zip(case.configs, uffs)]
+
+
+# --------------------------------------------------------------------------- physical check
+def params_only(case: Case, board_path, uffs, max_iter: int = 10) -> dict:
+    """Update the handed board's declared parameters alone on the case's tests (frequencies, MAC
+    pairing, bounded least squares): {"before": max |df| %, "after": max |df| %, "p": {name: value}}."""
+    from pcbdyn.board import load_board
+    from pcbdyn.testdata.uff import read_uff
+    from pcbdyn.updating.board_problem import BoardProblem, MeasuredModes, run
+
+    prob = BoardProblem(load_board(board_path))
+    cfgs = [prob.configuration(c, MeasuredModes.from_test(read_uff(u).modes), "freq")
+            for c, u in zip(case.configs, uffs)]
+    res, before, after = run(prob, cfgs, "bounded", max_iter=max_iter)
+    return {"before": max(s["max_freq_error_pct"] for s in before),
+            "after": max(s["max_freq_error_pct"] for s in after),
+            "mean_mac_after": float(np.mean([q["mac"] for s in after for q in s["pairs"] if q["mac"] is not None])),
+            "n_pairs": [len(s["pairs"]) for s in after],
+            "p": dict(zip(prob.names, map(float, res.p)))}
+
+
+def main(argv=None):
+    import argparse
+    import time
+
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--cases", default=None, help="comma-separated case names (default: all)")
+    ap.add_argument("--out", default=str(ROOT / "out" / "diagnosis_bench"))
+    ap.add_argument("--calibrate", action="store_true", help="run the parameters-only update per case")
+    a = ap.parse_args(argv)
+    cases = [BY_NAME[n] for n in a.cases.split(",")] if a.cases else CASES
+    print(f"{'case':<26} {'effect':<44} {'cfgs':<10} {'mesh':>6} {'before %':>9} {'params-only %':>14}  modes")
+    for c in cases:
+        t0 = time.perf_counter()
+        board, uffs, truth = make_case(c, Path(a.out) / c.name)
+        eff = "; ".join(f"{e['kind']} {e['magnitude']:.3g} {e['unit']} @({e['at_mm'][0]:.0f},{e['at_mm'][1]:.0f})"
+                        for e in truth["effects"]) or "none"
+        row = f"{c.name:<26} {eff:<44} {','.join(truth['configs']):<10} {1e3 * truth['truth_mesh_m']:>6.3g}"
+        if a.calibrate:
+            r = params_only(c, board, uffs)
+            row += f" {r['before']:>9.2f} {r['after']:>14.2f}  {r['n_pairs']}"
+        print(row + f"  ({time.perf_counter() - t0:.0f} s)", flush=True)
+
+
+if __name__ == "__main__":
+    main()
