@@ -79,6 +79,9 @@ class Case:
     noise: tuple = (0.2, 2.0)  # (frequency %, shape %)
     seed: int = 0
     note: str = ""
+    #: the parameters-only update leaves > 2 % (False: an effect the declared parameters nearly
+    #: absorb; judged on type, place and magnitude only, as the acceptance's after-check does not apply)
+    leaves_over_2pct: bool = True
 
     @property
     def noise_only(self) -> bool:
@@ -118,7 +121,8 @@ CASES = [
          truth_mesh=FINE_MESH, true_values=WEDGE_TRUE, seed=7, note="a 40 mm square of the bare board 4 x stiffer (a bonded spreader); truth mesh halved"),
     Case("region_U5_wedge", "wedge", (Effect("region_stiffness", 3.0, polygon=((0.0795, 0.074), (0.1095, 0.074),
                                                                             (0.1095, 0.104), (0.0795, 0.104))),),
-         true_values=WEDGE_TRUE, seed=8, note="U5 4 x stiffer than modelled (a bonded heat sink)"),
+         true_values=WEDGE_TRUE, seed=8, leaves_over_2pct=False,
+         note="U5 4 x stiffer than modelled (a bonded heat sink); k_guides and E_board absorb most of it (1.6 %)"),
     Case("stiffener_row", "card", (Effect("stiffener", 1.0, path=((0.0, 0.112), (0.162, 0.112))),),
          true_values=CARD_TRUE, seed=9, note="a rib across the card at y = 112 mm"),
     Case("stiffener_col_wedge_fine", "wedge", (Effect("stiffener", 1.0, path=((0.135, 0.0), (0.135, 0.178))),),
