@@ -25,8 +25,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..correlation.pairing import pair_modes
+from ..fe.assembly import assemble
 from ..fe.modal import solve_modes
-from .catalogue import bilinear_forms
+from .catalogue import bilinear_forms, derivatives
 
 
 @dataclass
@@ -58,6 +59,8 @@ class ConfigState:
     factors ``s``, its rows ``r``."""
 
     model: object
+    K: object
+    M: object
     modes: object
     pairs: np.ndarray
     f_a: np.ndarray
@@ -118,21 +121,34 @@ class ModalResidual:
         self.derivatives = derivatives
         self.n_params = n_params
         self.n_rows = sum(o.n_rows for o in self.observations)
+        self._at = (None, None, {})  # last p, its [(model, K, M)], {(config, candidate): (dK, dM)}
 
     # --- states ----------------------------------------------------------------------------
-    def evaluate(self, p, candidates=(), values=()) -> State:
-        """Full re-solve of every configuration at parameters ``p`` with the effects."""
-        from .select import with_effects
+    def _assembled(self, p):
+        if self._at[0] is None or not np.array_equal(self._at[0], p):
+            self._at = (p.copy(), [(m, *assemble(m)) for m in self.build(p)], {})
+        return self._at[1], self._at[2]
 
+    def evaluate(self, p, candidates=(), values=()) -> State:
+        """Full re-solve of every configuration at parameters ``p`` with the effects. The effects
+        enter K and M linearly, so their exact derivative matrices are added to the model's
+        (assembled once per p); the configuration states keep the model without them."""
         p = np.asarray(p, float)
         st = State(p, list(candidates), np.asarray(values, float))
-        for ob, model in zip(self.observations, self.build(p)):
-            st.configs.append(self._config(ob, with_effects(model, candidates, values)))
+        models, cache = self._assembled(p)
+        for k, (ob, (model, K, M)) in enumerate(zip(self.observations, models)):
+            for c, v in zip(candidates, st.values):
+                if v != 0.0:
+                    if (k, c.name) not in cache:
+                        cache[k, c.name] = derivatives(model, c)
+                    dK, dM = cache[k, c.name]
+                    K, M = K + v * dK, M + v * dM
+            st.configs.append(self._config(ob, model, K, M))
         return st
 
-    def _config(self, ob: Observation, model) -> ConfigState:
+    def _config(self, ob: Observation, model, K, M) -> ConfigState:
         m = ob.f.size
-        modes = solve_modes(model, n_modes=max(2 * m, m + 6))
+        modes = solve_modes(model, n_modes=max(2 * m, m + 6), K=K, M=M)
         f_all = modes.frequencies
         if ob.shapes is None:
             pairs = np.arange(m)
@@ -156,12 +172,13 @@ class ModalResidual:
         if u is not None:
             rms = np.sqrt(np.mean(ob.shapes**2, axis=0))
             rows.append(((ob.shapes - s * u) / (ob.sigma_s * rms)).T.ravel())
-        return ConfigState(model, modes, pairs, f_a, mac, u, s, np.concatenate(rows))
+        return ConfigState(model, K, M, modes, pairs, f_a, mac, u, s, np.concatenate(rows))
 
     # --- sensitivities ---------------------------------------------------------------------
-    def _columns(self, ob: Observation, cs: ConfigState, BK, BM) -> np.ndarray:
+    def _columns(self, ob: Observation, cs: ConfigState, BK, BM, dU_static=None) -> np.ndarray:
         """Rows of d(model prediction)/d(parameter) in noise units from bilinear forms
-        BK, BM (n_col, n_basis, m) over the basis [rigid, elastic] and the paired modes."""
+        BK, BM (n_col, n_basis, m) over the basis [rigid, elastic] and the paired modes;
+        ``dU_static`` (n_pts, m, n_col): the shape derivatives' part from the modes beyond the basis."""
         modes = cs.modes
         nr = modes.n_rigid
         lam_b = np.r_[np.zeros(nr), modes.omega2]
@@ -177,6 +194,8 @@ class ModalResidual:
             C = np.where(same[None], 0.0, B / np.where(same, 1.0, gap)[None])
             Ub = np.asarray(ob.read @ np.column_stack([modes.rigid_shapes, modes.shapes]))
             dU = np.einsum("pk,cki->pic", Ub, C, optimize=True)  # (n_pts, m, n_col)
+            if dU_static is not None:
+                dU = dU + dU_static
             uh = cs.u / np.linalg.norm(cs.u, axis=0)
             dU -= uh[:, :, None] * np.einsum("pi,pic->ic", uh, dU)[None]
             rms = np.sqrt(np.mean(ob.shapes**2, axis=0))
@@ -208,5 +227,26 @@ class ModalResidual:
             basis, paired = self._basis(cs)
             BK = np.stack([basis.T @ (dK @ paired) for dK, _ in pairs])
             BM = np.stack([basis.T @ (dM @ paired) for _, dM in pairs])
-            out.append(self._columns(ob, cs, BK, BM) * st.p[None, :])
+            static = None
+            if cs.u is not None:
+                lam = cs.modes.omega2[cs.pairs]
+                F = np.stack([dK @ paired - (dM @ paired) * lam[None, :] for dK, dM in pairs], axis=2)
+                static = np.asarray(ob.read @ _beyond_basis(cs, basis, F.reshape(F.shape[0], -1))).reshape(
+                    -1, lam.size, len(pairs))
+            out.append(self._columns(ob, cs, BK, BM, static) * st.p[None, :])
         return np.vstack(out)
+
+
+def _beyond_basis(cs: ConfigState, basis, F) -> np.ndarray:
+    """-(G - sum_basis phi_k phi_k^T / (lambda_k + mu)) F: the modes above the computed ones answer a
+    force F quasi-statically (modal acceleration), G = (K + mu M)^-1 on the constrained DOFs, mu a
+    small shift that keeps a free board's G finite. It completes the modal expansion of the
+    eigenvector derivative (eqs. 3.8-3.14) for parameters that act over the whole board."""
+    from ..fe.linsolve import factorize
+    from ..fe.modal import reduced_system
+
+    red, Kr, Mr = reduced_system(cs.model, cs.K, cs.M)
+    lam_b = np.r_[np.zeros(cs.modes.n_rigid), cs.modes.omega2]
+    mu = 1e-3 * lam_b[lam_b > 0].min()
+    G = red.expand(factorize((Kr + mu * Mr).tocsc()).solve(red.T.T @ F))
+    return -(G - basis @ ((basis.T @ F) / (lam_b + mu)[:, None]))

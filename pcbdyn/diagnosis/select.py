@@ -28,8 +28,6 @@ import numpy as np
 from scipy.optimize import lsq_linear
 from scipy.stats import chi2 as chi2_dist
 
-from .catalogue import add_effect
-
 #: magnitudes are bounded by this many times their kind's typical ``scale`` (a 1 kg mass or a
 #: 1e7 N/m spring is no longer an effect a test setup hides; unbounded, a huge mass pins a node)
 UPPER = 100.0
@@ -59,14 +57,6 @@ class Selection:
     @property
     def frequencies(self) -> np.ndarray:
         return self.state.configs[0].f_a
-
-
-def with_effects(model, candidates, values):
-    """``model`` carrying each candidate at its value (zero values are left out)."""
-    for c, v in zip(candidates, values):
-        if v != 0.0:
-            model = add_effect(model, c, float(v))
-    return model
 
 
 def penalty(n_obs: int, n_candidates: int, alpha: float = ALPHA) -> float:
