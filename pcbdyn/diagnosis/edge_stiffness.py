@@ -30,7 +30,7 @@ class _EdgeStiffness:
 
     def generate(self, layout, segments: int = 4) -> list:
         return [chain_candidate(self.name, layout, f"{side}[{i}]", chain)
-                for side, i, chain in layout.segments(segments)]
+                for side, i, chain in layout.segment_runs(segments)]
 
     def blocks(self, model, candidates) -> list:
         edges = [c.data["edges"] for c in candidates]

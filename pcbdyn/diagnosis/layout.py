@@ -75,6 +75,21 @@ class Layout:
                 out.append((name, i, chain[a:b + 1]))
         return out
 
+    def segment_runs(self, n: int) -> list:
+        """[(side name, label, node chain)]: every run of consecutive pieces of :meth:`segments`
+        (label "i" for piece i alone, "i-j" for pieces i to j, the whole side included), so that an
+        effect over part of a side is one candidate wherever it starts and ends on the n cuts."""
+        pieces: dict = {}
+        for name, i, chain in self.segments(n):
+            pieces.setdefault(name, []).append(chain)
+        out = []
+        for name, chains in pieces.items():
+            for i in range(len(chains)):
+                for j in range(i, len(chains)):
+                    run = np.concatenate([chains[i]] + [c[1:] for c in chains[i + 1:j + 1]])
+                    out.append((name, f"{i}" if i == j else f"{i}-{j}", run))
+        return out
+
     def cells_in(self, polygon) -> list:
         """[(set name, cell indices)] of the shell cells whose centroid lies in ``polygon`` [m]."""
         path = PolyPath(np.asarray(polygon, dtype=float))

@@ -27,7 +27,7 @@ class _LineMass:
 
     def generate(self, layout, segments: int = 4) -> list:
         return [chain_candidate(self.name, layout, f"{side}[{i}]", chain)
-                for side, i, chain in layout.segments(segments)]
+                for side, i, chain in layout.segment_runs(segments)]
 
     def blocks(self, model, candidates) -> list:
         nodes = np.concatenate([c.nodes for c in candidates])

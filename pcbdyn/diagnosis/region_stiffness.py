@@ -9,7 +9,9 @@ properties the cells have in the model they are applied to, so a region effect f
 declared parameters (board E, part thickness) when both are estimated together, and overlapping
 region effects add up.
 
-Candidates: a coarse grid of square patches of side ``patch`` [m] and every part footprint.
+Candidates: a grid of square patches of side ``patch`` [m], grids of twice that side (aligned and
+shifted by half a patch, so that a larger region is met by one candidate of about its size) and
+every part footprint.
 """
 
 from __future__ import annotations
@@ -113,10 +115,15 @@ class _RegionStiffness:
             raise ValueError(f"patch must be > 0 m, got {patch}")
         xy = layout.xy[layout.shell_nodes()]
         lo, hi = xy.min(axis=0), xy.max(axis=0)
-        nx, ny = np.maximum(1, np.round((hi - lo) / patch)).astype(int)
-        gx, gy = np.linspace(lo[0], hi[0], nx + 1), np.linspace(lo[1], hi[1], ny + 1)
-        polys = [(f"patch[{i},{j}]", [[gx[i], gy[j]], [gx[i + 1], gy[j]], [gx[i + 1], gy[j + 1]], [gx[i], gy[j + 1]]])
-                 for j in range(ny) for i in range(nx)]
+        polys = []
+        for tag, size, shift in (("", patch, 0.0), ("2x", 2 * patch, 0.0), ("2x+", 2 * patch, 0.5)):
+            n = np.maximum(1, np.round((hi - lo) / size)).astype(int)
+            step = (hi - lo) / n
+            gx = lo[0] + step[0] * (np.arange(n[0] + 1 + (shift > 0)) - shift)
+            gy = lo[1] + step[1] * (np.arange(n[1] + 1 + (shift > 0)) - shift)
+            polys += [(f"patch{tag}[{i},{j}]", [[gx[i], gy[j]], [gx[i + 1], gy[j]], [gx[i + 1], gy[j + 1]],
+                                                [gx[i], gy[j + 1]]])
+                      for j in range(gy.size - 1) for i in range(gx.size - 1)]
         polys += list(layout.footprints.items())
         return [c for label, poly in polys if (c := _candidate(layout, label, poly)) is not None]
 

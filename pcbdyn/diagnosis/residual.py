@@ -38,6 +38,13 @@ class Observation:
     RMS of the mode's measured shape); ``xyz``, ``directions``: the measured DOFs [m]. Without
     shapes the modes pair by order."""
 
+    def subset(self, keep) -> "Observation":
+        """The observation of the measured modes ``keep`` (a boolean mask or indices)."""
+        k = np.asarray(keep)
+        return Observation(self.name, self.f[k], self.sigma_f[k], None if self.shapes is None else self.shapes[:, k],
+                           self.read, None if self.sigma_s is None else self.sigma_s[k], self.xyz, self.directions,
+                           self.numbers[k])
+
     name: str | None
     f: np.ndarray
     sigma_f: np.ndarray
@@ -46,6 +53,11 @@ class Observation:
     sigma_s: np.ndarray | None = None
     xyz: np.ndarray | None = None
     directions: np.ndarray | None = None
+    numbers: np.ndarray | None = None  # the test's mode numbers (default 1..m)
+
+    def __post_init__(self):
+        if self.numbers is None:
+            self.numbers = np.arange(1, np.size(self.f) + 1)
 
     @property
     def n_rows(self) -> int:
@@ -55,7 +67,7 @@ class Observation:
 @dataclass
 class ConfigState:
     """A configuration's model at one state: ``modes``, ``pairs`` (elastic mode index per measured
-    mode), paired frequencies ``f_a``, ``mac``, the model shapes at the points ``u`` and scale
+    mode; ``matched`` False where no model mode resembles it and the nearest free one stands in), paired frequencies ``f_a``, ``mac``, the model shapes at the points ``u`` and scale
     factors ``s``, its rows ``r``."""
 
     model: object
@@ -63,6 +75,7 @@ class ConfigState:
     M: object
     modes: object
     pairs: np.ndarray
+    matched: np.ndarray
     f_a: np.ndarray
     mac: np.ndarray
     u: np.ndarray | None
@@ -96,7 +109,7 @@ class State:
             df = 100.0 * (c.f_a / ob.f - 1.0)
             per.append({"configuration": ob.name or "base", "max_freq_error_pct": float(np.max(np.abs(df))),
                         "mean_mac": float(np.mean(c.mac)) if ob.shapes is not None else None,
-                        "modes": [{"test_mode": i + 1, "model_mode": int(c.pairs[i]) + 1, "f_test_hz": float(ob.f[i]),
+                        "modes": [{"test_mode": int(ob.numbers[i]), "model_mode": int(c.pairs[i]) + 1, "f_test_hz": float(ob.f[i]),
                                    "f_model_hz": float(c.f_a[i]), "df_pct": float(df[i]),
                                    "mac": float(c.mac[i]) if ob.shapes is not None else None}
                                   for i in range(ob.f.size)]})
@@ -152,6 +165,7 @@ class ModalResidual:
         f_all = modes.frequencies
         if ob.shapes is None:
             pairs = np.arange(m)
+            matched = np.ones(m, bool)
             u = s = None
             mac = np.ones(m)
         else:
@@ -159,6 +173,7 @@ class ModalResidual:
             pairs = -np.ones(m, int)
             for pr in pair_modes(ob.shapes, U, ob.f, f_all, min_mac=0.3).pairs:
                 pairs[pr.test] = pr.model
+            matched = pairs >= 0
             free = [k for k in range(f_all.size) if k not in set(pairs.tolist())]
             for i in np.flatnonzero(pairs < 0):  # unpaired: nearest unused frequency keeps the rows defined
                 k = min(free, key=lambda k: abs(f_all[k] / ob.f[i] - 1))
@@ -172,7 +187,7 @@ class ModalResidual:
         if u is not None:
             rms = np.sqrt(np.mean(ob.shapes**2, axis=0))
             rows.append(((ob.shapes - s * u) / (ob.sigma_s * rms)).T.ravel())
-        return ConfigState(model, K, M, modes, pairs, f_a, mac, u, s, np.concatenate(rows))
+        return ConfigState(model, K, M, modes, pairs, matched, f_a, mac, u, s, np.concatenate(rows))
 
     # --- sensitivities ---------------------------------------------------------------------
     def _columns(self, ob: Observation, cs: ConfigState, BK, BM, dU_static=None) -> np.ndarray:

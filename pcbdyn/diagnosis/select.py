@@ -87,7 +87,8 @@ def estimate(res, p0, cands, v0, steps: int, bounds=None, fit_params: bool = Tru
     scale = np.r_[np.ones(npar), [c.spec.scale for c in cands]]
     v = np.clip(np.asarray(v0, float), lo_v, hi_v)
     st = res.evaluate(p, cands, v)
-    lo_p, hi_p = (np.full(p.size, -np.inf), np.full(p.size, np.inf)) if bounds is None else bounds
+    lo_p, hi_p = (np.full(p.size, 0.0), np.full(p.size, np.inf)) if bounds is None else bounds
+    lo_p = np.maximum(lo_p, 1e-6 * np.abs(p))  # ln p: a parameter may shrink a millionfold, not vanish
     for _ in range(steps):
         J = _jacobian(res, st, cands, npar) * scale
         if J.shape[1] == 0:

@@ -63,7 +63,7 @@ class Effect:
 class Case:
     """``base``: "card" (free six-part card, parameters t_PGA, t_JLCC, t_CQFP, E_board) or "wedge"
     (the card in two wedge-lock guides, parameters k_guides, E_board). ``drop_transducer``: the 13 g
-    transducer is left out of the handed board (the truth keeps it). ``true_values``: the truth's
+    transducer is left out of the handed board and is the hidden effect of the truth. ``true_values``: the truth's
     declared parameters {name: SI value}; ``handed_values``: nominal values of the handed board
     that differ from the example's (k_guides). ``configs``: tested configurations (None: base).
     ``truth_mesh``: mesh of the truth model [m] (None: the model's)."""
@@ -103,8 +103,9 @@ CASES = [
          truth_mesh=FINE_MESH, drop_transducer=True, true_values=CARD_TRUE, seed=1,
          note="transducer left out; three configurations (53.2 g at c2, c3); truth mesh halved"),
     Case("pm_inertia", "card", (Effect("point_mass", 25e-3, at=(0.140, 0.150)),
-                                Effect("point_inertia", 1.5e-5, at=(0.140, 0.150), required=False)),
-         true_values=CARD_TRUE, seed=2, note="a 25 g part with rotary inertia (a relay) away from the points"),
+                                Effect("point_inertia", 2e-6, at=(0.140, 0.150), required=False)),
+         true_values=CARD_TRUE, seed=2, note="a 25 g part with rotary inertia (a relay, radius of gyration "
+                                             "about 9 mm) away from the points"),
     Case("gs_standoff", "card", (Effect("ground_spring", 1.5e5, at=(0.081, 0.113)),), true_values=CARD_TRUE,
          seed=3, note="a standoff touching the middle of the free card"),
     Case("gs_standoff_wedge_fine", "wedge", (Effect("ground_spring", 2e5, at=(0.135, 0.113)),),
@@ -161,9 +162,13 @@ def handed_text(case: Case) -> str:
 
 
 def truth_text(case: Case) -> str:
-    """The true board: the example board with its transducer and its declared parameters at the
-    case's true values (the hidden effect is added at FE level)."""
+    """The true board: the example board with its declared parameters at the case's true values
+    (the hidden effect is added at FE level); with ``drop_transducer`` the transducer is the hidden
+    effect, so the board itself leaves it out as the handed one does."""
     text = (CARD if case.base == "card" else WEDGE).read_text()
+    if case.drop_transducer:
+        text, n = TRANSDUCER.subn("", text)
+        assert n == 1, "the transducer block of the example board was not found"
     tv = case.true_values
     if "E_board" in tv:
         text, n = re.subn(r'E = "26 GPa"', f'E = "{tv["E_board"] / 1e9:.6g} GPa"', text)

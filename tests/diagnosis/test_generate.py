@@ -89,19 +89,23 @@ def test_edge_segments_lie_on_the_outline_or_a_support_line_and_cover_each_edge(
         on_y = any(np.allclose(xy[:, 1], v, atol=1e-9) for v in lines["y"])
         assert on_x or on_y, c.name
         assert c.data["length"] > 0
+    def pieces(cs):  # single pieces ("[i]"), not runs of several ("[i-j]")
+        return [c for c in cs if "-" not in c.name.rsplit("[", 1)[1]]
+
     left = [c for c in segs if np.allclose(c.geometry["segment"][:, 0], 0.0)]
-    assert len(left) == 4
-    assert sum(c.data["length"] for c in left) == pytest.approx(H, rel=1e-9)
+    assert len(pieces(left)) == 4 and len(left) == 10  # 4 pieces, 10 runs of consecutive pieces
+    assert sum(c.data["length"] for c in pieces(left)) == pytest.approx(H, rel=1e-9)
+    assert max(c.data["length"] for c in left) == pytest.approx(H, rel=1e-9)  # the run of the whole side
     inner = [c for c in segs if np.allclose(c.geometry["segment"][:, 0], W - 0.005)]
-    assert len(inner) == 4  # the right guide acts on the inner line of its 5 mm strip
+    assert len(pieces(inner)) == 4  # the right guide acts on the inner line of its 5 mm strip
     assert not [c for c in segs if np.allclose(c.geometry["segment"][:, 0], W)]  # held strip: dropped
     free = [c for c in segs if np.allclose(c.geometry["segment"][:, 1], 0.0)]
-    assert len(free) == 4
+    assert len(pieces(free)) == 4
     lm = of(cands, "line_mass")
     assert {c.name.split("@")[1] for c in lm} < {c.name.split("@")[1] for c in segs}
     # a mass on a guide line whose translations are held does nothing: only free edges remain
     assert {round(float(c.geometry["segment"][0, 1]), 9) for c in lm} == {0.0, H}
-    assert len(lm) == 8 and all(np.ptp(c.geometry["segment"][:, 1]) == 0 for c in lm)
+    assert len(pieces(lm)) == 8 and len(lm) == 20 and all(np.ptp(c.geometry["segment"][:, 1]) == 0 for c in lm)
 
 
 def test_each_part_footprint_is_a_region_candidate(board):
@@ -112,7 +116,12 @@ def test_each_part_footprint_is_a_region_candidate(board):
     assert sorted(map(tuple, np.sort(cells, axis=1))) == sorted(map(tuple, np.sort(
         bm.model.sets["components.U1"].conn, axis=1)))
     patches = [c for c in of(cands, "region_stiffness") if "patch" in c.name]
-    assert len(patches) == 4 * 3
+    assert len([c for c in patches if "@patch[" in c.name]) == 4 * 3
+    double = [c for c in patches if "@patch2x[" in c.name]  # twice the side: four times the cells
+    assert len(double) == 2 * 2
+    assert sum(len(c.data["cells"]["quad4"]) for c in double) == sum(
+        len(c.data["cells"]["quad4"]) for c in patches if "@patch[" in c.name)
+    assert [c for c in patches if "@patch2x+[" in c.name]  # and shifted by half of it
 
 
 def test_stiffener_paths_follow_rows_and_columns(board):
