@@ -115,8 +115,9 @@ def measured_configurations(board, test_uff, extras) -> list:
     from ..updating.board_problem import MeasuredModes
     from .correlate import load_test_modes
 
+    extra = parse_extra(extras)  # usage errors before any file is read
     data = [(None, MeasuredModes.from_test(load_test_modes(test_uff)))]
-    for name, path in parse_extra(extras):
+    for name, path in extra:
         if board.configuration(name) is None:
             raise BoardError(f"{board.path.name}: configuration '{name}' (from {name}={path}) is not in "
                              "[[configurations]]")

@@ -32,6 +32,15 @@ from .layout import from_board
 from .residual import ModalResidual, Observation
 from .select import ALPHA, estimate, search
 
+#: where candidates go: sides cut into 8 pieces (every run of consecutive pieces is a candidate)
+CANDIDATE_OPTIONS = {"segments": 8}
+
+
+def _options(kinds) -> set:
+    from .catalogue import KINDS, kind
+
+    return {o for name in (kinds or KINDS) for o in kind(name).options}
+
 @dataclass
 class Diagnosis:
     """The outcome: ``effects`` (JSON-ready dicts), ``noise_only``, ``message`` (plain words),
@@ -85,27 +94,30 @@ def _discretisation(board, config, mesh_size, p_values, ob, coarse_state):
     return df, 4.0 / 3.0 * np.sqrt(np.clip(1.0 - mac, 0.0, None))
 
 
-def diagnose(board, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_size=None, kinds=None,
-             max_effects: int = 3, alpha: float = ALPHA, progress=None) -> Diagnosis:
-    """Diagnose ``board`` against ``tests`` = [(configuration name or None, MeasuredModes)]."""
-    say = progress or (lambda msg: None)
-    h = mesh_size or board.mesh_size
-    names = [p.name for p in board.parameters]
-    say("building the models")
-    bms = [build_model(board, c, h, shared_mesh=True) for c, _ in tests]
-    params = [bms[0].parameters[n] for n in names]
-    p0 = np.array([p.value for p in params], float)
-    bounds = (np.array([p.bounds[0] for p in params], float), np.array([p.bounds[1] for p in params], float))
+class _BoardModels:
+    """The board's configurations on one mesh, as functions of the declared parameters."""
 
-    def at(p):
-        return [bm.with_parameters(dict(zip(names, np.asarray(p, float).tolist()))) for bm in bms]
+    def __init__(self, board, configs, h):
+        self.names = [p.name for p in board.parameters]
+        self.bms = [build_model(board, c, h, shared_mesh=True) for c in configs]
+        params = [self.bms[0].parameters[n] for n in self.names]
+        self.p0 = np.array([p.value for p in params], float)
+        self.bounds = (np.array([p.bounds[0] for p in params], float), np.array([p.bounds[1] for p in params], float))
 
-    def build(p):
-        return [b.model for b in at(p)]
+    def at(self, p):
+        return [bm.with_parameters(dict(zip(self.names, np.asarray(p, float).tolist()))) for bm in self.bms]
 
-    def derivatives(p, models):
-        return [[b.parameters[n].derivatives(b) for n in names] for b in at(p)]
+    def build(self, p):
+        return [b.model for b in self.at(p)]
 
+    def derivatives(self, p, models):
+        return [[b.parameters[n].derivatives(b) for n in self.names] for b in self.at(p)]
+
+    def residual(self, observations) -> ModalResidual:
+        return ModalResidual(observations, self.build, self.derivatives if self.names else None, len(self.names))
+
+
+def _observations(tests, bms) -> list:
     obs = []
     for (c, mm), bm in zip(tests, bms):
         ob = Observation(c, np.asarray(mm.frequencies, float), np.ones(len(mm.frequencies)), xyz=mm.xyz,
@@ -115,95 +127,140 @@ def diagnose(board, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_size=
             ob.read = model_probe(bm.model, mm.xyz, mm.directions, tol=0.02).P
             ob.sigma_s = np.ones(ob.f.size)  # until the noise is known
         obs.append(ob)
-    res = ModalResidual(obs, build, derivatives if names else None, len(names))
+    return obs
+
+
+def _set_noise(board, models, h, obs, state, freq_pct, shape_pct) -> None:
+    """Each observation's sigmas: measurement noise and discretisation in quadrature."""
+    for ob, cs in zip(obs, state.configs):
+        basis = None
+        if ob.shapes is not None:  # rigid-body modes first: a free board's shapes hold them at the points
+            wide = solve_modes(cs.model, n_modes=ob.shapes.shape[0] // 2)
+            basis = np.asarray(ob.read @ np.column_stack([wide.rigid_shapes, wide.shapes]))
+        sf, ss = _noise_sigmas(ob, freq_pct, shape_pct, basis)
+        df, ds = _discretisation(board, ob.name, h, dict(zip(models.names, models.p0.tolist())), ob, cs)
+        ob.sigma_f = np.sqrt(sf**2 + df**2)
+        ob.sigma_s = None if ss is None else np.sqrt(ss**2 + ds**2)
+
+
+def _range_test(res, base, n_params, alpha) -> dict:
+    """Chi-square test of the parameters-only residual and the ranks of A and [A b] at the noise
+    level (thesis section 5.2.3: b outside the range of A is what the parameters cannot explain)."""
+    dof = max(res.n_rows - n_params, 1)
+    A = res.param_columns(base.state)
+    level = np.sqrt(chi2_dist.isf(alpha, dof))
+    return {"rows": res.n_rows, "dof": dof, "chi2_parameters_only": base.chi2,
+            "p_value_noise": float(chi2_dist.sf(base.chi2, dof)), "alpha": alpha,
+            "rank_A": int(np.sum(np.linalg.svd(A, compute_uv=False) > level)) if A.size else 0,
+            "rank_Ab": int(np.sum(np.linalg.svd(np.column_stack([A, base.state.r]), compute_uv=False) > level))}
+
+
+def diagnose(board, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_size=None, kinds=None,
+             max_effects: int = 3, alpha: float = ALPHA, progress=None) -> Diagnosis:
+    """Diagnose ``board`` against ``tests`` = [(configuration name or None, MeasuredModes)]."""
+    say = progress or (lambda msg: None)
+    h = mesh_size or board.mesh_size
+    say("building the models")
+    models = _BoardModels(board, [c for c, _ in tests], h)
+    names, p0 = models.names, models.p0
+    obs = _observations(tests, models.bms)
+    res = models.residual(obs)
     say("solving the model as given")
     before = res.evaluate(p0)
     unmatched = {ob.name or "base": (np.flatnonzero(~cs.matched) + 1).tolist() for ob, cs in zip(obs, before.configs)}
     if any(unmatched.values()):  # modes the model has no partner for (MAC < 0.3): local modes of what it lacks
         say(f"test modes without a model partner, left out: {unmatched}")
         obs = [ob.subset(cs.matched) for ob, cs in zip(obs, before.configs)]
-        res = ModalResidual(obs, build, derivatives if names else None, len(names))
+        res = models.residual(obs)
         before = res.evaluate(p0)
     say("estimating the noise and the model's discretisation error")
-    for ob, cs, (c, _) in zip(obs, before.configs, tests):
-        basis = None
-        if ob.shapes is not None:  # rigid-body modes first: a free board's shapes hold them at the points
-            wide = solve_modes(cs.model, n_modes=ob.shapes.shape[0] // 2)
-            basis = np.asarray(ob.read @ np.column_stack([wide.rigid_shapes, wide.shapes]))
-        sf, ss = _noise_sigmas(ob, freq_noise_pct, shape_noise_pct, basis)
-        df, ds = _discretisation(board, c, h, dict(zip(names, p0.tolist())), ob, cs)
-        ob.sigma_f = np.sqrt(sf**2 + df**2)
-        ob.sigma_s = None if ss is None else np.sqrt(ss**2 + ds**2)
+    _set_noise(board, models, h, obs, before, freq_noise_pct, shape_noise_pct)
     before = res.evaluate(p0)
     say(f"fitting the {len(names)} declared parameter(s)" if names else "no declared parameters")
-    base = estimate(res, p0, [], [], 10, bounds)
-    dof = max(res.n_rows - len(names), 1)
-    p_noise = float(chi2_dist.sf(base.chi2, dof))
-    stats = {"unpaired_test_modes": unmatched, "rows": res.n_rows, "dof": dof, "chi2_before": before.chi2, "chi2_parameters_only": base.chi2,
-             "p_value_noise": p_noise, "alpha": alpha,
+    base = estimate(res, p0, [], [], 10, models.bounds)
+    stats = {"unpaired_test_modes": unmatched, "chi2_before": before.chi2, **_range_test(res, base, len(names), alpha),
              "sigma_f_pct": [np.round(100 * o.sigma_f, 4).tolist() for o in obs],
              "sigma_shape_pct": [None if o.sigma_s is None else np.round(100 * o.sigma_s, 4).tolist() for o in obs]}
     out = dict(before=before.summary(obs), parameters_only=base.state.summary(obs),
                parameters={n: {"initial": float(a), "parameters_only": float(b)} for n, a, b in zip(names, p0, base.p)},
                statistics=stats)
-    if p_noise > alpha:
+    if stats["p_value_noise"] > alpha and not any(unmatched.values()):
         for n, v in zip(names, base.p):
             out["parameters"][n]["final"] = float(v)
         return Diagnosis([], True, "what remains after fitting the declared parameters is within the noise "
-                         f"(chi^2 = {base.chi2:.1f} for {dof} degrees of freedom, p = {p_noise:.2f}): no effect is "
-                         "missing that the data can show", after=out["parameters_only"], **out)
+                         f"(chi^2 = {base.chi2:.1f} for {stats['dof']} degrees of freedom, p = "
+                         f"{stats['p_value_noise']:.2f}): no effect is missing that the data can show",
+                         after=out["parameters_only"], **out)
     say("generating the candidate effects")
-    cands = generate(from_board(bms[0]), kinds)
+    cands = generate(from_board(models.bms[0]), kinds,
+                     **{k: v for k, v in CANDIDATE_OPTIONS.items() if k in _options(kinds)})
     say(f"searching {len(cands)} candidate effects")
-    sel = search(res, cands, p0, bounds, max_effects=max_effects, shortlist=2, alpha=alpha, base=base)
-    stats["chi2_after"] = sel.chi2[-1]
-    stats["candidates"] = len(cands)
+    sel = search(res, cands, p0, models.bounds, max_effects=max_effects, shortlist=2, alpha=alpha, base=base)
+    stats.update(chi2_after=sel.chi2[-1], candidates=len(cands))
     for n, v in zip(names, sel.p):
         out["parameters"][n]["final"] = float(v)
     chosen = [cands[i] for i in sel.chosen]
-    effects = [_merged(chosen, sel.values, sel.cov, g) for g in _neighbours(chosen, 1.5 * h)]
+    effects = [_merged(chosen, sel.values, sel.cov, g) for g in _neighbours(chosen, MERGE_REACH * h)]
     if effects:
         msg = f"{len(effects)} effect(s) the model lacks: " + "; ".join(
             f"{e['type']} ({e['parameter']}) at {e['at_mm']} mm" for e in effects)
     else:
         msg = ("the residual exceeds the noise but no candidate effect explains it beyond chance: "
                "nothing is reported (check the noise level, the pairing and the declared parameters)")
+    if any(unmatched.values()):
+        msg += f"; test modes with no model partner (MAC < 0.3), left out of the fit: {unmatched}"
     return Diagnosis(effects, False, msg, after=sel.state.summary(obs), evidence=_evidence(res, base.state, cands),
                      candidates=chosen, **out)
 
 
 #: kinds that act at one node: an effect between nodes is shared by its neighbours
 POINT_KINDS = ("point_mass", "point_inertia", "ground_spring")
+#: [element sizes] how far apart shares of one effect may be found (an unstructured mesh puts the
+#: nodes around a point up to about two elements apart)
+MERGE_REACH = 2.6
+
+
+def _linked(a, b, reach: float) -> bool:
+    """Two chosen effects that are one: point effects of one kind within ``reach`` [m] (a mass or a
+    spring between nodes is fitted as shares on the nodes around it), or a point mass within
+    ``reach`` of a line mass (a mass spread over part of an edge is fitted as a line plus points)."""
+    if a.kind == b.kind and a.kind in POINT_KINDS:
+        return np.hypot(a.at[0] - b.at[0], a.at[1] - b.at[1]) <= reach
+    if {a.kind, b.kind} == {"point_mass", "line_mass"}:
+        line, point = (a, b) if a.kind == "line_mass" else (b, a)
+        p0, p1 = np.asarray(line.geometry["segment"], float)
+        t = np.clip(np.dot(np.subtract(point.at, p0), p1 - p0) / max(np.dot(p1 - p0, p1 - p0), 1e-300), 0.0, 1.0)
+        return np.linalg.norm(p0 + t * (p1 - p0) - np.asarray(point.at)) <= reach
+    return False
 
 
 def _neighbours(chosen, reach: float) -> list:
-    """Groups of chosen effects to report as one: point effects of one kind linked by steps of at
-    most ``reach`` [m] (a mass or spring between nodes is fitted as shares on the nodes around it)."""
+    """Groups of chosen effects linked (:func:`_linked`) directly or through others, reported as one."""
     from scipy.sparse.csgraph import connected_components
 
     n = len(chosen)
     link = np.eye(n, dtype=bool)
     for a in range(n):
         for b in range(a + 1, n):
-            ca, cb = chosen[a], chosen[b]
-            link[a, b] = link[b, a] = (ca.kind == cb.kind and ca.kind in POINT_KINDS
-                                       and np.hypot(ca.at[0] - cb.at[0], ca.at[1] - cb.at[1]) <= reach)
+            link[a, b] = link[b, a] = _linked(chosen[a], chosen[b], reach)
     _, label = connected_components(link, directed=False)
     return [np.flatnonzero(label == g).tolist() for g in dict.fromkeys(label.tolist())]
 
 
 def _merged(chosen, values, cov, group) -> dict:
-    """One effect entry (JSON-ready) for a group: the magnitudes summed at their weighted centre, the
-    uncertainty of the sum from the fit's covariance."""
-    c = chosen[group[0]]
+    """One effect entry (JSON-ready) for a group: the magnitudes summed at their weighted centre (on a
+    line mass: the line mass's place and extent), the uncertainty of the sum from the fit's covariance."""
+    lines = [k for k in group if chosen[k].kind == "line_mass"]
+    c = chosen[lines[0] if lines else group[0]]
     d = c.describe()
     v = np.asarray(values, float)[group]
     if len(group) > 1:
         xy = np.array([chosen[k].at for k in group])
         w = v / v.sum() if v.sum() > 0 else np.full(v.size, 1.0 / v.size)
-        d["at_mm"] = np.round(1e3 * (w @ xy), 3).tolist()
+        if not lines:
+            d["at_mm"] = np.round(1e3 * (w @ xy), 3).tolist()
         d["name"] = "+".join(chosen[k].name for k in group)
-        d["nodes_mm"] = np.round(1e3 * xy, 3).tolist()
+        d["merged_at_mm"] = np.round(1e3 * xy, 3).tolist()
     var = float(np.sum(cov[np.ix_(group, group)])) if cov.size else 0.0
     d.update(magnitude=float(v.sum()), uncertainty=float(np.sqrt(max(var, 0.0))), kind=c.kind)
     return d

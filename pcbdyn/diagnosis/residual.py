@@ -66,9 +66,10 @@ class Observation:
 
 @dataclass
 class ConfigState:
-    """A configuration's model at one state: ``modes``, ``pairs`` (elastic mode index per measured
-    mode; ``matched`` False where no model mode resembles it and the nearest free one stands in), paired frequencies ``f_a``, ``mac``, the model shapes at the points ``u`` and scale
-    factors ``s``, its rows ``r``."""
+    """A configuration's model at one state: its matrices ``K``, ``M`` (with the effects),
+    ``modes``, ``pairs`` (elastic mode index per measured mode; ``matched`` False where no model
+    mode resembles it and the nearest free one stands in), paired frequencies ``f_a``, ``mac``, the
+    model shapes at the points ``u`` and scale factors ``s``, its rows ``r``."""
 
     model: object
     K: object
@@ -109,7 +110,8 @@ class State:
             df = 100.0 * (c.f_a / ob.f - 1.0)
             per.append({"configuration": ob.name or "base", "max_freq_error_pct": float(np.max(np.abs(df))),
                         "mean_mac": float(np.mean(c.mac)) if ob.shapes is not None else None,
-                        "modes": [{"test_mode": int(ob.numbers[i]), "model_mode": int(c.pairs[i]) + 1, "f_test_hz": float(ob.f[i]),
+                        "modes": [{"test_mode": int(ob.numbers[i]), "model_mode": int(c.pairs[i]) + 1,
+                                   "f_test_hz": float(ob.f[i]),
                                    "f_model_hz": float(c.f_a[i]), "df_pct": float(df[i]),
                                    "mac": float(c.mac[i]) if ob.shapes is not None else None}
                                   for i in range(ob.f.size)]})

@@ -76,12 +76,14 @@ class Fit:
         return self.state.chi2
 
 
-def estimate(res, p0, cands, v0, steps: int, bounds=None, fit_params: bool = True, tol: float = 1e-5) -> Fit:
+def estimate(res, p0, cands, v0, steps: int, bounds=None, tol: float = 1e-5, param_columns=None) -> Fit:
     """Gauss-Newton on (ln p, magnitudes) with bounded steps (``bounds`` = (lower, upper) of p),
     halving a step that raises chi^2; ``cov`` is the covariance of (ln p, magnitudes) from the
-    last Jacobian, scaled by the residual's own variance when larger than stated."""
+    last Jacobian, scaled by the residual's own variance when larger than stated.
+    ``param_columns``: the parameters' columns held from an earlier state (a quick fit that
+    ranks candidates need not re-derive the board's matrices at every step)."""
     p = np.asarray(p0, float)
-    npar = p.size if fit_params else 0
+    npar = p.size
     lo_v = np.array([c.spec.lower for c in cands], float)
     hi_v = UPPER * np.array([c.spec.scale for c in cands], float)
     scale = np.r_[np.ones(npar), [c.spec.scale for c in cands]]
@@ -90,14 +92,14 @@ def estimate(res, p0, cands, v0, steps: int, bounds=None, fit_params: bool = Tru
     lo_p, hi_p = (np.full(p.size, 0.0), np.full(p.size, np.inf)) if bounds is None else bounds
     lo_p = np.maximum(lo_p, 1e-6 * np.abs(p))  # ln p: a parameter may shrink a millionfold, not vanish
     for _ in range(steps):
-        J = _jacobian(res, st, cands, npar) * scale
+        J = _jacobian(res, st, cands, npar, param_columns) * scale
         if J.shape[1] == 0:
             break
         lo = np.r_[np.log(lo_p / p)[:npar], (lo_v - v)] / scale
         hi = np.r_[np.log(hi_p / p)[:npar], (hi_v - v)] / scale
         dy = lsq_linear(J, st.r, bounds=(np.minimum(lo, 0.0), np.maximum(hi, 0.0))).x * scale
         for _half in range(4):
-            p_new = p * np.exp(dy[:npar]) if npar else p
+            p_new = p * np.exp(dy[:npar])
             v_new = np.clip(v + dy[npar:], lo_v, hi_v)
             try:
                 trial = res.evaluate(p_new, cands, v_new)
@@ -108,19 +110,19 @@ def estimate(res, p0, cands, v0, steps: int, bounds=None, fit_params: bool = Tru
             dy = 0.5 * dy
         else:
             break
-        small = np.all(np.abs(dy) <= tol * np.maximum(np.r_[np.ones(npar), np.abs(v)], scale * tol))
+        small = np.all(np.abs(dy) <= tol * np.r_[np.ones(npar), np.maximum(np.abs(v), scale[npar:])])
         p, v, st = trial.p, v_new, trial
         if small:
             break
-    J = _jacobian(res, st, cands, npar)
+    J = _jacobian(res, st, cands, npar, param_columns)
     k = J.shape[1]
     var = max(1.0, st.chi2 / max(res.n_rows - k, 1))
     cov = var * np.linalg.pinv(J.T @ J) if k else np.zeros((0, 0))
     return Fit(p, v, st, cov)
 
 
-def _jacobian(res, st, cands, npar):
-    cols = [res.param_columns(st)[:, :npar]] if npar else []
+def _jacobian(res, st, cands, npar, param_columns=None):
+    cols = [res.param_columns(st) if param_columns is None else param_columns] if npar else []
     if cands:
         cols.append(res.effect_columns(st, cands))
     return np.hstack(cols) if cols else np.zeros((res.n_rows, 0))
@@ -144,7 +146,8 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
             break
         st = fit.state
         A = res.effect_columns(st, candidates) * scale
-        Q = _orth(np.hstack([res.param_columns(st), res.effect_columns(st, [candidates[i] for i in sel.chosen])]))
+        P = res.param_columns(st)
+        Q = _orth(np.hstack([P, res.effect_columns(st, [candidates[i] for i in sel.chosen])]))
         A_p, r_p = A - Q @ (Q.T @ A), st.r - Q @ (Q.T @ st.r)
         norm2 = np.einsum("ij,ij->j", A_p, A_p)
         ok = norm2 > 1e-12 * norm2.max()
@@ -156,7 +159,7 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
         if not order.size:
             break
         fits = [estimate(res, fit.p, [candidates[i] for i in sel.chosen + [j]], np.r_[sel.values, value[j]],
-                         RANK_STEPS, bounds, fit_params=False) for j in order]
+                         RANK_STEPS, bounds, param_columns=P) for j in order]
         best = int(np.argmin([f.chi2 for f in fits]))
         idx = sel.chosen + [int(order[best])]
         new = estimate(res, fit.p, [candidates[i] for i in idx], fits[best].values, newton_steps, bounds)
