@@ -11,7 +11,7 @@ demo: setup
 	$(VENV)/pcbdyn build examples/six_part_card/board.toml --out out/six_part_card --json out/six_part_card/modes.json
 
 test: setup
-	$(VENV)/python -m pytest -q
+	$(VENV)/python -m pytest -q -n 2 --dist loadgroup
 
 bench: setup
 	for b in benchmarks/*.py; do $(VENV)/python $$b || exit 1; done

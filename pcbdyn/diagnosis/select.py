@@ -73,7 +73,7 @@ class Fit:
 
     @property
     def chi2(self) -> float:
-        return self.state.chi2
+        return np.inf if self.state is None else self.state.chi2
 
 
 def estimate(res, p0, cands, v0, steps: int, bounds=None, tol: float = 1e-5, param_columns=None) -> Fit:
@@ -88,7 +88,10 @@ def estimate(res, p0, cands, v0, steps: int, bounds=None, tol: float = 1e-5, par
     hi_v = UPPER * np.array([c.spec.scale for c in cands], float)
     scale = np.r_[np.ones(npar), [c.spec.scale for c in cands]]
     v = np.clip(np.asarray(v0, float), lo_v, hi_v)
-    st = res.evaluate(p, cands, v)
+    try:
+        st = res.evaluate(p, cands, v)
+    except (ValueError, ArithmeticError, np.linalg.LinAlgError):  # e.g. overlapping regions softened below zero
+        return Fit(p, v, None, np.zeros((0, 0)))
     lo_p, hi_p = (np.full(p.size, 0.0), np.full(p.size, np.inf)) if bounds is None else bounds
     lo_p = np.maximum(lo_p, 1e-6 * np.abs(p))  # ln p: a parameter may shrink a millionfold, not vanish
     for _ in range(steps):
@@ -161,6 +164,8 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
         fits = [estimate(res, fit.p, [candidates[i] for i in sel.chosen + [j]], np.r_[sel.values, value[j]],
                          RANK_STEPS, bounds, param_columns=P) for j in order]
         best = int(np.argmin([f.chi2 for f in fits]))
+        if not np.isfinite(fits[best].chi2):
+            break
         idx = sel.chosen + [int(order[best])]
         new = estimate(res, fit.p, [candidates[i] for i in idx], fits[best].values, newton_steps, bounds)
         if not _worth(sel.chi2[-1], new.chi2, n, p0.size + len(idx), pen):

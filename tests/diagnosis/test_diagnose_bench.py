@@ -5,9 +5,9 @@ Per effect case: the effect's type and location (within max(15 mm, one model ele
 magnitude within 30 %, and the max frequency error after below 0.5 % where the parameters-only
 update left more than 2 %. Per noise-only case: no effect, ``noise_only`` true.
 
-The bench itself is checked physically (``test_bench_data``): the tests load, are z-only at about
-100 points below 1 kHz, and the effect cases leave a parameters-only update above 2 % (noise-only
-cases below 1.5 %), so that the acceptance tests are about something.
+The bench itself is checked (``test_bench_data``: the tests load, are z-only at about 100 points
+below 1 kHz; ``test_diagnose_bench``: the effect cases leave a parameters-only fit above 2 %,
+noise-only cases below 1.5 %), so that the acceptance tests are about something.
 """
 
 from __future__ import annotations
@@ -134,11 +134,23 @@ def judge(case, truth: dict, data: dict) -> list:
 
 
 # ---------------------------------------------------------------------------------------- tests
+#: cases where diagnose misses the acceptance today, and why (strict: a fix turns them into passes)
+KNOWN = {}
+
+
+def cases():
+    """One parameter per case, both tests of a case on one xdist worker (the data are made once)."""
+    out = []
+    for c in bc.CASES:
+        marks = [pytest.mark.xdist_group(c.name)]
+        out.append(pytest.param(c, marks=marks, id=c.name))
+    return out
+
+
 @pytest.mark.slow
-@pytest.mark.parametrize("case", bc.CASES, ids=[c.name for c in bc.CASES])
+@pytest.mark.parametrize("case", cases())
 def test_bench_data(bench, case):
-    """The bench is physical: UFFs load (z only, ~100 points, modes < 1 kHz) and the parameters-only
-    update leaves > 2 % on effect cases, < 1.5 % on noise-only ones."""
+    """The bench is what the issue asks: UFFs load, z only, about 100 points, modes below 1 kHz."""
     from pcbdyn.testdata.uff import read_uff
 
     board, uffs, truth = bench(case)
@@ -149,20 +161,24 @@ def test_bench_data(bench, case):
         assert 4 <= f.size and f.max() < bc.F_MAX * 1.01
         assert 95 <= len(td.modes.dofs.point_ids) <= 110
         assert np.allclose(np.abs(td.modes.dofs.directions), [0.0, 0.0, 1.0])
-    r = bc.params_only(case, board, uffs)
-    print(f"\n{case.name}: before {r['before']:.2f} %, parameters only {r['after']:.2f} %, {r['p']}")
-    if case.noise_only:
-        assert r["after"] < NOISE_PARAMS_ONLY_MAX_PCT
-    elif case.leaves_over_2pct:
-        assert r["after"] > PARAMS_ONLY_MIN_PCT
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("case", bc.CASES, ids=[c.name for c in bc.CASES])
+@pytest.mark.parametrize("case", cases())
 def test_diagnose_bench(bench, case, tmp_path):
+    """Acceptance per case (module docstring). The bench is physical too: the parameters-only fit
+    leaves more than 2 % where the case says so (the effect matters), less than 1.5 % on noise-only
+    data (noise plus the discretisation of a coarser model)."""
+    if case.name in KNOWN:
+        pytest.xfail(KNOWN[case.name])
     board, uffs, truth = bench(case)
     data = run_diagnose(case, board, uffs, tmp_path)
     print(json.dumps({k: data.get(k) for k in ("effects", "noise_only", "before", "parameters_only", "after")}, indent=1))
+    po = data["parameters_only"]["max_freq_error_pct"]
+    if case.noise_only:
+        assert po < NOISE_PARAMS_ONLY_MAX_PCT
+    elif case.leaves_over_2pct:
+        assert po > PARAMS_ONLY_MIN_PCT
     bad = judge(case, truth, data)
     assert not bad, f"{case.name}: " + "; ".join(bad)
 
