@@ -11,13 +11,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..fe import EdgeSpringProperty
+from ..board.effects import edge_spring_property
 from ..fe.elements import kernel
 from .catalogue import Blocks, chain_candidate, copy_model
-
-
-def _prop(kr: float) -> EdgeSpringProperty:
-    return EdgeSpringProperty(k=(0.0, 0.0, 0.0, kr, 0.0, 0.0), normal=(0.0, 0.0, 1.0))
 
 
 class _EdgeStiffness:
@@ -35,12 +31,12 @@ class _EdgeStiffness:
     def blocks(self, model, candidates) -> list:
         edges = [c.data["edges"] for c in candidates]
         conn = np.concatenate(edges)
-        Ke, Me = kernel("edge_spring")(model.nodes[conn], _prop(1.0))
+        Ke, Me = kernel("edge_spring")(model.nodes[conn], edge_spring_property(1.0))
         return [Blocks(conn, Ke, Me, np.repeat(np.arange(len(edges)), [e.shape[0] for e in edges]))]
 
     def apply(self, model, candidate, value: float):
         m = copy_model(model)
-        m.add(f"effects.{candidate.name}", "edge_spring", candidate.data["edges"], _prop(value))
+        m.add(f"effects.{candidate.name}", "edge_spring", candidate.data["edges"], edge_spring_property(value))
         return m
 
 

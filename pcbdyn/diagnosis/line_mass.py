@@ -6,15 +6,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..board.effects import tributary_weights
 from ..fe import MassProperty
 from .catalogue import Blocks, chain_candidate, copy_model
-
-
-def _weights(xy: np.ndarray) -> np.ndarray:
-    """Tributary-length fractions of the nodes of a chain (sum 1)."""
-    L = np.linalg.norm(np.diff(xy, axis=0), axis=1)
-    w = np.r_[L, 0.0] + np.r_[0.0, L]
-    return w / w.sum()
 
 
 class _LineMass:
@@ -31,7 +25,7 @@ class _LineMass:
 
     def blocks(self, model, candidates) -> list:
         nodes = np.concatenate([c.nodes for c in candidates])
-        w = np.concatenate([_weights(model.nodes[c.nodes, :2]) for c in candidates])
+        w = np.concatenate([tributary_weights(model.nodes[c.nodes, :2]) for c in candidates])
         Me = np.zeros((nodes.size, 6, 6))
         Me[:, [0, 1, 2], [0, 1, 2]] = w[:, None]
         owner = np.repeat(np.arange(len(candidates)), [c.nodes.size for c in candidates])
@@ -39,7 +33,7 @@ class _LineMass:
 
     def apply(self, model, candidate, value: float):
         m = copy_model(model)
-        for k, (n, w) in enumerate(zip(candidate.nodes, _weights(model.nodes[candidate.nodes, :2]))):
+        for k, (n, w) in enumerate(zip(candidate.nodes, tributary_weights(model.nodes[candidate.nodes, :2]))):
             m.add(f"effects.{candidate.name}.{k}", "mass", [[int(n)]], MassProperty(value * w))
         return m
 

@@ -32,8 +32,9 @@ from .layout import from_board
 from .residual import ModalResidual, Observation
 from .select import ALPHA, estimate, search
 
-#: where candidates go: sides cut into 8 pieces (every run of consecutive pieces is a candidate)
-CANDIDATE_OPTIONS = {"segments": 8}
+#: where candidates go: sides cut into 8 pieces (every run of consecutive pieces is a candidate);
+#: stiffener rows and columns every element (``path_spacing`` in element sizes)
+CANDIDATE_OPTIONS = {"segments": 8, "path_spacing": 1.0}
 
 
 def _options(kinds) -> set:
@@ -192,8 +193,8 @@ def diagnose(board, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_size=
                          f"{stats['p_value_noise']:.2f}): no effect is missing that the data can show",
                          after=out["parameters_only"], **out)
     say("generating the candidate effects")
-    cands = generate(from_board(models.bms[0]), kinds,
-                     **{k: v for k, v in CANDIDATE_OPTIONS.items() if k in _options(kinds)})
+    options = {k: v * h if k == "path_spacing" else v for k, v in CANDIDATE_OPTIONS.items() if k in _options(kinds)}
+    cands = generate(from_board(models.bms[0]), kinds, **options)
     say(f"searching {len(cands)} candidate effects")
     sel = search(res, cands, p0, models.bounds, max_effects=max_effects, shortlist=2, alpha=alpha, base=base)
     stats.update(chi2_after=sel.chi2[-1], candidates=len(cands))

@@ -16,35 +16,11 @@ every part footprint.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
+from ..board.effects import ScaledShell
 from ..fe.elements import kernel
 from .catalogue import Blocks, Candidate, copy_model
-
-
-@dataclass(frozen=True)
-class ScaledShell:
-    """A shell property whose stiffness is ``factor`` times that of ``base`` (mass unchanged)."""
-
-    base: object
-    factor: float
-
-    def membrane(self):
-        return self.factor * np.asarray(self.base.membrane())
-
-    def bending(self):
-        return self.factor * np.asarray(self.base.bending())
-
-    def shear(self):
-        return self.factor * np.asarray(self.base.shear())
-
-    def mass_per_area(self):
-        return self.base.mass_per_area()
-
-    def rotary_inertia_per_area(self):
-        return self.base.rotary_inertia_per_area()
 
 
 def _centroid(conns, xy) -> np.ndarray:

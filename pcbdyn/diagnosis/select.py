@@ -158,10 +158,10 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
         gain = np.where(ok, value**2 * norm2 / scale**2, -np.inf)
         gain[value < lower] = -np.inf  # an effect of unphysical sign cannot be the answer
         gain[sel.chosen] = -np.inf
-        order = _shortlist(gain, kinds, shortlist)
+        order = np.union1d(_shortlist(gain, kinds, shortlist), _companions(candidates, sel.chosen))
         if not order.size:
             break
-        fits = [estimate(res, fit.p, [candidates[i] for i in sel.chosen + [j]], np.r_[sel.values, value[j]],
+        fits = [estimate(res, fit.p, [candidates[i] for i in sel.chosen + [j]], np.r_[sel.values, max(value[j], 0.0)],
                          RANK_STEPS, bounds, param_columns=P) for j in order]
         best = int(np.argmin([f.chi2 for f in fits]))
         if not np.isfinite(fits[best].chi2):
@@ -191,6 +191,15 @@ def _orth(A):
         return np.zeros((A.shape[0], 0))
     U, s, _ = np.linalg.svd(A, full_matrices=False)
     return U[:, s > 1e-10 * s[0]] if s.size and s[0] > 0 else np.zeros((A.shape[0], 0))
+
+
+def _companions(candidates, chosen) -> np.ndarray:
+    """Candidates on the very nodes of a chosen one (the rotary inertia of a mass found, a spring
+    under it): always tried next, whatever their linear score, since a part found is the likeliest
+    place of its other properties."""
+    taken = {tuple(candidates[i].nodes.tolist()) for i in chosen}
+    return np.array([j for j, c in enumerate(candidates) if j not in chosen and tuple(c.nodes.tolist()) in taken
+                     and c.nodes.size == 1], dtype=np.int64)
 
 
 def _shortlist(gain, kinds, per_kind: int) -> np.ndarray:

@@ -10,30 +10,12 @@ proportional to b, hence to EI. Defaults: aluminium (70 GPa, 2700 kg/m^3), h = 4
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
-from ..fe import BeamProperty
+from ..board.effects import rib_property
+from ..board.spec import RibSection
 from ..fe.elements import kernel
 from .catalogue import Blocks, chain_candidate, copy_model
-
-
-@dataclass(frozen=True)
-class RibSection:
-    E: float = 70e9
-    nu: float = 0.33
-    rho: float = 2700.0
-    h: float = 4e-3
-
-    def prop(self, EI: float, plate_thickness: float) -> BeamProperty:
-        b = 12.0 * EI / (self.E * self.h**3)
-        I = b * self.h**3 / 12.0
-        return BeamProperty(self.E, self.nu, self.rho, b * self.h, I, I, 4.0 * I, orientation=(0.0, 0.0, 1.0),
-                            offset=(0.0, 0.0, 0.5 * (plate_thickness + self.h)))
-
-    def mass_per_length(self, EI: float) -> float:
-        return self.rho * 12.0 * EI / (self.E * self.h**2)
 
 
 class _Stiffener:
@@ -73,7 +55,7 @@ class _Stiffener:
             ks = np.flatnonzero(thick == t)
             edges = [candidates[k].data["edges"] for k in ks]
             conn = np.concatenate(edges)
-            Ke, Me = kernel("beam2")(model.nodes[conn], self.section.prop(1.0, t))
+            Ke, Me = kernel("beam2")(model.nodes[conn], rib_property(1.0, t, self.section))
             out.append(Blocks(conn, Ke, Me, np.repeat(ks, [e.shape[0] for e in edges])))
         return out
 
@@ -82,7 +64,7 @@ class _Stiffener:
             raise ValueError(f"{candidate.name}: a stiffener's EI must be > 0 N m^2, got {value}")
         m = copy_model(model)
         m.add(f"effects.{candidate.name}", "beam2", candidate.data["edges"],
-              self.section.prop(value, candidate.data["thickness"]))
+              rib_property(value, candidate.data["thickness"], self.section))
         return m
 
 

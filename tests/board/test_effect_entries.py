@@ -216,14 +216,17 @@ def test_all_kinds_in_one_file_and_parameters_target_them(base, tmp_path):
         assert abs((M2 - M1) - 0.3 * v * dM).max() <= 1e-7 * abs(M1).max(), name
 
 
-def test_stiffener_section_matches_the_diagnosis_kind():
-    from pcbdyn.diagnosis.stiffener import RibSection
+def test_stiffener_section_has_the_bending_stiffness_asked():
+    """The rib's section (shared with the diagnosis stiffener kind): E I = EI about both axes,
+    mass rho b h per length with b = 12 EI / (E h^3), axis (t + h) / 2 above the mid-surface."""
+    from pcbdyn.board.spec import RibSection
 
-    xyz = np.array([[[0.0, 0.0, 0.0], [0.01, 0.0, 0.0]], [[0.02, 0.01, 0.0], [0.025, 0.019, 0.0]]])
+    s = RibSection()
     for EI in (0.3, 7.0):
-        Kb, Mb = kernel("beam2")(xyz, rib_property(EI, 1.6e-3))
-        Kd, Md = kernel("beam2")(xyz, RibSection().prop(EI, 1.6e-3))
-        assert np.array_equal(Kb, Kd) and np.array_equal(Mb, Md)
+        prop = rib_property(EI, 1.6e-3)
+        assert prop.E * prop.Iy == pytest.approx(EI, rel=1e-12) and prop.Iz == prop.Iy
+        assert prop.rho * prop.A == pytest.approx(s.rho * 12 * EI / (s.E * s.h**2), rel=1e-12)
+        assert prop.offset[2] == pytest.approx(0.5 * (1.6e-3 + s.h))
 
 
 def test_edge_spring_on_a_slanted_edge_resists_rotation_about_that_edge_only(tmp_path):
