@@ -29,7 +29,7 @@ from ..fe.modal import solve_modes
 from ..fe.probe import model_probe
 from .catalogue import generate
 from .layout import from_board
-from .residual import ModalResidual, Observation
+from .residual import ModalResidual, Observation, paired_mac
 from .select import ALPHA, estimate, search
 
 #: where candidates go: sides cut into 8 pieces (every run of consecutive pieces is a candidate);
@@ -90,8 +90,7 @@ def _discretisation(board, config, mesh_size, p_values, ob, coarse_state):
     if ob.shapes is None:
         return df, np.zeros(m)
     read = model_probe(fine, ob.xyz, ob.directions, tol=0.02).P
-    u = np.asarray(read @ modes.shapes[:, k])
-    mac = np.abs(np.sum(u * coarse_state.u, axis=0)) ** 2 / (np.sum(u * u, axis=0) * np.sum(coarse_state.u**2, axis=0))
+    mac = paired_mac(np.asarray(read @ modes.shapes[:, k]), coarse_state.u)
     return df, 4.0 / 3.0 * np.sqrt(np.clip(1.0 - mac, 0.0, None))
 
 

@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..correlation.mac import mac
 from ..correlation.pairing import pair_modes
 from ..fe.assembly import assemble
 from ..fe.modal import solve_modes
@@ -120,8 +121,9 @@ class State:
                 "mean_mac": float(np.mean(macs)) if macs else None, "configurations": per}
 
 
-def _mac(a, b):
-    return np.abs(np.sum(a * b, axis=0)) ** 2 / (np.sum(a * a, axis=0) * np.sum(b * b, axis=0))
+def paired_mac(a, b) -> np.ndarray:
+    """MAC of column i of ``a`` with column i of ``b`` (thesis eq. 2.3)."""
+    return np.diagonal(mac(a, b)).copy()
 
 
 class ModalResidual:
@@ -169,7 +171,7 @@ class ModalResidual:
             pairs = np.arange(m)
             matched = np.ones(m, bool)
             u = s = None
-            mac = np.ones(m)
+            macs = np.ones(m)
         else:
             U = np.asarray(ob.read @ modes.shapes)
             pairs = -np.ones(m, int)
@@ -183,13 +185,13 @@ class ModalResidual:
                 free.remove(k)
             u = U[:, pairs]
             s = np.sum(u * ob.shapes, axis=0) / np.sum(u * u, axis=0)
-            mac = _mac(u, ob.shapes)
+            macs = paired_mac(u, ob.shapes)
         f_a = f_all[pairs]
         rows = [(ob.f - f_a) / (ob.sigma_f * ob.f)]
         if u is not None:
             rms = np.sqrt(np.mean(ob.shapes**2, axis=0))
             rows.append(((ob.shapes - s * u) / (ob.sigma_s * rms)).T.ravel())
-        return ConfigState(model, K, M, modes, pairs, matched, f_a, mac, u, s, np.concatenate(rows))
+        return ConfigState(model, K, M, modes, pairs, matched, f_a, macs, u, s, np.concatenate(rows))
 
     # --- sensitivities ---------------------------------------------------------------------
     def _columns(self, ob: Observation, cs: ConfigState, BK, BM, dU_static=None) -> np.ndarray:
