@@ -6,10 +6,11 @@ whether what remains is noise, and otherwise find, place and size the effects th
 2. Noise: the stated levels (uniform bounds as in thesis eqs. 5.72-5.73, so a standard deviation
    of p / sqrt(3)), or, for shapes without a stated level, the part of each measured shape that no
    combination of the model's modes can represent (a measured shape projected on the span of as
-   many modes as half the points; what is left over is noise). Model discretisation is
-   added in quadrature: the change of each paired frequency and shape from the model to one
-   meshed twice as fine (Richardson, 4/3 of it for an O(h^2) element), so that a coarse mesh is
-   not mistaken for an effect.
+   many modes as half the points; what is left over is noise). Model discretisation: the paired
+   frequencies of the modes the mesh resolves are corrected to a converged mesh by Richardson
+   extrapolation from the model and one meshed twice as fine (an O(h^2) element); what that
+   leaves uncertain, and the shapes' change (4/3 of it), is added to the noise in quadrature, so
+   that a coarse mesh is neither mistaken for an effect nor left in the error reported after.
 3. The declared parameters alone are fitted; if chi^2 is within what noise gives (chi-square
    test, probability ``alpha``) the data lie in the range of the model (thesis section 5.2.3) and
    nothing is invented.
@@ -29,12 +30,13 @@ from ..fe.modal import solve_modes
 from ..fe.probe import model_probe
 from .catalogue import generate
 from .layout import from_board
+from ..correlation.mac import mac
 from .residual import ModalResidual, Observation, paired_mac
 from .select import ALPHA, estimate, search
 
-#: where candidates go: sides cut into 8 pieces (every run of consecutive pieces is a candidate);
+#: where candidates go: sides cut into 16 pieces (every run of consecutive pieces is a candidate);
 #: stiffener rows and columns every element (``path_spacing`` in element sizes)
-CANDIDATE_OPTIONS = {"segments": 8, "path_spacing": 1.0}
+CANDIDATE_OPTIONS = {"segments": 16, "path_spacing": 1.0}
 
 
 def _options(kinds) -> set:
@@ -79,19 +81,32 @@ def _noise_sigmas(ob: Observation, freq_pct, shape_pct, basis_shapes):
     return sf, np.maximum(np.sqrt(np.mean(var)) / rms, 1e-4)
 
 
+#: a mode is resolved by the model's mesh when the twice finer mesh changes its shape at the
+#: points by less than this (sqrt(1 - MAC)): only then is its frequency change an O(h^2) error
+RESOLVED_SHAPE_CHANGE = 0.02
+
+
 def _discretisation(board, config, mesh_size, p_values, ob, coarse_state):
-    """(relative frequency error, relative shape error) per paired mode: 4/3 of the change to a mesh
-    twice as fine."""
+    """(frequency correction factor, its relative uncertainty, relative shape error, resolved) per
+    paired mode, from the model meshed twice as fine (fine modes paired by MAC at the points). A resolved
+    mode (:data:`RESOLVED_SHAPE_CHANGE`) is corrected by Richardson extrapolation of an O(h^2)
+    element, f_0 = f_h/2 + (f_h/2 - f_h) / 3, whose own error (a third of the step) stays as noise;
+    any other mode (not yet in the asymptotic range, or no shapes to tell) takes the finer mesh's
+    frequency, the whole step counted as noise."""
     fine = build_model(board, config, mesh_size / 2.0, shared_mesh=True).with_parameters(p_values).model
-    m = ob.f.size
     modes = solve_modes(fine, n_modes=int(coarse_state.pairs.max()) + 4)
-    k = np.minimum(coarse_state.pairs, modes.frequencies.size - 1)
-    df = 4.0 / 3.0 * np.abs(coarse_state.f_a / modes.frequencies[k] - 1.0)
     if ob.shapes is None:
-        return df, np.zeros(m)
-    read = model_probe(fine, ob.xyz, ob.directions, tol=0.02).P
-    mac = paired_mac(np.asarray(read @ modes.shapes[:, k]), coarse_state.u)
-    return df, 4.0 / 3.0 * np.sqrt(np.clip(1.0 - mac, 0.0, None))
+        k = np.minimum(coarse_state.pairs, modes.frequencies.size - 1)
+        change = np.full(k.size, np.inf)
+    else:
+        U = np.asarray(model_probe(fine, ob.xyz, ob.directions, tol=0.02).P @ modes.shapes)
+        k = mac(coarse_state.u, U).argmax(axis=1)
+        change = np.sqrt(np.clip(1.0 - paired_mac(U[:, k], coarse_state.u), 0.0, None))
+    step = modes.frequencies[k] / (coarse_state.f_a / ob.f_scale) - 1.0
+    resolved = change <= RESOLVED_SHAPE_CHANGE
+    scale = 1.0 + step * np.where(resolved, 4.0 / 3.0, 1.0)
+    sigma = np.abs(step) * np.where(resolved, 1.0 / 3.0, 1.0)
+    return scale, sigma, np.where(np.isfinite(change), 4.0 / 3.0 * change, 0.0), resolved
 
 
 class _BoardModels:
@@ -130,17 +145,22 @@ def _observations(tests, bms) -> list:
     return obs
 
 
-def _set_noise(board, models, h, obs, state, freq_pct, shape_pct) -> None:
-    """Each observation's sigmas: measurement noise and discretisation in quadrature."""
+def _set_noise(board, models, h, obs, state, freq_pct, shape_pct) -> list:
+    """Each observation's discretisation correction of the model frequencies, and its sigmas:
+    measurement noise and what remains of the discretisation error, in quadrature. Returns which
+    modes the mesh resolves, per observation."""
+    resolved = []
     for ob, cs in zip(obs, state.configs):
         basis = None
         if ob.shapes is not None:  # rigid-body modes first: a free board's shapes hold them at the points
             wide = solve_modes(cs.model, n_modes=ob.shapes.shape[0] // 2)
             basis = np.asarray(ob.read @ np.column_stack([wide.rigid_shapes, wide.shapes]))
         sf, ss = _noise_sigmas(ob, freq_pct, shape_pct, basis)
-        df, ds = _discretisation(board, ob.name, h, dict(zip(models.names, models.p0.tolist())), ob, cs)
+        ob.f_scale, df, ds, ok = _discretisation(board, ob.name, h, dict(zip(models.names, models.p0.tolist())), ob, cs)
         ob.sigma_f = np.sqrt(sf**2 + df**2)
         ob.sigma_s = None if ss is None else np.sqrt(ss**2 + ds**2)
+        resolved.append(ok.tolist())
+    return resolved
 
 
 def _range_test(res, base, n_params, alpha) -> dict:
@@ -174,11 +194,13 @@ def diagnose(board, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_size=
         res = models.residual(obs)
         before = res.evaluate(p0)
     say("estimating the noise and the model's discretisation error")
-    _set_noise(board, models, h, obs, before, freq_noise_pct, shape_noise_pct)
+    resolved = _set_noise(board, models, h, obs, before, freq_noise_pct, shape_noise_pct)
     before = res.evaluate(p0)
     say(f"fitting the {len(names)} declared parameter(s)" if names else "no declared parameters")
     base = estimate(res, p0, [], [], 10, models.bounds)
     stats = {"unpaired_test_modes": unmatched, "chi2_before": before.chi2, **_range_test(res, base, len(names), alpha),
+             "mesh_correction_pct": [np.round(100 * (o.f_scale - 1.0), 4).tolist() for o in obs],
+             "mesh_resolved": resolved,
              "sigma_f_pct": [np.round(100 * o.sigma_f, 4).tolist() for o in obs],
              "sigma_shape_pct": [None if o.sigma_s is None else np.round(100 * o.sigma_s, 4).tolist() for o in obs]}
     out = dict(before=before.summary(obs), parameters_only=base.state.summary(obs),

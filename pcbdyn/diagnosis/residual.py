@@ -2,8 +2,8 @@
 declared parameters and to candidate effects (issue 7, steps 2 and 5).
 
 Rows, per test configuration: one per measured mode,
-    r_i = (f_x,i - f_a,i) / (sigma_f,i f_x,i),
-and, with measured shapes, one per point and mode,
+    r_i = (f_x,i - c_i f_a,i) / (sigma_f,i f_x,i),
+c_i being the model's discretisation correction of the mode (1 when none is known), and, with measured shapes, one per point and mode,
     r_ji = (phi_x,ji - s_i u_ji) / (sigma_s,i rms(phi_x,i)),
 u_i being the paired model shape read at the points and s_i its modal scale factor (the
 least-squares fit of u_i to phi_x,i), so that the shape counts and not its scaling. With the right
@@ -36,15 +36,16 @@ class Observation:
     """One test configuration: measured frequencies ``f`` [Hz] (m,), optionally shapes (n_pts, m)
     that the model gives as ``read @ u`` (``read`` (n_pts, n_dof), full DOFs); relative standard
     deviations ``sigma_f`` (m,) of the frequencies and ``sigma_s`` (m,) of a shape component (per
-    RMS of the mode's measured shape); ``xyz``, ``directions``: the measured DOFs [m]. Without
-    shapes the modes pair by order."""
+    RMS of the mode's measured shape); ``xyz``, ``directions``: the measured DOFs [m];
+    ``f_scale`` (m,): the factor that takes the paired model frequency to its converged-mesh value
+    (a discretisation correction; 1 by default). Without shapes the modes pair by order."""
 
     def subset(self, keep) -> "Observation":
         """The observation of the measured modes ``keep`` (a boolean mask or indices)."""
         k = np.asarray(keep)
         return Observation(self.name, self.f[k], self.sigma_f[k], None if self.shapes is None else self.shapes[:, k],
                            self.read, None if self.sigma_s is None else self.sigma_s[k], self.xyz, self.directions,
-                           self.numbers[k])
+                           self.numbers[k], self.f_scale[k])
 
     name: str | None
     f: np.ndarray
@@ -55,10 +56,13 @@ class Observation:
     xyz: np.ndarray | None = None
     directions: np.ndarray | None = None
     numbers: np.ndarray | None = None  # the test's mode numbers (default 1..m)
+    f_scale: np.ndarray | None = None
 
     def __post_init__(self):
         if self.numbers is None:
             self.numbers = np.arange(1, np.size(self.f) + 1)
+        if self.f_scale is None:
+            self.f_scale = np.ones(np.size(self.f))
 
     @property
     def n_rows(self) -> int:
@@ -69,7 +73,8 @@ class Observation:
 class ConfigState:
     """A configuration's model at one state: its matrices ``K``, ``M`` (with the effects),
     ``modes``, ``pairs`` (elastic mode index per measured mode; ``matched`` False where no model
-    mode resembles it and the nearest free one stands in), paired frequencies ``f_a``, ``mac``, the
+    mode resembles it and the nearest free one stands in), paired frequencies ``f_a`` (with the
+    observation's discretisation correction), ``mac``, the
     model shapes at the points ``u`` and scale factors ``s``, its rows ``r``."""
 
     model: object
@@ -186,7 +191,7 @@ class ModalResidual:
             u = U[:, pairs]
             s = np.sum(u * ob.shapes, axis=0) / np.sum(u * u, axis=0)
             macs = paired_mac(u, ob.shapes)
-        f_a = f_all[pairs]
+        f_a = f_all[pairs] * ob.f_scale
         rows = [(ob.f - f_a) / (ob.sigma_f * ob.f)]
         if u is not None:
             rms = np.sqrt(np.mean(ob.shapes**2, axis=0))
@@ -205,7 +210,7 @@ class ModalResidual:
         lam = lam_b[ib]
         B = BK - BM * lam[None, None, :]
         dlam = B[:, ib, np.arange(ib.size)]  # (n_col, m)
-        df = dlam / (8.0 * np.pi**2 * cs.f_a)
+        df = dlam * ob.f_scale**2 / (8.0 * np.pi**2 * cs.f_a)  # d(c f)/dp, f = f_a / c
         out = [(df / (ob.sigma_f * ob.f)).T]
         if cs.u is not None:
             gap = lam[None, :] - lam_b[:, None]  # (n_basis, m)

@@ -34,6 +34,9 @@ class ElementSet:
         if self.etype == "spring":
             if self.conn.shape[1] not in (1, 2):
                 raise ModelError(f"element set '{self.name}': a spring cell has 1 or 2 nodes")
+        elif self.etype == "mass":
+            if self.conn.shape[1] == 2:
+                raise ModelError(f"element set '{self.name}': a mass cell has 1 node or a footprint of 3 or more")
         elif self.etype in NODES_PER_CELL:
             if self.conn.shape[1] != NODES_PER_CELL[self.etype]:
                 raise ModelError(

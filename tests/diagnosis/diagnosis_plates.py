@@ -36,3 +36,16 @@ def total_mass(model, dof=2):
     r = np.zeros(model.n_dof)
     r[dof::6] = 1.0
     return float(r @ (M @ r))
+
+
+def rotary_inertia(model, axis: int, about) -> float:
+    """r^T M r of a unit rigid rotation about global ``axis`` through the point ``about``."""
+    from pcbdyn.fe.assembly import assemble
+
+    _, M = assemble(model)
+    e = np.eye(3)[axis]
+    r = np.zeros((model.n_nodes, 6))
+    r[:, :3] = np.cross(e, model.nodes - np.asarray(about, float))
+    r[:, 3:] = e
+    r = r.ravel()
+    return float(r @ (M @ r))
