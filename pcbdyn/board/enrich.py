@@ -18,13 +18,12 @@ from __future__ import annotations
 
 import datetime as _dt
 import re
-import tomllib
 from pathlib import Path
 
 import numpy as np
 
 from ..atomic import atomic_path
-from .spec import BoardError, load_board
+from .spec import BoardError, load_board, read_toml
 
 TYPES = ("point_mass", "point_inertia", "ground_spring", "edge_stiffness", "line_mass", "stiffener",
          "region_stiffness")
@@ -144,13 +143,7 @@ def write_enriched(original_path, effects, out_path=None, date: str | None = Non
     ``out_path`` (default ``<stem>.diagnosed.toml`` beside the original), atomically; the result
     is loaded with ``load_board`` before it replaces ``out_path``. Returns the path written."""
     src = Path(original_path)
-    if not src.is_file():
-        raise BoardError(f"{src}: no such file")
-    text = src.read_text()
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise BoardError(f"{src.name}: not valid TOML: {exc}; fix the syntax at that line") from None
+    text, data = read_toml(src)
     dst = Path(out_path) if out_path is not None else enriched_path(src)
     body = text if text.endswith("\n") or not text else text + "\n"
     body += effect_block(list(effects), data, date)

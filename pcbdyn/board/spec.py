@@ -315,17 +315,21 @@ class _Reader:
         return float(value)
 
 
-def load_board(path) -> Board:
-    """Read and validate a board.toml."""
+def read_toml(path) -> tuple:
+    """(text, parsed data) of a TOML file; a BoardError naming the file when it is missing or malformed."""
     path = Path(path)
     if not path.is_file():
         raise BoardError(f"{path}: no such file")
     text = path.read_text()
     try:
-        data = tomllib.loads(text)
+        return text, tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise BoardError(f"{path.name}: not valid TOML: {exc}; fix the syntax at that line") from None
-    return parse_board(data, path)
+
+
+def load_board(path) -> Board:
+    """Read and validate a board.toml."""
+    return parse_board(read_toml(path)[1], Path(path))
 
 
 def parse_board(data: dict, path: Path) -> Board:
@@ -609,6 +613,16 @@ def _circle(centre, diameter, n=12) -> np.ndarray:
     return np.asarray(centre) + 0.5 * diameter * np.c_[np.cos(ang), np.sin(ang)]
 
 
+def _point_on_board(r, board, f, where, what: str):
+    """A fixture's ``at`` point, required and on the board."""
+    if "at" not in f:
+        r.fail(f"{where}.at", f"missing; a {what} needs at = [\"x mm\", \"y mm\"]")
+    at = r.point(f["at"], f"{where}.at")
+    if not board.outline.contains(at)[0]:
+        r.fail(f"{where}.at", f"{f['at']} is not on the board; move the {what} inside the outline")
+    return at
+
+
 def _fixture(r, f, where, board, i) -> Fixture:
     r.table(f, where, ["name", "type", "edge", "width", "k_rot", "at", "k", "diameter", "from", "to"],
             required=["type"])
@@ -632,22 +646,14 @@ def _fixture(r, f, where, board, i) -> Fixture:
             k = f["k_rot"]
             fx.k_rot = k if k in ("clamped", "hinged") else r.q(k, "N*m/rad/m", f"{where}.k_rot", nonneg=True)
     elif typ == "standoff":
-        if "at" not in f:
-            r.fail(f"{where}.at", "missing; a standoff needs at = [\"x mm\", \"y mm\"]")
-        fx.at = r.point(f["at"], f"{where}.at")
-        if not board.outline.contains(fx.at)[0]:
-            r.fail(f"{where}.at", f"{f['at']} is not on the board; move the standoff inside the outline")
+        fx.at = _point_on_board(r, board, f, where, "standoff")
         k = f.get("k", "rigid")
         fx.k = "rigid" if k == "rigid" else r.q(k, "N/m", f"{where}.k", positive=True)
         fx.diameter = r.q(f.get("diameter", "6 mm"), "mm", f"{where}.diameter", positive=True)
         if not board.outline.contains(_circle(fx.at, fx.diameter)).all():
             r.fail(f"{where}.diameter", "the standoff's pad reaches off the board; move it or make it smaller")
     elif typ == "point_spring":
-        if "at" not in f:
-            r.fail(f"{where}.at", "missing; a point spring needs at = [\"x mm\", \"y mm\"]")
-        fx.at = r.point(f["at"], f"{where}.at")
-        if not board.outline.contains(fx.at)[0]:
-            r.fail(f"{where}.at", f"{f['at']} is not on the board; move the point spring inside the outline")
+        fx.at = _point_on_board(r, board, f, where, "point spring")
         if "k" not in f:
             r.fail(f"{where}.k", "missing; add k = \"1e5 N/m\" (stiffness to ground in z)")
         fx.k = r.q(f["k"], "N/m", f"{where}.k", positive=True)
