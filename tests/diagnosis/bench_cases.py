@@ -44,7 +44,9 @@ class Effect:
     along ``segment`` (two end points on a boundary side) or ``path`` (two end points across the
     plate), or over ``polygon`` [m]; ``value`` in SI (kg, kg m^2, N/m, N m/rad/m, 1, N m^2, kg).
     ``required``: diagnose must find it (False: reported or not, not judged; e.g. a rotary inertia
-    too small to show above the noise)."""
+    too small to show above the noise). ``declared``: the truth board declares it as a board.toml
+    entry (a [[masses]] body: a mass and its rotary inertia at one point), so that the truth is
+    the board's own, mesh-independent model of it, not a candidate on the truth mesh."""
 
     kind: str
     value: float
@@ -53,6 +55,7 @@ class Effect:
     path: tuple | None = None
     polygon: tuple | None = None
     required: bool = True
+    declared: bool = False
 
     @property
     def report_as(self) -> str:
@@ -104,8 +107,8 @@ CASES = [
     Case("pm_transducer_cfg", "card", (Effect("point_mass", 13e-3, at=SHAKER),), configs=C23,
          drop_transducer=True, true_values=CARD_TRUE, seed=1,
          note="transducer left out; three configurations (53.2 g with rotary inertia at c2, c3)"),
-    Case("pm_inertia", "card", (Effect("point_mass", 25e-3, at=(0.140, 0.150)),
-                                Effect("point_inertia", 2e-6, at=(0.140, 0.150), required=False)),
+    Case("pm_inertia", "card", (Effect("point_mass", 25e-3, at=(0.140, 0.150), declared=True),
+                                Effect("point_inertia", 2e-6, at=(0.140, 0.150), required=False, declared=True)),
          true_values=CARD_TRUE, seed=2, note="a 25 g part with rotary inertia (a relay, radius of gyration "
                                              "about 9 mm) away from the points"),
     Case("gs_standoff", "card", (Effect("ground_spring", 1.5e5, at=(0.081, 0.113)),), true_values=CARD_TRUE,
@@ -181,7 +184,19 @@ def truth_text(case: Case) -> str:
     if "k_guides" in tv:
         text, n = re.subn(r'k_rot = "1e4 N\*m/rad/m"', f'k_rot = "{tv["k_guides"]:.6g} N*m/rad/m"', text)
         assert n == 2
-    return text
+    return text + declared_text(case)
+
+
+def declared_text(case: Case) -> str:
+    """[[masses]] entries of the case's declared effects: one body per point (its mass and rotary inertia)."""
+    bodies: dict = {}
+    for e in case.effects:
+        if e.declared:
+            assert e.kind in ("point_mass", "point_inertia"), f"{e.kind} cannot be declared in the truth board"
+            bodies.setdefault(tuple(e.at), {})[e.kind] = e.value
+    return "".join(f'\n[[masses]]\nname = "hidden_{i}"\nat = ["{1e3 * at[0]:.6g} mm", "{1e3 * at[1]:.6g} mm"]\n'
+                   f'mass = "{1e3 * b.get("point_mass", 0.0):.6g} g"\ninertia = "{b.get("point_inertia", 0.0):.6g} kg*m^2"\n'
+                   for i, (at, b) in enumerate(bodies.items()))
 
 
 def points_grid(width: float, height: float, n: int = 10, inset: float = 5e-3):
@@ -292,7 +307,8 @@ def make_case(case: Case, folder) -> tuple:
         assert bm.model.nodes.shape == base.model.nodes.shape and np.allclose(bm.model.nodes, base.model.nodes)
         model = bm.model
         for e, c in zip(case.effects, cands):
-            model = dg.add_effect(model, c, e.value)
+            if not e.declared:
+                model = dg.add_effect(model, c, e.value)
         modes = solve_modes(model, f_max=F_MAX)
         f_axis = np.arange(0.0, 1200.0 + 1e-9, 1.0)
         data = simulate_on_model(model, modes, points, dofs, excite=(*SHAKER, 0.0), f_axis=f_axis, zeta=0.01,

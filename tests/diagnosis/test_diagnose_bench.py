@@ -136,9 +136,10 @@ def judge(case, truth: dict, data: dict) -> list:
 # ---------------------------------------------------------------------------------------- tests
 #: cases where diagnose misses the acceptance today, and why (strict: a fix turns them into passes)
 KNOWN = {
-    "pm_inertia": "the 25 g part with rotary inertia is found as three point masses of about 9 g, 11 to 15 mm "
-                  "around it (together 27.3 g centred within 1 mm of it, max frequency error after 0.46 %): "
-                  "they lie further apart than the merging reach (2.6 elements), so the nearest is judged (-62 %)",
+    "pm_inertia": "the 25 g part (a [[masses]] body with rotary inertia in the truth board) is found within 1 mm "
+                  "(+1 %), but its rotary inertia is placed 11 mm away (-38 %) and the max frequency error after "
+                  "stays at 1.0 %: the inertia candidate acts through the cells around one node, the true body "
+                  "through its 9 mm radius of gyration",
     "line_mass_top_cfg": "the connector is found on the true segment (+4 %), but mode 6 of configuration c2 "
                          "stays 1.0 % off after (0.5 % allowed): the 53.2 g mass at the board's edge moves "
                          "that mode 2.4 % between the model's mesh and one twice as fine",
