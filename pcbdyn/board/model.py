@@ -181,7 +181,7 @@ def build_model(board: Board, config: str | None = None, mesh_size: float | None
     masses += [(f"configurations.{cfg.name}.{m.name}", m) for m in (cfg.masses if cfg else [])]
     for name, m in masses:
         node = point_nodes[name]
-        shells = [mesh.all_cells(t) for t in ("quad4", "tri3")]
+        shells = [(t, mesh.all_cells(t)) for t in ("quad4", "tri3")]
         add(*supports.point_mass(name, node, m, q, supports.mass_footprint(mesh.nodes, shells, node, m.mass, m.inertia)))
     for mk in effects.effect_sets(board, mesh, q, makers):
         add(*mk)

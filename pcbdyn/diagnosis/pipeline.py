@@ -20,6 +20,7 @@ whether what remains is noise, and otherwise find, place and size the effects th
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -32,7 +33,7 @@ from .catalogue import generate
 from .layout import from_board
 from ..correlation.mac import mac
 from .residual import ModalResidual, Observation, paired_mac
-from .select import ALPHA, estimate, search
+from .select import ALPHA, estimate, refine, search
 
 #: where candidates go: sides cut into 16 pieces (every run of consecutive pieces is a candidate);
 #: stiffener rows and columns every element (``path_spacing`` in element sizes)
@@ -218,6 +219,9 @@ def diagnose(board, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_size=
     cands = generate(from_board(models.bms[0]), kinds, **options)
     say(f"searching {len(cands)} candidate effects")
     sel = search(res, cands, p0, models.bounds, max_effects=max_effects, shortlist=2, alpha=alpha, base=base)
+    if any(RUN.match(cands[i].name) for i in sel.chosen):
+        say("refining where the effects along the sides begin and end")
+        sel = refine(res, cands, sel, _run_neighbours(cands), models.bounds, alpha=alpha)
     stats.update(chi2_after=sel.chi2[-1], candidates=len(cands))
     for n, v in zip(names, sel.p):
         out["parameters"][n]["final"] = float(v)
@@ -235,6 +239,32 @@ def diagnose(board, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_size=
                      candidates=chosen, **out)
 
 
+#: the name of a candidate over a run of pieces of a side: "<kind>@<side>[i]" or "[i-j]"
+RUN = re.compile(r"^(?P<base>.+)\[(?P<i>\d+)(?:-(?P<j>\d+))?\]$")
+
+
+def _run_neighbours(cands):
+    """neighbours(i): the candidates of the same kind and side as candidate i whose run of pieces
+    starts and ends at most one piece from its own (none for other candidates)."""
+    runs: dict = {}
+    for k, c in enumerate(cands):
+        if m := RUN.match(c.name):
+            i = int(m["i"])
+            runs.setdefault(m["base"], {})[(i, int(m["j"] or i))] = k
+
+    def neighbours(k):
+        m = RUN.match(cands[k].name)
+        if not m:
+            return []
+        i = int(m["i"])
+        j = int(m["j"] or i)
+        side = runs[m["base"]]
+        return [side[(a, b)] for a in (i - 1, i, i + 1) for b in (j - 1, j, j + 1)
+                if (a, b) != (i, j) and (a, b) in side]
+
+    return neighbours
+
+
 #: kinds that act at one node: an effect between nodes is shared by its neighbours
 POINT_KINDS = ("point_mass", "point_inertia", "ground_spring")
 #: [element sizes] how far apart shares of one effect may be found (an unstructured mesh puts the
@@ -245,15 +275,30 @@ MERGE_REACH = 2.6
 def _linked(a, b, reach: float) -> bool:
     """Two chosen effects that are one: point effects of one kind within ``reach`` [m] (a mass or a
     spring between nodes is fitted as shares on the nodes around it), or a point mass within
-    ``reach`` of a line mass (a mass spread over part of an edge is fitted as a line plus points)."""
+    ``reach`` of a line mass (a mass spread over part of an edge is fitted as a line plus points),
+    or line masses whose segments overlap or lie within ``reach``."""
     if a.kind == b.kind and a.kind in POINT_KINDS:
         return np.hypot(a.at[0] - b.at[0], a.at[1] - b.at[1]) <= reach
+    if a.kind == b.kind == "line_mass":  # masses along one stretch of a side add up
+        return _segment_gap(a.geometry["segment"], b.geometry["segment"]) <= reach
     if {a.kind, b.kind} == {"point_mass", "line_mass"}:
         line, point = (a, b) if a.kind == "line_mass" else (b, a)
         p0, p1 = np.asarray(line.geometry["segment"], float)
         t = np.clip(np.dot(np.subtract(point.at, p0), p1 - p0) / max(np.dot(p1 - p0, p1 - p0), 1e-300), 0.0, 1.0)
         return np.linalg.norm(p0 + t * (p1 - p0) - np.asarray(point.at)) <= reach
     return False
+
+
+def _segment_gap(s, t) -> float:
+    """Shortest distance [m] between two straight segments (0 where they overlap or cross)."""
+    s, t = np.asarray(s, float), np.asarray(t, float)
+
+    def to_segment(p, seg):
+        d = seg[1] - seg[0]
+        u = np.clip(np.dot(p - seg[0], d) / max(np.dot(d, d), 1e-300), 0.0, 1.0)
+        return float(np.linalg.norm(seg[0] + u * d - p))
+
+    return min([to_segment(p, t) for p in s] + [to_segment(p, s) for p in t])
 
 
 def _neighbours(chosen, reach: float) -> list:
@@ -270,10 +315,11 @@ def _neighbours(chosen, reach: float) -> list:
 
 
 def _merged(chosen, values, cov, group) -> dict:
-    """One effect entry (JSON-ready) for a group: the magnitudes summed at their weighted centre (on a
-    line mass: the line mass's place and extent), the uncertainty of the sum from the fit's covariance."""
+    """One effect entry (JSON-ready) for a group: the magnitudes summed at their weighted centre (on
+    line masses: the place and extent of the largest), the uncertainty of the sum from the fit's
+    covariance."""
     lines = [k for k in group if chosen[k].kind == "line_mass"]
-    c = chosen[lines[0] if lines else group[0]]
+    c = chosen[max(lines, key=lambda k: values[k]) if lines else group[0]]
     d = c.describe()
     v = np.asarray(values, float)[group]
     if len(group) > 1:

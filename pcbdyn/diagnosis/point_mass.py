@@ -29,8 +29,8 @@ class _Lumped:
     def _cell(self, model, node: int) -> np.ndarray:
         if self.param == "mass":
             return np.array([node])
-        shells = [s.conn for s in model.sets.values() if s.etype in ("quad4", "tri3")]
-        return mass_footprint(model.nodes, shells, node, 0.0, 1.0)
+        shells = [(s.etype, s.conn) for s in model.sets.values() if s.etype in ("quad4", "tri3")]
+        return mass_footprint(model.nodes, shells, node, 0.0, 1.0)[0]
 
     def _property(self, value: float):
         return MassProperty(value, (0.0, 0.0, 0.0)) if self.param == "mass" else MassProperty(0.0, (value, value, 0.0))

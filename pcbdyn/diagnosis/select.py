@@ -180,6 +180,47 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
     return sel
 
 
+def refine(res, candidates, sel: Selection, neighbours, bounds=None, newton_steps: int = 8,
+           alpha: float = ALPHA) -> Selection:
+    """Local search on the geometry of the effects found: each chosen candidate is swapped in turn
+    for each of ``neighbours(i)`` (candidate indices of the same kind next to it, e.g. a segment
+    one piece longer or shorter), all magnitudes and the declared parameters re-estimated; the
+    best swap is kept while it lowers chi^2, then effects the others now explain are pruned.
+    Forward selection adds effects greedily on a coarse set of places; this lets a place found
+    early move to where the effects found later leave it best."""
+    pen = penalty(res.n_rows, len(candidates), alpha)
+    n_par = np.size(sel.p)
+    idx = list(sel.chosen)
+    fit = Fit(sel.p, sel.values, sel.state, np.zeros((0, 0)))
+    improved = bool(idx)
+    while improved:
+        improved = False
+        best = None
+        P = res.param_columns(fit.state)  # held while ranking the swaps, as in :func:`search`
+        for k, i in enumerate(idx):
+            for j in neighbours(i):
+                if j in idx:
+                    continue
+                trial_idx = idx[:k] + [j] + idx[k + 1:]
+                trial = estimate(res, fit.p, [candidates[t] for t in trial_idx], fit.values, RANK_STEPS, bounds,
+                                 param_columns=P)
+                if trial.chi2 < (fit.chi2 if best is None else best[1].chi2) * (1 - 1e-6):
+                    best = (trial_idx, trial)
+        if best is not None:
+            new = estimate(res, best[1].p, [candidates[t] for t in best[0]], best[1].values, newton_steps, bounds)
+            if new.chi2 < fit.chi2 * (1 - 1e-6):
+                idx, fit, improved = best[0], new, True
+    if idx == list(sel.chosen):
+        return sel
+    idx, fit = _prune(res, candidates, idx, fit, newton_steps, bounds, pen, n_par)
+    sel.chosen, sel.values, sel.p, sel.state = idx, fit.values, fit.p, fit.state
+    sel.cov = fit.cov[n_par:, n_par:]
+    sel.sigma = np.sqrt(np.clip(np.diag(sel.cov), 0.0, None))
+    sel.chi2.append(fit.chi2)
+    sel.criterion.append(fit.chi2 + len(idx) * pen)
+    return sel
+
+
 def _worth(chi2_before, chi2_after, n, k, pen) -> bool:
     """The drop exceeds the penalty in stated noise units and in units of the variance left."""
     drop = chi2_before - chi2_after

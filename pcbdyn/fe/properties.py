@@ -6,7 +6,7 @@ Every property is a frozen dataclass; :func:`dataclasses.replace` makes a pertur
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -105,10 +105,13 @@ class EdgeSpringProperty:
 
 @dataclass(frozen=True)
 class MassProperty:
-    """Point mass ``m`` [kg] with rotary inertia ``inertia`` (3,) diagonal or (3,3) [kg m^2], global axes."""
+    """Point mass ``m`` [kg] with rotary inertia ``inertia`` (3,) diagonal or (3,3) [kg m^2], global axes.
+    ``footprint`` (n_samples, nodes per cell): for a cell of several nodes, the interpolation
+    weights of points sampling the body's footprint (None: the nodes themselves sample it)."""
 
     m: float
     inertia: tuple = (0.0, 0.0, 0.0)
+    footprint: object = field(default=None, compare=False)
 
     def inertia_matrix(self) -> np.ndarray:
         J = np.asarray(self.inertia, dtype=float)

@@ -140,9 +140,6 @@ KNOWN = {
                   "(+1 %), but its rotary inertia is placed 11 mm away (-38 %) and the max frequency error after "
                   "stays at 1.0 %: the inertia candidate acts through the cells around one node, the true body "
                   "through its 9 mm radius of gyration",
-    "line_mass_top_cfg": "the connector is found on the true segment (+4 %), but mode 6 of configuration c2 "
-                         "stays 1.0 % off after (0.5 % allowed): the 53.2 g mass at the board's edge moves "
-                         "that mode 2.4 % between the model's mesh and one twice as fine",
     "stiffener_row": "a stiffener is found 9 mm from the true row (EI -6 %) with two small effects beside it, "
                      "and the max frequency error after stays at 1.5 %: the model's node rows zig-zag on the "
                      "unstructured mesh, the true rib is straight",

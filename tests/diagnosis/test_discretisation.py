@@ -39,15 +39,18 @@ def correction(board, config, reference_mesh):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("config", [None, "c3"])
-def test_resolved_modes_move_towards_a_converged_mesh(config):
-    """Against the card meshed four times finer (a nearly converged reference), every resolved
-    mode's corrected frequency is closer than the raw one, and the error left is within three of
-    the stated sigmas (a third of the h -> h/2 step). Configuration c3 carries a 53.2 g mass with
-    rotary inertia: on its footprint it converges with the mesh as the bare card does."""
+@pytest.mark.parametrize("config,min_resolved", [(None, N_MODES - 1), ("c2", 3), ("c3", N_MODES - 1)])
+def test_corrected_frequencies_move_towards_a_converged_mesh(config, min_resolved):
+    """Against the card meshed four times finer (a nearly converged reference), every mode's
+    corrected frequency is closer than the raw one, and the error left is within three of the
+    stated sigmas (a third of the h -> h/2 step where the mesh resolves the mode, the whole step
+    elsewhere). Configurations c2 (at the board's edge) and c3 carry a 53.2 g mass with rotary
+    inertia: on its footprint it converges with the mesh; at the edge its half-disc footprint
+    changes the shapes of the higher modes between h and h/2 (not resolved: the finer mesh's
+    frequency is taken)."""
     board = load_board(CARD)
     f_h, scale, sigma, resolved, f_ref = correction(board, config, board.mesh_size / 4.0)
-    assert resolved.sum() >= N_MODES - 1
+    assert resolved.sum() >= min_resolved
     raw, corrected = np.abs(f_h / f_ref - 1.0), np.abs(f_h * scale / f_ref - 1.0)
-    assert np.all(corrected[resolved] < raw[resolved])
-    assert np.all(corrected[resolved] <= 3.0 * sigma[resolved])
+    assert np.all(corrected < raw)
+    assert np.all(corrected <= 3.0 * sigma)

@@ -81,3 +81,26 @@ def test_noise_alone_gives_no_effect(card, seed):
     m, cands = card
     sel = forward_select(m, cands, measured(m, None, 0.0, seed=seed), SIGMA)
     assert sel.chosen == []
+
+
+def test_refine_moves_a_segment_found_too_short_to_the_true_run(card):
+    """A line mass over two pieces of a free side, first fitted on one of them: the local search
+    on the run's ends (:func:`refine` with the pipeline's neighbours) moves it to the true run and
+    recovers its mass."""
+    from pcbdyn.diagnosis.pipeline import RUN, _run_neighbours
+    from pcbdyn.diagnosis.residual import ModalResidual, Observation
+    from pcbdyn.diagnosis.select import Selection, estimate, refine
+
+    m, cands = card
+    runs = {c.name: i for i, c in enumerate(cands) if c.kind == "line_mass" and RUN.match(c.name)}
+    side = RUN.match(next(n for n in runs if n.endswith("[1-2]")))["base"]
+    truth, start = runs[f"{side}[1-2]"], runs[f"{side}[1]"]
+    f_test = solve_modes(dg.add_effect(m, cands[truth], 0.03), n_modes=N_MODES).frequencies
+    res = ModalResidual([Observation(None, f_test, np.full(N_MODES, SIGMA))], lambda p: [m])
+    fit = estimate(res, np.zeros(0), [cands[start]], [0.03], 8)
+    assert fit.chi2 > 10.0  # the wrong run cannot explain the data
+    sel = Selection(chosen=[start], values=fit.values, p=fit.p, chi2=[fit.chi2], state=fit.state)
+    sel = refine(res, cands, sel, _run_neighbours(cands))
+    assert [cands[i].name for i in sel.chosen] == [cands[truth].name]
+    assert sel.values[0] == pytest.approx(0.03, rel=1e-3)
+    assert sel.chi2[-1] < 1e-3

@@ -29,10 +29,11 @@ def spring_matrices(xyz: np.ndarray, prop):
 def mass_matrices(xyz: np.ndarray, prop):
     """A rigid body of mass m and rotary inertia J at a cell's first node. A one-node cell carries
     it on that node's six DOFs. A cell of three or more nodes (a footprint) moves the body with
-    the least-squares rigid motion of its nodes' translations (as an RBE3 link, adding no
-    stiffness): u_i = u_b + theta_b x r_i, so M = G^T diag(m, m, m, J) G with G the pseudo-inverse
-    of that map; a rotary inertia then acts on the slope of the footprint, which converges with
-    the mesh, not on one node's rotations, which a refined shell mesh decouples."""
+    the least-squares rigid motion of the translations of points sampling the footprint (the nodes
+    themselves, or ``prop.footprint``'s interpolation weights), as an RBE3 link that adds no
+    stiffness: u_s = u_b + theta_b x r_s, so M = G^T diag(m, m, m, J) G with G the pseudo-inverse of
+    that map; a rotary inertia then acts on the slope of the footprint, which converges with the
+    mesh, not on one node's rotations, which a refined shell mesh decouples."""
     n_cells, nn, _ = xyz.shape
     J = prop.inertia_matrix()
     if not prop.m >= 0 or J.shape != (3, 3) or np.any(np.linalg.eigvalsh(0.5 * (J + J.T)) < 0):
@@ -43,13 +44,17 @@ def mass_matrices(xyz: np.ndarray, prop):
     if nn == 1:
         Me = np.broadcast_to(Mb, (n_cells, 6, 6)).copy()
         return np.zeros_like(Me), Me
-    r = xyz - xyz[:, :1, :]
-    A = np.zeros((n_cells, nn, 3, 6))
+    W = np.eye(nn) if prop.footprint is None else np.asarray(prop.footprint, float)
+    if W.ndim != 2 or W.shape[1] != nn:
+        raise ModelError(f"MassProperty.footprint must be (n_samples, {nn}) weights of the cell's nodes, got {W.shape}")
+    ns = W.shape[0]
+    r = np.einsum("sn,cnk->csk", W, xyz) - xyz[:, :1, :]
+    A = np.zeros((n_cells, ns, 3, 6))
     A[:, :, :, :3] = np.eye(3)
     A[:, :, 0, 4], A[:, :, 0, 5] = r[..., 2], -r[..., 1]  # u = u_b + theta_y z - theta_z y
     A[:, :, 1, 3], A[:, :, 1, 5] = -r[..., 2], r[..., 0]  # v = v_b - theta_x z + theta_z x
     A[:, :, 2, 3], A[:, :, 2, 4] = r[..., 1], -r[..., 0]  # w = w_b + theta_x y - theta_y x
-    G = np.linalg.pinv(A.reshape(n_cells, 3 * nn, 6))  # (n_cells, 6, 3 nn)
+    G = np.linalg.pinv(A.reshape(n_cells, 3 * ns, 6)) @ np.kron(W, np.eye(3))  # (n_cells, 6, 3 nn)
     Mt = np.einsum("cai,ab,cbj->cij", G, Mb, G)
     Me = np.zeros((n_cells, nn, 6, nn, 6))
     Me[:, :, :3, :, :3] = Mt.reshape(n_cells, nn, 3, nn, 3)
