@@ -8,7 +8,10 @@ the success ratio (eq. 5.66) per equation type, method and noise level.
 
 Methods (all see the same noisy equations of a shot):
 
-- ``tls-qrf``: :func:`~.subset.tls_qrf` (thesis 5.2.3);
+- ``tls-qrf``: :func:`~.subset.tls_qrf` (thesis 5.2.3), b weighted for TLS (eq. 4.43) by the
+  errors the stated noise level makes in A and b, measured by drawing that noise again on the
+  shot's data (:func:`~.weighting.tls_column_weight_from_noise`): the study states the level,
+  as a tester states the precision of a measurement;
 - ``svd-qr``: :func:`~.subset.svd_qr` (5.2.2);
 - ``qr``: :func:`~.subset.qr_basic_solution` with the threshold of eq. 5.64;
 - ``min-norm``: the minimum-norm LS solution of all parameters at the full numerical rank (only
@@ -35,7 +38,7 @@ from .sensitivity import frequencies_hz, solve_modes
 from .solvers import RankDeficiencyWarning, solve_ls
 from .subset import qr_basic_solution, svd_qr, threshold_selection, tls_qrf
 from .success import add_noise, success_ratio, success_statistics
-from .weighting import unit_row_weights, weight_rows
+from .weighting import tls_column_weight_from_noise, unit_row_weights, weight_rows
 
 #: the thesis' simulated free PCB (section 5.4.4, Table 5.10): 162 x 178 x 2.8 mm, E 26 GPa,
 #: rho 2640 kg/m^3 on a 6 x 7 mesh; element thicknesses [mm] of the model ("pa") and of the
@@ -57,11 +60,12 @@ def _rank(rank, n):
     return int(rank) if rank >= 0 else n + int(rank)
 
 
-def localise(method: str, A, b, rank: int | None = None) -> np.ndarray:
-    """Indices of the parameters ``method`` (see the module doc) detects as erroneous."""
+def localise(method: str, A, b, rank: int | None = None, t_b: float | None = None) -> np.ndarray:
+    """Indices of the parameters ``method`` (see the module doc) detects as erroneous; ``t_b``:
+    TLS weight of b (default eq. 4.43 with k_A = k_b)."""
     r = _rank(rank, A.shape[1])
     if method == "tls-qrf":
-        return tls_qrf(A, b, rank=r).selected
+        return tls_qrf(A, b, rank=r, t_b=t_b).selected
     if method == "svd-qr":
         return svd_qr(A, b, rank=r).selected
     if method == "qr":
@@ -204,22 +208,29 @@ class SimulatedFreePCB:
     def n_params(self) -> int:
         return len(self.parameter_names)
 
-    def equations(self, kind: str, level_pct: float, rng):
-        """Weighted (A, b) of equation type ``kind`` from test data with ``level_pct`` % uniform
-        noise (eqs. 5.72-5.74) drawn from ``rng``."""
+    def measure(self, kind: str, level_pct: float, rng) -> tuple:
+        """The simulated test data equations of type ``kind`` use, with ``level_pct`` % uniform
+        noise (eqs. 5.72-5.74) drawn from ``rng``: (omega, shapes) or one FRF matrix per
+        configuration."""
         if kind in ("qms", "fbm"):
             c = self.configs[0]
-            om, phi = add_noise(c["omega_x"], level_pct, rng), add_noise(c["phi_x"], level_pct, rng)
-            build = qms_equations if kind == "qms" else fbm_equations
-            return _weighted(build(self.K, c["M"], om, phi, self.dKs, self.dMs, self.p_a))
+            return add_noise(c["omega_x"], level_pct, rng), add_noise(c["phi_x"], level_pct, rng)
         if kind in ("frf", "frf+pbc"):
-            blocks = []
-            for c in self.configs[: 1 if kind == "frf" else 2]:
-                H = add_noise(c["H_x"], level_pct, rng)
-                blocks.append(_weighted(frf_receptance_equations(
-                    self.K, c["M"], c["omegas"], H, self.excitation, self.dKs, self.dMs, self.p_a)))
-            return tuple(stack(blocks))
+            return tuple(add_noise(c["H_x"], level_pct, rng) for c in self.configs[: 1 if kind == "frf" else 2])
         raise ValueError(f"equation type {kind!r}: choose one of {', '.join(self.kinds)}")
+
+    def build(self, kind: str, data: tuple):
+        """Weighted (A, b) of equation type ``kind`` from test data (:meth:`measure`)."""
+        if kind in ("qms", "fbm"):
+            build = qms_equations if kind == "qms" else fbm_equations
+            return _weighted(build(self.K, self.configs[0]["M"], *data, self.dKs, self.dMs, self.p_a))
+        return tuple(stack([_weighted(frf_receptance_equations(
+            self.K, c["M"], c["omegas"], H, self.excitation, self.dKs, self.dMs, self.p_a))
+            for c, H in zip(self.configs, data)]))
+
+    def equations(self, kind: str, level_pct: float, rng):
+        """Weighted (A, b) of equation type ``kind`` from test data with ``level_pct`` % noise."""
+        return self.build(kind, self.measure(kind, level_pct, rng))
 
 
 class BoardCase:
@@ -278,16 +289,25 @@ class BoardCase:
         self._A_freq = blk.A * self._d[:, None]
         self._f_a = frequencies_hz(lam_a[el])
 
+    def measure(self, kind: str, level_pct: float, rng) -> tuple:
+        """(omega,) or (omega, shapes) of the simulated test with ``level_pct`` % uniform noise
+        (eqs. 5.72-5.73) drawn from ``rng``."""
+        if kind not in self.kinds:
+            raise ValueError(f"equation type {kind!r}: choose one of {', '.join(self.kinds)}")
+        om = add_noise(self.omega_x, level_pct, rng)
+        return (om,) if kind == "freq" else (om, add_noise(self.phi_x, level_pct, rng))
+
+    def build(self, kind: str, data: tuple):
+        """Weighted (A, b) of equation type ``kind`` from test data (:meth:`measure`); the
+        frequency equations' A comes from the model alone (noise enters b only)."""
+        if kind == "freq":
+            return self._A_freq, self._d * (data[0] / (2 * np.pi) - self._f_a)
+        build = qms_equations if kind == "qms" else fbm_equations
+        return _weighted(build(self.K, self.M, *data, self.dKs, self.dMs, self.p_a))
+
     def equations(self, kind: str, level_pct: float, rng):
         """Weighted (A, b) from data with ``level_pct`` % uniform noise (eqs. 5.72-5.73)."""
-        om = add_noise(self.omega_x, level_pct, rng)
-        if kind == "freq":
-            return self._A_freq, self._d * (om / (2 * np.pi) - self._f_a)
-        if kind in ("qms", "fbm"):
-            build = qms_equations if kind == "qms" else fbm_equations
-            phi = add_noise(self.phi_x, level_pct, rng)
-            return _weighted(build(self.K, self.M, om, phi, self.dKs, self.dMs, self.p_a))
-        raise ValueError(f"equation type {kind!r}: choose one of {', '.join(self.kinds)}")
+        return self.build(kind, self.measure(kind, level_pct, rng))
 
 
 CASES = {"simulated_free_pcb": SimulatedFreePCB, "board": BoardCase}
@@ -300,14 +320,25 @@ def _init(case):
     _CASE = case
 
 
+#: redraws of the stated noise on a shot's data that measure its effect on A and b (TLS weight)
+NOISE_REDRAWS = 3
+
+
 def _run_batch(kind, level, shots, methods, seed, rank, case=None):
     case = _CASE if case is None else case
     rows = []
     for shot in shots:
-        rng = np.random.default_rng([seed, case.kinds.index(kind), int(round(level * 1e6)), shot])
-        A, b = compress(*case.equations(kind, level, rng))
+        key = [seed, case.kinds.index(kind), int(round(level * 1e6)), shot]
+        data = case.measure(kind, level, np.random.default_rng(key))
+        A, b = case.build(kind, data)
+        t_b = None
+        if "tls-qrf" in methods:
+            redraw = np.random.default_rng(key + [1])
+            t_b = tls_column_weight_from_noise(A, b, [
+                case.build(kind, tuple(add_noise(d, level, redraw) for d in data)) for _ in range(NOISE_REDRAWS)])
+        A, b = compress(A, b)
         for method in methods:
-            sel = localise(method, A, b, rank)
+            sel = localise(method, A, b, rank, t_b)
             rows.append({
                 "equations": kind, "level_pct": level, "shot": shot, "method": method,
                 "success_ratio": success_ratio(sel, case.true_errors), "n_detected": int(sel.size),

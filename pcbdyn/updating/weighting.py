@@ -41,3 +41,20 @@ def tls_column_weight(A, b, precision_ratio: float = 1.0) -> float:
     if nb == 0:
         raise ValueError("b is zero: nothing to update (the model already matches the data)")
     return precision_ratio * np.linalg.norm(A) / nb
+
+
+def tls_column_weight_from_noise(A, b, redraws) -> float | None:
+    """t_{n+1} of eq. 4.43 with the precision coefficients taken from the measurement noise
+    itself: ``redraws`` are equations (A_d, b_d) built again from the measured data with the
+    stated noise drawn once more (eqs. 5.72-5.74, a parametric bootstrap), so k_A ||A||_F and
+    k_b ||b|| are the observed error norms. TLS assumes errors of one size in every entry of
+    [A, t b]; the error of A is spread over its n columns, so b's column is scaled to carry the
+    error of one column of A: t = ||dA||_F / (sqrt(n) ||db||) (rms over the redraws). None when
+    A or b does not change (no noise, or equations whose A holds no measured data, where LS, not
+    TLS, is the model)."""
+    A, b = np.asarray(A), np.asarray(b)
+    dA = np.sqrt(np.mean([np.linalg.norm(np.asarray(Ad) - A) ** 2 for Ad, _ in redraws]))
+    db = np.sqrt(np.mean([np.linalg.norm(np.asarray(bd) - b) ** 2 for _, bd in redraws]))
+    if not (dA > 0 and db > 0):
+        return None
+    return float(dA / (np.sqrt(A.shape[1]) * db))
