@@ -100,6 +100,32 @@ class Layout:
                 out.append((name, inside))
         return out
 
+    @property
+    def element_size(self) -> float:
+        """Median length [m] of the shell cells' edges."""
+        e = _edges([c for _, c in self.cells()])
+        return float(np.median(np.linalg.norm(self.xy[e[:, 0]] - self.xy[e[:, 1]], axis=1)))
+
+    def line_cells(self, p0, p1, step: float):
+        """The straight line from ``p0`` to ``p1`` cut into pieces of at most ``step`` [m], each
+        piece's two ends located in the shell cells: (host nodes (n, 8), the ends' shape-function
+        weights (n, 2, 8), end points (n, 2, 2) [m]), as :mod:`..fe.elements.embedded_beam` takes
+        them; pieces with an end off the plate are left out."""
+        from ..fe.probe import locate
+
+        p0, p1 = np.asarray(p0, float), np.asarray(p1, float)
+        n = max(1, int(np.ceil(np.linalg.norm(p1 - p0) / step)))
+        t = np.linspace(0.0, 1.0, n + 1)[:, None]
+        xy = p0 + t * (p1 - p0)
+        z = float(np.mean(self.model.nodes[self.shell_nodes(), 2]))
+        loc = locate(self.model.nodes, [(self.model.sets[nm].etype, c) for nm, c in self.cells()],
+                     np.column_stack([xy, np.full(n + 1, z)]))
+        ok = loc.found[:-1] & loc.found[1:]
+        conn = np.hstack([loc.nodes[:-1], loc.nodes[1:]])[ok]
+        W = np.zeros((n, 2, 8))
+        W[:, 0, :4], W[:, 1, 4:] = loc.weights[:-1], loc.weights[1:]
+        return conn, W[ok], np.stack([xy[:-1], xy[1:]], axis=1)[ok]
+
     def node_path(self, p0, p1) -> np.ndarray:
         """The chain of shell nodes from the node nearest ``p0`` to the node nearest ``p1`` that
         follows the straight line between them (shortest path over element edges, each edge

@@ -15,7 +15,9 @@ whether what remains is noise, and otherwise find, place and size the effects th
    test, probability ``alpha``) the data lie in the range of the model (thesis section 5.2.3) and
    nothing is invented.
 4. Otherwise the catalogue's candidates are searched (:func:`.select.search`), the effects'
-   magnitudes estimated together with the declared parameters.
+   magnitudes estimated together with the declared parameters; runs along the sides are refined
+   (:func:`.select.refine`) and a mass with an inertia beside it refitted as one body
+   (:mod:`.bodies`).
 """
 
 from __future__ import annotations
@@ -29,6 +31,7 @@ from scipy.stats import chi2 as chi2_dist
 from ..board import build_model
 from ..fe.modal import solve_modes
 from ..fe.probe import model_probe
+from .bodies import as_bodies
 from .catalogue import generate
 from .layout import from_board
 from ..correlation.mac import mac
@@ -219,9 +222,13 @@ def diagnose(board, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_size=
     cands = generate(from_board(models.bms[0]), kinds, **options)
     say(f"searching {len(cands)} candidate effects")
     sel = search(res, cands, p0, models.bounds, max_effects=max_effects, shortlist=2, alpha=alpha, base=base)
-    if any(RUN.match(cands[i].name) for i in sel.chosen):
-        say("refining where the effects along the sides begin and end")
-        sel = refine(res, cands, sel, _run_neighbours(cands), models.bounds, alpha=alpha)
+    if any(_movable(cands[i]) for i in sel.chosen):
+        say("refining where the effects along the sides begin and end and where stiffeners run")
+        sel = refine(res, cands, sel, _local_moves(cands), models.bounds, alpha=alpha)
+    if {"point_mass", "point_inertia"} <= {cands[i].kind for i in sel.chosen}:
+        say("fitting a part found as a mass with an inertia beside it as one body")
+        sel = as_bodies(res, cands, sel, _neighbours([cands[i] for i in sel.chosen], MERGE_REACH * h),
+                        MERGE_REACH * h, models.bounds, alpha=alpha)
     stats.update(chi2_after=sel.chi2[-1], candidates=len(cands))
     for n, v in zip(names, sel.p):
         out["parameters"][n]["final"] = float(v)
@@ -241,26 +248,41 @@ def diagnose(board, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_size=
 
 #: the name of a candidate over a run of pieces of a side: "<kind>@<side>[i]" or "[i-j]"
 RUN = re.compile(r"^(?P<base>.+)\[(?P<i>\d+)(?:-(?P<j>\d+))?\]$")
+#: the name of a stiffener row or column: "stiffener@y=<value>mm" or "stiffener@x=<value>mm"
+LINE = re.compile(r"^(?P<base>.+@[xy])=(?P<v>[-0-9.e]+)mm$")
 
 
-def _run_neighbours(cands):
-    """neighbours(i): the candidates of the same kind and side as candidate i whose run of pieces
-    starts and ends at most one piece from its own (none for other candidates)."""
+def _movable(cand) -> bool:
+    """A candidate :func:`_local_moves` can move (a run of pieces of a side, a stiffener line)."""
+    return bool(RUN.match(cand.name) or LINE.match(cand.name))
+
+
+def _local_moves(cands):
+    """neighbours(i) for :func:`.select.refine`: the candidates of the same kind and side as
+    candidate i whose run of pieces starts and ends at most one piece from its own, or the
+    stiffener lines next to it in the same direction (none for other candidates)."""
     runs: dict = {}
+    lines: dict = {}
     for k, c in enumerate(cands):
         if m := RUN.match(c.name):
             i = int(m["i"])
             runs.setdefault(m["base"], {})[(i, int(m["j"] or i))] = k
+        elif m := LINE.match(c.name):
+            lines.setdefault(m["base"], []).append((float(m["v"]), k))
+    order = {b: [k for _, k in sorted(v)] for b, v in lines.items()}
 
     def neighbours(k):
-        m = RUN.match(cands[k].name)
-        if not m:
-            return []
-        i = int(m["i"])
-        j = int(m["j"] or i)
-        side = runs[m["base"]]
-        return [side[(a, b)] for a in (i - 1, i, i + 1) for b in (j - 1, j, j + 1)
-                if (a, b) != (i, j) and (a, b) in side]
+        if m := RUN.match(cands[k].name):
+            i = int(m["i"])
+            j = int(m["j"] or i)
+            side = runs[m["base"]]
+            return [side[(a, b)] for a in (i - 1, i, i + 1) for b in (j - 1, j, j + 1)
+                    if (a, b) != (i, j) and (a, b) in side]
+        if m := LINE.match(cands[k].name):
+            row = order[m["base"]]
+            at = row.index(k)
+            return [row[t] for t in (at - 1, at + 1) if 0 <= t < len(row)]
+        return []
 
     return neighbours
 

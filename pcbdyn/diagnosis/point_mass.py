@@ -2,8 +2,9 @@
 optional rotary inertia about the two in-plane axes as a second, separate parameter
 (``point_inertia``, reported as a point_mass). dM/dm puts 1 on the node's three translations;
 dM/dJ is the unit rotary inertia of a body moving with the cells around the node (the footprint
-of :func:`..fixtures.supports.mass_footprint`, as a board's [[masses]] entry of inertia alone);
-dK = 0 (thesis eq. 3.11 with k = i and dK = 0 gives d lambda_i / dm = -lambda_i |phi_i(node)|^2)."""
+of :func:`..fixtures.supports.mass_footprint`, as a board's [[masses]] entry of inertia alone).
+A candidate with ``data["radius"]`` is one half of a body (:mod:`.bodies`): its mass or inertia
+moves with the disc of that radius of gyration, as a [[masses]] entry with both. dK = 0 (thesis eq. 3.11 with k = i and dK = 0 gives d lambda_i / dm = -lambda_i |phi_i(node)|^2)."""
 
 from __future__ import annotations
 
@@ -11,7 +12,7 @@ import numpy as np
 
 from ..fe import MassProperty
 from ..fe.elements.discrete import mass_matrices
-from ..fixtures.supports import mass_footprint
+from ..fixtures.supports import disc_footprint, mass_footprint
 from .catalogue import Blocks, copy_model, node_candidates
 
 
@@ -26,28 +27,41 @@ class _Lumped:
     def generate(self, layout, spacing: float | None = None) -> list:
         return node_candidates(self.name, layout, spacing)
 
-    def _cell(self, model, node: int) -> np.ndarray:
-        if self.param == "mass":
-            return np.array([node])
+    def footprint(self, model, candidate) -> tuple:
+        """(cell nodes, sample weights or None) the candidate's body moves with: with
+        ``data["radius"]`` (a body of that radius of gyration centred at ``data["centre"]``,
+        :mod:`.bodies`) the disc of :func:`..fixtures.supports.disc_footprint`, for its mass and
+        its inertia alike; else its node for a mass and the cells around the node for an inertia."""
+        node = int(candidate.nodes[0])
+        radius = candidate.data.get("radius")
+        if radius is None and self.param == "mass":
+            return np.array([node]), None
         shells = [(s.etype, s.conn) for s in model.sets.values() if s.etype in ("quad4", "tri3")]
-        return mass_footprint(model.nodes, shells, node, 0.0, 1.0)[0]
+        if radius is None:
+            return mass_footprint(model.nodes, shells, node, 0.0, 1.0)[0], None
+        return disc_footprint(model.nodes, shells, candidate.data["centre"], float(radius))
 
-    def _property(self, value: float):
-        return MassProperty(value, (0.0, 0.0, 0.0)) if self.param == "mass" else MassProperty(0.0, (value, value, 0.0))
+    def _property(self, value: float, weights=None):
+        if self.param == "mass":
+            return MassProperty(value, (0.0, 0.0, 0.0), footprint=weights)
+        return MassProperty(0.0, (value, value, 0.0), footprint=weights)
 
     def blocks(self, model, candidates) -> list:
-        cells = [self._cell(model, int(c.nodes[0])) for c in candidates]
+        cells = [self.footprint(model, c) for c in candidates]
+        groups: dict = {}  # cells without sample weights share a block per size; a body has its own
+        for i, (conn, W) in enumerate(cells):
+            groups.setdefault(conn.size if W is None else -1 - i, []).append(i)
         out = []
-        for size in sorted({c.size for c in cells}):
-            idx = np.array([i for i, c in enumerate(cells) if c.size == size])
-            conn = np.array([cells[i] for i in idx])
-            Ke, Me = mass_matrices(model.nodes[conn], self._property(1.0))
-            out.append(Blocks(conn, Ke, Me, idx))
+        for _, idx in sorted(groups.items()):
+            conn = np.array([cells[i][0] for i in idx])
+            Ke, Me = mass_matrices(model.nodes[conn], self._property(1.0, cells[idx[0]][1]))
+            out.append(Blocks(conn, Ke, Me, np.array(idx)))
         return out
 
     def apply(self, model, candidate, value: float):
         m = copy_model(model)
-        m.add(f"effects.{candidate.name}", "mass", [self._cell(model, int(candidate.nodes[0]))], self._property(value))
+        conn, W = self.footprint(model, candidate)
+        m.add(f"effects.{candidate.name}", "mass", [conn], self._property(value, W))
         return m
 
 

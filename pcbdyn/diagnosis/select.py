@@ -170,13 +170,19 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
         new = estimate(res, fit.p, [candidates[i] for i in idx], fits[best].values, newton_steps, bounds)
         if not _worth(sel.chi2[-1], new.chi2, n, p0.size + len(idx), pen):
             break
-        idx, new = _prune(res, candidates, idx, new, newton_steps, bounds, pen, p0.size)
-        fit = new
-        sel.chosen, sel.values, sel.p, sel.state = idx, new.values, new.p, new.state
-        sel.cov = new.cov[p0.size:, p0.size:]
-        sel.sigma = np.sqrt(np.clip(np.diag(sel.cov), 0.0, None))
-        sel.chi2.append(new.chi2)
-        sel.criterion.append(new.chi2 + len(idx) * pen)
+        idx, fit = _prune(res, candidates, idx, new, newton_steps, bounds, pen, p0.size)
+        adopt(sel, idx, fit, pen)
+    return sel
+
+
+def adopt(sel: Selection, idx: list, fit: Fit, pen: float) -> Selection:
+    """``sel`` updated in place to the effects ``idx`` estimated by ``fit`` (one more step)."""
+    n_par = np.size(fit.p)
+    sel.chosen, sel.values, sel.p, sel.state = list(idx), fit.values, fit.p, fit.state
+    sel.cov = fit.cov[n_par:, n_par:]
+    sel.sigma = np.sqrt(np.clip(np.diag(sel.cov), 0.0, None))
+    sel.chi2.append(fit.chi2)
+    sel.criterion.append(fit.chi2 + len(idx) * pen)
     return sel
 
 
@@ -212,13 +218,7 @@ def refine(res, candidates, sel: Selection, neighbours, bounds=None, newton_step
                 idx, fit, improved = best[0], new, True
     if idx == list(sel.chosen):
         return sel
-    idx, fit = _prune(res, candidates, idx, fit, newton_steps, bounds, pen, n_par)
-    sel.chosen, sel.values, sel.p, sel.state = idx, fit.values, fit.p, fit.state
-    sel.cov = fit.cov[n_par:, n_par:]
-    sel.sigma = np.sqrt(np.clip(np.diag(sel.cov), 0.0, None))
-    sel.chi2.append(fit.chi2)
-    sel.criterion.append(fit.chi2 + len(idx) * pen)
-    return sel
+    return adopt(sel, *_prune(res, candidates, idx, fit, newton_steps, bounds, pen, n_par), pen)
 
 
 def _worth(chi2_before, chi2_after, n, k, pen) -> bool:

@@ -1,5 +1,8 @@
-"""``stiffener``: a rib along a straight path of nodes (a metal bar, a heat sink, a frame member
-bonded to the board), a beam whose axis is offset by (t + h) / 2 above the mid-surface.
+"""``stiffener``: a rib along a straight line (a metal bar, a heat sink, a frame member bonded to
+the board), a beam whose axis is offset by (t + h) / 2 above the mid-surface, embedded in the
+shell (:mod:`..fe.elements.embedded_beam`): its pieces, half an element long, end at points of
+the line inside the cells, so it runs straight whatever the mesh (a beam on a row of nodes of an unstructured mesh zig-zags,
+and a zig-zag rib is not the straight one the data come from).
 
 The parameter is its bending stiffness EI [N m^2] about the axis parallel to the board. To keep
 K and M linear in it, the rib has a fixed material and height h and only its width b varies
@@ -14,8 +17,9 @@ import numpy as np
 
 from ..board.effects import rib_property
 from ..board.spec import RibSection
+from ..fe import EmbeddedBeamProperty
 from ..fe.elements import kernel
-from .catalogue import Blocks, chain_candidate, copy_model
+from .catalogue import Blocks, Candidate, copy_model
 
 
 class _Stiffener:
@@ -30,7 +34,7 @@ class _Stiffener:
         self.section = section
 
     def generate(self, layout, path_spacing: float = 0.02) -> list:
-        """Full-span rows (along x) and columns (along y) of nodes every ``path_spacing`` [m]."""
+        """Full-span rows (along x) and columns (along y) every ``path_spacing`` [m]."""
         if not path_spacing > 0:
             raise ValueError(f"path_spacing must be > 0 m, got {path_spacing}")
         xy = layout.xy[layout.shell_nodes()]
@@ -41,30 +45,40 @@ class _Stiffener:
             for v in lo[axis] + (np.arange(n) + 0.5) * (hi[axis] - lo[axis]) / n:
                 p0, p1 = lo.copy(), hi.copy()
                 p0[axis] = p1[axis] = v
-                chain = layout.node_path(p0, p1)
-                if chain.size > 1:
-                    c = chain_candidate(self.name, layout, f"{label}={1e3 * v:.4g}mm", chain, key="path")
-                    c.data["thickness"] = layout.thickness
+                c = self.candidate(layout, f"{label}={1e3 * v:.4g}mm", p0, p1)
+                if c is not None:
                     out.append(c)
         return out
 
+    def candidate(self, layout, label: str, p0, p1):
+        """The rib along the straight line ``p0``-``p1`` [m] in pieces of half an element (None
+        where the line misses the plate)."""
+        conn, weights, ends = layout.line_cells(p0, p1, 0.5 * layout.element_size)
+        if not len(conn):
+            return None
+        pts = np.vstack([ends[:1, 0], ends[:, 1]])
+        length = float(np.linalg.norm(ends[:, 1] - ends[:, 0], axis=1).sum())
+        return Candidate(self.name, f"{self.name}@{label}", tuple(0.5 * (pts[0] + pts[-1])), np.unique(conn),
+                         {"path": pts[[0, -1]]},
+                         {"conn": conn, "weights": weights, "length": length, "thickness": layout.thickness})
+
+    def _property(self, value: float, candidate):
+        return EmbeddedBeamProperty(rib_property(value, candidate.data["thickness"], self.section),
+                                    candidate.data["weights"])
+
     def blocks(self, model, candidates) -> list:
         out = []
-        thick = np.array([c.data["thickness"] for c in candidates])
-        for t in np.unique(thick):  # one kernel call per plate thickness (it sets the offset)
-            ks = np.flatnonzero(thick == t)
-            edges = [candidates[k].data["edges"] for k in ks]
-            conn = np.concatenate(edges)
-            Ke, Me = kernel("beam2")(model.nodes[conn], rib_property(1.0, t, self.section))
-            out.append(Blocks(conn, Ke, Me, np.repeat(ks, [e.shape[0] for e in edges])))
+        for k, c in enumerate(candidates):
+            conn = c.data["conn"]
+            Ke, Me = kernel("embedded_beam2")(model.nodes[conn], self._property(1.0, c))
+            out.append(Blocks(conn, Ke, Me, np.full(len(conn), k)))
         return out
 
     def apply(self, model, candidate, value: float):
         if not value > 0:
             raise ValueError(f"{candidate.name}: a stiffener's EI must be > 0 N m^2, got {value}")
         m = copy_model(model)
-        m.add(f"effects.{candidate.name}", "beam2", candidate.data["edges"],
-              rib_property(value, candidate.data["thickness"], self.section))
+        m.add(f"effects.{candidate.name}", "embedded_beam2", candidate.data["conn"], self._property(value, candidate))
         return m
 
 

@@ -8,6 +8,7 @@ from .mesh import DOF_NAMES, NDOF, dof_index
 from .properties import (
     BeamProperty,
     EdgeSpringProperty,
+    EmbeddedBeamProperty,
     MassProperty,
     ShellProperty,
     SpringProperty,
@@ -20,6 +21,7 @@ __all__ = [
     "dof_index",
     "BeamProperty",
     "EdgeSpringProperty",
+    "EmbeddedBeamProperty",
     "MassProperty",
     "ShellProperty",
     "SpringProperty",

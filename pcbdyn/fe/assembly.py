@@ -118,7 +118,8 @@ def assemble(model, sets=None, props=None):
         npp = conn.shape[1] ** 2
         for a in range(0, conn.shape[0], CHUNK_CELLS):
             b = min(a + CHUNK_CELLS, conn.shape[0])
-            Ke, Me = kernel(es.etype)(model.nodes[conn[a:b]], prop)
+            part = prop.cells(a, b) if hasattr(prop, "cells") else prop  # per-cell data (EmbeddedBeamProperty)
+            Ke, Me = kernel(es.etype)(model.nodes[conn[a:b]], part)
             pending.append((slot[a * npp:b * npp], _node_blocks(Ke), _node_blocks(Me)))
             size += (b - a) * npp
             if size >= CHUNK_CELLS * 16:

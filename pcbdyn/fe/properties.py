@@ -116,3 +116,18 @@ class MassProperty:
     def inertia_matrix(self) -> np.ndarray:
         J = np.asarray(self.inertia, dtype=float)
         return np.diag(J) if J.ndim == 1 else J
+
+
+@dataclass(frozen=True)
+class EmbeddedBeamProperty:
+    """A ``beam`` section between two points inside host shell cells (element type
+    ``embedded_beam2``): ``weights`` (n_cells, 2, nodes_per_cell) interpolate each end's six DOFs
+    from the cell's nodes, so the beam moves with the shell it is tied to and can run straight
+    across a mesh whose node rows do not (a rib bonded along a line the mesh does not follow).
+    Per-cell data: :meth:`cells` gives the property of a slice of the set's cells."""
+
+    beam: BeamProperty
+    weights: object = field(compare=False)
+
+    def cells(self, a: int, b: int) -> "EmbeddedBeamProperty":
+        return EmbeddedBeamProperty(self.beam, np.asarray(self.weights)[a:b])

@@ -108,7 +108,7 @@ CASES = [
          drop_transducer=True, true_values=CARD_TRUE, seed=1,
          note="transducer left out; three configurations (53.2 g with rotary inertia at c2, c3)"),
     Case("pm_inertia", "card", (Effect("point_mass", 25e-3, at=(0.140, 0.150), declared=True),
-                                Effect("point_inertia", 2e-6, at=(0.140, 0.150), required=False, declared=True)),
+                                Effect("point_inertia", 2e-6, at=(0.140, 0.150), declared=True)),
          true_values=CARD_TRUE, seed=2, note="a 25 g part with rotary inertia (a relay, radius of gyration "
                                              "about 9 mm) away from the points"),
     Case("gs_standoff", "card", (Effect("ground_spring", 1.5e5, at=(0.081, 0.113)),), true_values=CARD_TRUE,
@@ -222,7 +222,7 @@ def _nearest(layout, xy) -> int:
 
 def candidate(layout, effect: Effect):
     """The candidate of ``effect`` on ``layout`` (the truth mesh)."""
-    from pcbdyn.diagnosis.catalogue import Candidate, chain_candidate
+    from pcbdyn.diagnosis.catalogue import Candidate, chain_candidate, kind
 
     k = effect.kind
     if k in ("point_mass", "point_inertia", "ground_spring"):
@@ -242,9 +242,8 @@ def candidate(layout, effect: Effect):
         assert score < 0.01 and chain.size > 1, f"{k}: segment {effect.segment} is not along a side"
         return chain_candidate(k, layout, f"{side}[hidden]", chain)
     if k == "stiffener":
-        chain = layout.node_path(np.asarray(effect.path[0]), np.asarray(effect.path[1]))
-        c = chain_candidate(k, layout, "hidden", chain, key="path")
-        c.data["thickness"] = layout.thickness
+        c = kind(k).candidate(layout, "hidden", np.asarray(effect.path[0]), np.asarray(effect.path[1]))
+        assert c is not None, f"{k}: path {effect.path} misses the plate"
         return c
     if k == "region_stiffness":
         from pcbdyn.diagnosis.region_stiffness import _candidate

@@ -134,33 +134,11 @@ def judge(case, truth: dict, data: dict) -> list:
 
 
 # ---------------------------------------------------------------------------------------- tests
-#: cases where diagnose misses the acceptance today, and why (strict: a fix turns them into passes)
-KNOWN = {
-    "pm_inertia": "the 25 g part (a [[masses]] body with rotary inertia in the truth board) is found within 1 mm "
-                  "(+1 %), but its rotary inertia is placed 11 mm away (-38 %) and the max frequency error after "
-                  "stays at 1.0 %: the inertia candidate acts through the cells around one node, the true body "
-                  "through its 9 mm radius of gyration",
-    "stiffener_row": "a stiffener is found 9 mm from the true row (EI -6 %) with two small effects beside it, "
-                     "and the max frequency error after stays at 1.5 %: the model's node rows zig-zag on the "
-                     "unstructured mesh, the true rib is straight",
-}
-
-
 def cases():
     """One parameter per case, both tests of a case on one xdist worker (the data are made once)."""
     out = []
     for c in bc.CASES:
         marks = [pytest.mark.xdist_group(c.name)]
-        out.append(pytest.param(c, marks=marks, id=c.name))
-    return out
-
-
-def diagnose_cases():
-    """:func:`cases`, the known misses expected to fail (strictly: a fix must remove them here)."""
-    out = []
-    for p in cases():
-        c = p.values[0]
-        marks = list(p.marks) + ([pytest.mark.xfail(strict=True, reason=KNOWN[c.name])] if c.name in KNOWN else [])
         out.append(pytest.param(c, marks=marks, id=c.name))
     return out
 
@@ -182,7 +160,7 @@ def test_bench_data(bench, case):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("case", diagnose_cases())
+@pytest.mark.parametrize("case", cases())
 def test_diagnose_bench(bench, case, tmp_path):
     """Acceptance per case (module docstring). The bench is physical too: the parameters-only fit
     leaves more than 2 % where the case says so (the effect matters), less than 1.5 % on noise-only

@@ -87,7 +87,7 @@ def test_refine_moves_a_segment_found_too_short_to_the_true_run(card):
     """A line mass over two pieces of a free side, first fitted on one of them: the local search
     on the run's ends (:func:`refine` with the pipeline's neighbours) moves it to the true run and
     recovers its mass."""
-    from pcbdyn.diagnosis.pipeline import RUN, _run_neighbours
+    from pcbdyn.diagnosis.pipeline import RUN, _local_moves
     from pcbdyn.diagnosis.residual import ModalResidual, Observation
     from pcbdyn.diagnosis.select import Selection, estimate, refine
 
@@ -100,7 +100,40 @@ def test_refine_moves_a_segment_found_too_short_to_the_true_run(card):
     fit = estimate(res, np.zeros(0), [cands[start]], [0.03], 8)
     assert fit.chi2 > 10.0  # the wrong run cannot explain the data
     sel = Selection(chosen=[start], values=fit.values, p=fit.p, chi2=[fit.chi2], state=fit.state)
-    sel = refine(res, cands, sel, _run_neighbours(cands))
+    sel = refine(res, cands, sel, _local_moves(cands))
     assert [cands[i].name for i in sel.chosen] == [cands[truth].name]
     assert sel.values[0] == pytest.approx(0.03, rel=1e-3)
     assert sel.chi2[-1] < 1e-3
+
+
+def test_a_mass_with_an_inertia_beside_it_is_refitted_as_one_body(card):
+    """A 40 g part of 10 mm radius of gyration centred between two nodes, first fitted as two mass
+    shares on those nodes and an inertia on the cells around one of them: :func:`as_bodies` makes
+    them one body, moving with its disc, placed where the data put it (the shares' centre is
+    0.8 mm off) and recovers m and J (the radius is a fixed point of the fit)."""
+    from pcbdyn.diagnosis.bodies import as_bodies
+    from pcbdyn.diagnosis.residual import ModalResidual, Observation
+    from pcbdyn.diagnosis.select import Selection, estimate, penalty
+    from pcbdyn.fixtures.supports import disc_footprint
+
+    m, cands = card
+    a, b = nearest(m, 0.09, 0.11), nearest(m, 0.09 + 0.16 / NX, 0.11)
+    centre = 0.5 * (m.nodes[a] + m.nodes[b])
+    shells = [(s.etype, s.conn) for s in m.sets.values() if s.etype == "quad4"]
+    conn, W = disc_footprint(m.nodes, shells, centre, 0.01)
+    truth = dg.catalogue.copy_model(m)
+    truth.add("part", "mass", [conn], MassProperty(0.04, (4e-6, 4e-6, 0.0), footprint=W))
+    f_test = solve_modes(truth, n_modes=N_MODES).frequencies
+    res = ModalResidual([Observation(None, f_test, np.full(N_MODES, SIGMA))], lambda p: [m])
+    by_name = {c.name: i for i, c in enumerate(cands)}
+    start = [by_name[f"point_mass@n{a}"], by_name[f"point_mass@n{b}"], by_name[f"point_inertia@n{a}"]]
+    fit = estimate(res, np.zeros(0), [cands[i] for i in start], [0.02, 0.02, 2e-6], 8)
+    sel = Selection(chosen=start, values=fit.values, p=fit.p, chi2=[fit.chi2], criterion=[fit.chi2 + 3 * penalty(N_MODES, len(cands))],
+                    state=fit.state)
+    cands = list(cands)
+    sel = as_bodies(res, cands, sel, [[0, 1], [2]], reach=2 * H)
+    assert [(cands[i].kind, cands[i].name.startswith("body@")) for i in sel.chosen] == [
+        ("point_mass", True), ("point_inertia", True)]
+    assert np.linalg.norm(np.subtract(cands[sel.chosen[0]].at, centre[:2])) < 2e-4
+    assert sel.values == pytest.approx([0.04, 4e-6], rel=0.005)
+    assert sel.chi2[-1] < 1e-2 * fit.chi2

@@ -146,10 +146,11 @@ def test_spring_and_mass_bad_input():
 
 @pytest.mark.parametrize("seed,sampled", [(None, False), (3, False), (4, True)])
 def test_footprint_mass_moves_with_the_rigid_motion_of_its_nodes(seed, sampled):
-    """A mass cell over a footprint (first node: the body), sampled at its nodes or at points
-    interpolated from them (weights summing to 1), carries exactly m under any rigid translation and
-    J about each axis under a rigid rotation about the body's point, whatever the footprint's
-    orientation in space; a motion of the nodes with no rigid part carries none."""
+    """A mass cell over a footprint, sampled at its nodes (the body at the first node) or at points
+    interpolated from them (weights summing to 1; the body at the first point, between nodes),
+    carries exactly m under any rigid translation and J about each axis under a rigid rotation
+    about the body's point, whatever the footprint's orientation in space; a motion of the nodes
+    with no rigid part carries none."""
     Q = np.eye(3) if seed is None else _rotation(seed)
     local = np.array([[0.0, 0.0, 0.0], [0.01, 0.0, 0.0], [-0.004, 0.009, 0.0], [0.003, -0.008, 0.0], [-0.01, -0.002, 0.0]])
     x0 = np.array([0.2, -0.1, 0.05])
@@ -163,7 +164,7 @@ def test_footprint_mass_moves_with_the_rigid_motion_of_its_nodes(seed, sampled):
     model.add("body", "mass", [list(range(5))], MassProperty(0.05, Jg, footprint=W))
     _, M = assemble(model)
     M = M.toarray()
-    r = model.nodes - x0
+    r = model.nodes - (x0 if W is None else W[0] @ model.nodes)
     for a in range(3):
         t = np.zeros((5, 6))
         t[:, a] = 1.0

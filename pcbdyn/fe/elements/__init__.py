@@ -12,6 +12,7 @@ KERNELS = {
     "quad4": ("shell_quad4", "matrices"),
     "tri3": ("shell_tri3", "matrices"),
     "beam2": ("beam", "matrices"),
+    "embedded_beam2": ("embedded_beam", "matrices"),
     "edge_spring": ("edge_spring", "matrices"),
 }
 

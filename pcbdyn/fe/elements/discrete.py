@@ -27,8 +27,9 @@ def spring_matrices(xyz: np.ndarray, prop):
 
 
 def mass_matrices(xyz: np.ndarray, prop):
-    """A rigid body of mass m and rotary inertia J at a cell's first node. A one-node cell carries
-    it on that node's six DOFs. A cell of three or more nodes (a footprint) moves the body with
+    """A rigid body of mass m and rotary inertia J at a cell's first node, or at the first sample
+    point of ``prop.footprint``. A one-node cell carries it on that node's six DOFs. A cell of
+    three or more nodes (a footprint) moves the body with
     the least-squares rigid motion of the translations of points sampling the footprint (the nodes
     themselves, or ``prop.footprint``'s interpolation weights), as an RBE3 link that adds no
     stiffness: u_s = u_b + theta_b x r_s, so M = G^T diag(m, m, m, J) G with G the pseudo-inverse of
@@ -48,7 +49,8 @@ def mass_matrices(xyz: np.ndarray, prop):
     if W.ndim != 2 or W.shape[1] != nn:
         raise ModelError(f"MassProperty.footprint must be (n_samples, {nn}) weights of the cell's nodes, got {W.shape}")
     ns = W.shape[0]
-    r = np.einsum("sn,cnk->csk", W, xyz) - xyz[:, :1, :]
+    samples = np.einsum("sn,cnk->csk", W, xyz)
+    r = samples - samples[:, :1, :]
     A = np.zeros((n_cells, ns, 3, 6))
     A[:, :, :, :3] = np.eye(3)
     A[:, :, 0, 4], A[:, :, 0, 5] = r[..., 2], -r[..., 1]  # u = u_b + theta_y z - theta_z y
