@@ -123,3 +123,17 @@ def measured_configurations(board, test_uff, extras) -> list:
                              "[[configurations]]")
         data.append((name, MeasuredModes.from_test(load_test_modes(path))))
     return data
+
+
+def parse_noise(text):
+    """'f=0.2,shape=2' -> (frequency %, shape %), None where not given (or 0)."""
+    from ..testdata.noise import Noise
+
+    if text is None:
+        return None, None
+    try:
+        n = Noise.parse(text)
+    except ValueError as exc:
+        raise click.BadParameter(f"{exc}; e.g. --noise f=0.2,shape=2 (percent, uniform bounds)",
+                                 param_hint="--noise") from None
+    return n.frequency_pct or None, n.shape_pct or None

@@ -14,21 +14,7 @@ from pathlib import Path
 
 import click
 
-from .common import done, fail, measured_configurations, step
-
-
-def parse_noise(text):
-    """'f=0.2,shape=2' -> (frequency %, shape %), None where not given (or 0)."""
-    from ..testdata.noise import Noise
-
-    if text is None:
-        return None, None
-    try:
-        n = Noise.parse(text)
-    except ValueError as exc:
-        raise click.BadParameter(f"{exc}; e.g. --noise f=0.2,shape=2 (percent, uniform bounds)",
-                                 param_hint="--noise") from None
-    return n.frequency_pct or None, n.shape_pct or None
+from .common import done, fail, measured_configurations, parse_noise, step
 
 
 @click.command("diagnose")

@@ -199,3 +199,14 @@ def tls_qrf(
         retained=retained, solution=solution, rank_Ab=rank_Ab, out_of_range=out, explains_data=explains,
         message=msg,
     )
+
+
+def noise_out_of_range(A, b, redraws) -> float:
+    """The part of b's noise outside range(A), relative to ||b|| (rms over ``redraws``, equations
+    rebuilt with the stated noise drawn again): what the 5.2.3 check must tolerate before it
+    says the parameters cannot explain the data."""
+    A, b = np.asarray(A, float), np.asarray(b, float)
+    U = np.linalg.svd(A, full_matrices=False)[0]
+    out = [np.asarray(bd, float) - b for _, bd in redraws]
+    out = [d - U @ (U.T @ d) for d in out]
+    return float(np.sqrt(np.mean([d @ d for d in out])) / np.linalg.norm(b))

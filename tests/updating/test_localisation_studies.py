@@ -158,24 +158,36 @@ def test_study_command(tmp_path):
 CARD = Path(__file__).resolve().parents[2] / "examples" / "six_part_card"
 
 
-def test_localize_command_finds_the_thicker_pgas(tmp_path):
-    """The six-part card whose two PGAs are 4.5 mm instead of the model's 3.5 mm: from a
-    noise-free simulated test, TLS/QR-F (QMS) selects t_PGA alone with a thickening, and the FBM
-    map peaks inside a PGA footprint (40 x 40 mm at (40.5, 38.14) and (94.5, 139.86) mm)."""
+def _thicker_pgas(tmp_path, extra: str = ""):
+    """model.toml (the card) and true.toml (its two PGAs 4.5 mm instead of 3.5 mm, no parameters,
+    ``extra`` TOML appended) in ``tmp_path``."""
     import re
-
-    from pcbdyn.cli import main
 
     text = (CARD / "board.toml").read_text()
     (tmp_path / "model.toml").write_text(text)
     for ref in ("U1", "U6"):
         text, n = re.subn(rf'(ref = "{ref}"\npackage = "PGA"\nat = \[[^\]]*\]\n)', r'\1thickness = "4.5 mm"\n', text)
         assert n == 1
-    (tmp_path / "true.toml").write_text(re.sub(r"\[\[parameters\]\]\n(?:.+\n)+\n?", "", text))
-    run = CliRunner().invoke
-    res = run(main, ["simulate-test", str(tmp_path / "true.toml"), "--points", str(CARD / "points.csv"),
-                     "--excite", "135,63.57", "--df", "5", "--out", str(tmp_path / "true.uff")])
+    (tmp_path / "true.toml").write_text(re.sub(r"\[\[parameters\]\]\n(?:.+\n)+\n?", "", text) + extra)
+
+
+def _simulate(tmp_path, name, *noise):
+    from pcbdyn.cli import main
+
+    res = CliRunner().invoke(main, ["simulate-test", str(tmp_path / "true.toml"), "--points", str(CARD / "points.csv"),
+                                    "--excite", "135,63.57", "--df", "5", *noise, "--out", str(tmp_path / name)])
     assert res.exit_code == 0, res.output
+
+
+def test_localize_command_finds_the_thicker_pgas(tmp_path):
+    """The six-part card whose two PGAs are 4.5 mm instead of the model's 3.5 mm: from a
+    noise-free simulated test, TLS/QR-F (QMS) selects t_PGA alone with a thickening, and the FBM
+    map peaks inside a PGA footprint (40 x 40 mm at (40.5, 38.14) and (94.5, 139.86) mm)."""
+    from pcbdyn.cli import main
+
+    _thicker_pgas(tmp_path)
+    _simulate(tmp_path, "true.uff")
+    run = CliRunner().invoke
     res = run(main, ["localize", str(tmp_path / "model.toml"), str(tmp_path / "true.uff"), "--out",
                      str(tmp_path / "loc"), "--json", str(tmp_path / "loc.json")])
     assert res.exit_code == 0, res.output
@@ -190,6 +202,32 @@ def test_localize_command_finds_the_thicker_pgas(tmp_path):
     res = run(main, ["localize", str(tmp_path / "model.toml"), str(tmp_path / "true.uff"),
                      f"c9={tmp_path / 'true.uff'}"])
     assert res.exit_code == 2 and "c9" in res.output
+
+
+def test_localize_with_the_stated_noise_tells_noise_from_a_missing_effect(tmp_path):
+    """2 % shape noise (eq. 5.73) leaves a quarter of b outside range(A): without the noise stated
+    the 5.2.3 check cries wolf; with ``--noise`` b is weighted for TLS by the errors that noise
+    makes and judged against them, so the thicker PGAs are explained (t_PGA alone), while a 30 g
+    mass the model lacks still is not."""
+    from pcbdyn.cli import main
+
+    noise = ("--noise", "f=0.2,shape=2")
+    _thicker_pgas(tmp_path, '\n[[masses]]\nname = "hidden"\nat = ["120 mm", "150 mm"]\nmass = "30 g"\n')
+    _simulate(tmp_path, "mass.uff", *noise, "--seed", "1")
+    _thicker_pgas(tmp_path)
+    _simulate(tmp_path, "noisy.uff", *noise, "--seed", "1")
+    out = {}
+    for name, stated in (("noisy", ()), ("noisy", noise), ("mass", noise)):
+        js = tmp_path / f"{name}{len(stated)}.json"
+        res = CliRunner().invoke(main, ["localize", str(tmp_path / "model.toml"), str(tmp_path / f"{name}.uff"), *stated,
+                                        "--json", str(js)])
+        assert res.exit_code == 0, res.output
+        out[name, bool(stated)] = json.loads(js.read_text())
+    plain, stated, lacking = out["noisy", False], out["noisy", True], out["mass", True]
+    assert plain["tls_weight"] is None and not plain["explains_data"]
+    assert stated["tls_weight"] > 0 and stated["explains_data"] and stated["selected"] == ["t_PGA"]
+    assert stated["out_of_range_pct"] == pytest.approx(plain["out_of_range_pct"])
+    assert not lacking["explains_data"] and lacking["out_of_range_pct"] > 2 * lacking["explain_tol_pct"]
 
 
 def test_board_study_command(tmp_path):
