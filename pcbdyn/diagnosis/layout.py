@@ -106,25 +106,44 @@ class Layout:
         e = _edges([c for _, c in self.cells()])
         return float(np.median(np.linalg.norm(self.xy[e[:, 0]] - self.xy[e[:, 1]], axis=1)))
 
-    def line_cells(self, p0, p1, step: float):
-        """The straight line from ``p0`` to ``p1`` cut into pieces of at most ``step`` [m], each
-        piece's two ends located in the shell cells: (host nodes (n, 8), the ends' shape-function
-        weights (n, 2, 8), end points (n, 2, 2) [m]), as :mod:`..fe.elements.embedded_beam` takes
-        them; pieces with an end off the plate are left out."""
+    def line_cells(self, p0, p1):
+        """The straight line from ``p0`` to ``p1`` cut where it crosses the shell cells' edges or
+        passes a node (each piece within one cell), the pieces' ends located in the cells: (host
+        nodes (n, 8), the ends' shape-function weights (n, 2, 8), end points (n, 2, 2) [m]), as
+        :mod:`..fe.elements.embedded_beam` takes them. Along a row of nodes the pieces end on the
+        nodes (a beam on that row). Pieces off the plate are left out."""
         from ..fe.probe import locate
 
         p0, p1 = np.asarray(p0, float), np.asarray(p1, float)
-        n = max(1, int(np.ceil(np.linalg.norm(p1 - p0) / step)))
-        t = np.linspace(0.0, 1.0, n + 1)[:, None]
-        xy = p0 + t * (p1 - p0)
-        z = float(np.mean(self.model.nodes[self.shell_nodes(), 2]))
-        loc = locate(self.model.nodes, [(self.model.sets[nm].etype, c) for nm, c in self.cells()],
-                     np.column_stack([xy, np.full(n + 1, z)]))
-        ok = loc.found[:-1] & loc.found[1:]
-        conn = np.hstack([loc.nodes[:-1], loc.nodes[1:]])[ok]
-        W = np.zeros((n, 2, 8))
+        d = p1 - p0
+        L2 = float(d @ d)
+        xy = self.xy
+        e = _edges([c for _, c in self.cells()])
+        a, u = xy[e[:, 0]], xy[e[:, 1]] - xy[e[:, 0]]
+        den = d[0] * u[:, 1] - d[1] * u[:, 0]
+        w = a - p0
+        ok = np.abs(den) > 1e-12 * np.sqrt(L2) * np.linalg.norm(u, axis=1)
+        den = np.where(ok, den, 1.0)
+        t = (w[:, 0] * u[:, 1] - w[:, 1] * u[:, 0]) / den
+        sgm = (w[:, 0] * d[1] - w[:, 1] * d[0]) / den
+        crossing = t[ok & (sgm >= 0) & (sgm <= 1)]
+        nodes = self.shell_nodes()
+        r = xy[nodes] - p0
+        on_line = np.abs(r[:, 0] * d[1] - r[:, 1] * d[0]) / np.sqrt(L2) < 1e-6 * self.element_size
+        ts = np.sort(np.r_[0.0, 1.0, crossing, (r[on_line] @ d) / L2])
+        ts = ts[(ts >= 0) & (ts <= 1)]
+        ts = ts[np.r_[True, np.diff(ts) > 1e-9]]
+        pts = p0 + ts[:, None] * d
+        z = float(np.mean(self.model.nodes[nodes, 2]))
+        mids = 0.5 * (pts[:-1] + pts[1:])
+        cells = [(self.model.sets[nm].etype, c) for nm, c in self.cells()]
+        loc = locate(self.model.nodes, cells, np.column_stack([pts, np.full(len(pts), z)]))
+        inside = locate(self.model.nodes, cells, np.column_stack([mids, np.full(len(mids), z)])).found
+        keep = loc.found[:-1] & loc.found[1:] & inside
+        conn = np.hstack([loc.nodes[:-1], loc.nodes[1:]])[keep]
+        W = np.zeros((len(mids), 2, 8))
         W[:, 0, :4], W[:, 1, 4:] = loc.weights[:-1], loc.weights[1:]
-        return conn, W[ok], np.stack([xy[:-1], xy[1:]], axis=1)[ok]
+        return conn, W[keep], np.stack([pts[:-1], pts[1:]], axis=1)[keep]
 
     def node_path(self, p0, p1) -> np.ndarray:
         """The chain of shell nodes from the node nearest ``p0`` to the node nearest ``p1`` that

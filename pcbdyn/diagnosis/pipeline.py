@@ -90,14 +90,13 @@ def _noise_sigmas(ob: Observation, freq_pct, shape_pct, basis_shapes):
 RESOLVED_SHAPE_CHANGE = 0.02
 
 
-def _discretisation(board, config, mesh_size, p_values, ob, coarse_state):
+def _discretisation(fine, ob, coarse_state):
     """(frequency correction factor, its relative uncertainty, relative shape error, resolved) per
-    paired mode, from the model meshed twice as fine (fine modes paired by MAC at the points). A resolved
+    paired mode, from ``fine``, the model meshed twice as fine (its modes paired by MAC at the points). A resolved
     mode (:data:`RESOLVED_SHAPE_CHANGE`) is corrected by Richardson extrapolation of an O(h^2)
     element, f_0 = f_h/2 + (f_h/2 - f_h) / 3, whose own error (a third of the step) stays as noise;
     any other mode (not yet in the asymptotic range, or no shapes to tell) takes the finer mesh's
     frequency, the whole step counted as noise."""
-    fine = build_model(board, config, mesh_size / 2.0, shared_mesh=True).with_parameters(p_values).model
     modes = solve_modes(fine, n_modes=int(coarse_state.pairs.max()) + 4)
     if ob.shapes is None:
         k = np.minimum(coarse_state.pairs, modes.frequencies.size - 1)
@@ -160,7 +159,9 @@ def _set_noise(board, models, h, obs, state, freq_pct, shape_pct) -> list:
             wide = solve_modes(cs.model, n_modes=ob.shapes.shape[0] // 2)
             basis = np.asarray(ob.read @ np.column_stack([wide.rigid_shapes, wide.shapes]))
         sf, ss = _noise_sigmas(ob, freq_pct, shape_pct, basis)
-        ob.f_scale, df, ds, ok = _discretisation(board, ob.name, h, dict(zip(models.names, models.p0.tolist())), ob, cs)
+        fine = build_model(board, ob.name, h / 2.0, shared_mesh=True).with_parameters(
+            dict(zip(models.names, models.p0.tolist()))).model
+        ob.f_scale, df, ds, ok = _discretisation(fine, ob, cs)
         ob.sigma_f = np.sqrt(sf**2 + df**2)
         ob.sigma_s = None if ss is None else np.sqrt(ss**2 + ds**2)
         resolved.append(ok.tolist())

@@ -95,8 +95,9 @@ class _RegionStiffness:
         for tag, size, shift in (("", patch, 0.0), ("2x", 2 * patch, 0.0), ("2x+", 2 * patch, 0.5)):
             n = np.maximum(1, np.round((hi - lo) / size)).astype(int)
             step = (hi - lo) / n
-            gx = lo[0] + step[0] * (np.arange(n[0] + 1 + (shift > 0)) - shift)
-            gy = lo[1] + step[1] * (np.arange(n[1] + 1 + (shift > 0)) - shift)
+            # shifted patches are cut at the plate's edges (an enriched board holds its regions inside the outline)
+            gx = np.clip(lo[0] + step[0] * (np.arange(n[0] + 1 + (shift > 0)) - shift), lo[0], hi[0])
+            gy = np.clip(lo[1] + step[1] * (np.arange(n[1] + 1 + (shift > 0)) - shift), lo[1], hi[1])
             polys += [(f"patch{tag}[{i},{j}]", [[gx[i], gy[j]], [gx[i + 1], gy[j]], [gx[i + 1], gy[j + 1]],
                                                 [gx[i], gy[j + 1]]])
                       for j in range(gy.size - 1) for i in range(gx.size - 1)]

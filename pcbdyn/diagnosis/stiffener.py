@@ -1,8 +1,9 @@
 """``stiffener``: a rib along a straight line (a metal bar, a heat sink, a frame member bonded to
 the board), a beam whose axis is offset by (t + h) / 2 above the mid-surface, embedded in the
-shell (:mod:`..fe.elements.embedded_beam`): its pieces, half an element long, end at points of
-the line inside the cells, so it runs straight whatever the mesh (a beam on a row of nodes of an unstructured mesh zig-zags,
-and a zig-zag rib is not the straight one the data come from).
+shell (:mod:`..fe.elements.embedded_beam`): its pieces end where the line crosses the cells'
+edges, so it runs straight whatever the mesh: a beam on a row of nodes of an unstructured mesh
+zig-zags, and a zig-zag rib is not the straight one the data come from (where a row of nodes does
+follow the line, the pieces end on its nodes: a beam on that row).
 
 The parameter is its bending stiffness EI [N m^2] about the axis parallel to the board. To keep
 K and M linear in it, the rib has a fixed material and height h and only its width b varies
@@ -51,9 +52,8 @@ class _Stiffener:
         return out
 
     def candidate(self, layout, label: str, p0, p1):
-        """The rib along the straight line ``p0``-``p1`` [m] in pieces of half an element (None
-        where the line misses the plate)."""
-        conn, weights, ends = layout.line_cells(p0, p1, 0.5 * layout.element_size)
+        """The rib along the straight line ``p0``-``p1`` [m] (None where it misses the plate)."""
+        conn, weights, ends = layout.line_cells(p0, p1)
         if not len(conn):
             return None
         pts = np.vstack([ends[:1, 0], ends[:, 1]])

@@ -108,13 +108,12 @@ def same_mesh_diagnosis(bmE, kind, effect):
     for s in [s for s in base.sets if s == prefix or s.startswith(prefix + ".")]:
         del base.sets[s]
     pts = np.asarray(effect["path" if kind == "stiffener" else "segment"])
+    layout = dg.from_model(base, thickness=bd.thickness)
+    if kind == "stiffener":  # a straight rib, embedded: on the board's mesh line its pieces end on the nodes
+        return base, dg.kind(kind).candidate(layout, "c", pts[0], pts[-1])
     pieces = [bmE.mesh.chain_on_segment(a, b) for a, b in zip(pts[:-1], pts[1:])]
     chain = np.concatenate([pieces[0]] + [p[1:] for p in pieces[1:]])
-    layout = dg.from_model(base, thickness=bd.thickness)
-    c = chain_candidate(kind, layout, "c", chain, key="path" if kind == "stiffener" else "segment")
-    if kind == "stiffener":
-        c.data["thickness"] = bd.thickness
-    return base, c
+    return base, chain_candidate(kind, layout, "c", chain, key="segment")
 
 
 @pytest.mark.parametrize("kind", list(CASES))
@@ -139,9 +138,11 @@ def test_enriched_board_is_the_diagnosed_model(base, tmp_path, kind):
     assert np.max(np.abs(fE / f_baseE - 1)) > 1e-3  # the effect does something
 
     # across meshes: the diagnosed model on the original mesh, within the meshes' own difference
+    # (a stiffener crossing the original mesh's cells, embedded, is up to 2.5 % stiffer than on a
+    # mesh line: tests/fe/test_rib.py)
     mesh_diff = np.max(np.abs(f_baseE / f0 - 1))
     assert mesh_diff < 0.03
-    assert np.max(np.abs(fE / f_diag - 1)) < 2 * mesh_diff + 2e-3
+    assert np.max(np.abs(fE / f_diag - 1)) < 2 * mesh_diff + 2e-3 + (0.025 if kind == "stiffener" else 0.0)
     if kind in ("point_mass", "line_mass"):
         assert bmE.mass() == pytest.approx(bm0.mass() + value, rel=1e-10)
         assert bmE.mass() == pytest.approx(total_mass(diagnosed), rel=1e-10)

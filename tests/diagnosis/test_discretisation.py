@@ -34,7 +34,8 @@ def correction(board, config, reference_mesh):
                      model_probe(models.bms[0].model, xyz, dirs, tol=0.02).P, np.full(N_MODES, 0.01), xyz, dirs)
     state = models.residual([ob]).evaluate(models.p0).configs[0]
     p = dict(zip(models.names, models.p0.tolist()))
-    scale, sigma, _, resolved = _discretisation(board, config, board.mesh_size, p, ob, state)
+    fine = build_model(board, config, board.mesh_size / 2.0, shared_mesh=True).with_parameters(p).model
+    scale, sigma, _, resolved = _discretisation(fine, ob, state)
     return state.f_a, scale, sigma, resolved, rm.frequencies
 
 
