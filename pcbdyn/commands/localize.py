@@ -29,12 +29,12 @@ def evidence(method, A, b, names, rank=None, alpha=0.8, redraws=()) -> tuple:
     the noise makes (else eq. 4.43 with k_A = k_b) and b counts as explained up to the part of
     those errors outside range(A)."""
     from ..updating.study import localise
-    from ..updating.subset import EXPLAIN_TOL, noise_out_of_range, tls_qrf
+    from ..updating.subset import EXPLAIN_TOL, explain_tol_from_noise, tls_qrf
     from ..updating.weighting import tls_column_weight_from_noise
 
     r = None if rank is None else (rank if rank >= 0 else A.shape[1] + rank)
     t_b = tls_column_weight_from_noise(A, b, redraws) if redraws else None
-    tol = max(EXPLAIN_TOL, 2.0 * noise_out_of_range(A, b, redraws)) if redraws else EXPLAIN_TOL
+    tol = explain_tol_from_noise(A, b, redraws) if redraws else EXPLAIN_TOL
     tls = tls_qrf(A, b, rank=r, alpha=alpha, t_b=t_b, explain_tol=tol)
     if method == "tls-qrf":
         sel, order, ratios = tls.selected, tls.order, tls.descending_ratio
@@ -68,8 +68,8 @@ def noise_redraws(problem, tests, eq_type, matching, shape, freq_pct, shape_pct,
 
     from ..updating.board_problem import config_pairing
     from ..updating.iteration import build_equations
-    from ..updating.study import NOISE_REDRAWS
     from ..updating.success import add_noise
+    from ..updating.weighting import NOISE_REDRAWS
 
     rng = np.random.default_rng(seed)
     redraws = []

@@ -5,8 +5,7 @@ builds the model that was fitted).
 
 Forward selection finds the two separately, the inertia on the cells around some node nearby
 (where a body that wide would act on the plate's slope), the mass often as shares on the nodes
-around it. Here the
-pair becomes two candidates at the mass shares' centre with the footprint of radius r
+around it. Here the pair becomes two candidates at the mass shares' centre with the footprint of radius r
 (:mod:`.point_mass`); r depends on the magnitudes, so the fit is repeated with r updated until it
 settles (a fixed point; each fit is linear in m and J at fixed r), and the centre is moved to
 where the data put it. The body replaces the pair when it lowers the information criterion of
@@ -19,16 +18,11 @@ from dataclasses import replace
 
 import numpy as np
 
+from .catalogue import weighted_centre
 from .select import ALPHA, RANK_STEPS, adopt, estimate, penalty
 
 #: fixed-point iterations on the radius of gyration, and the relative change that ends them
 RADIUS_ITERATIONS, RADIUS_TOL = 5, 0.02
-
-
-def _centre(chosen, values, group) -> np.ndarray:
-    w = np.abs(np.asarray(values, float)[group])
-    pts = np.array([chosen[k].at for k in group], float)
-    return (w[:, None] * pts).sum(0) / w.sum() if w.sum() > 0 else pts.mean(0)
 
 
 def _body(home, centre, radius: float) -> tuple:
@@ -49,9 +43,12 @@ def _pairs(candidates, sel, groups, reach: float) -> list:
     chosen = [candidates[i] for i in sel.chosen]
     inertias = [g for g in groups if chosen[g[0]].kind == "point_inertia"]
     out = []
+    def centre(group):
+        return weighted_centre([chosen[k] for k in group], np.asarray(sel.values)[group])
+
     for gm in (g for g in groups if chosen[g[0]].kind == "point_mass"):
-        c = _centre(chosen, sel.values, gm)
-        near = [(float(np.linalg.norm(_centre(chosen, sel.values, gj) - c)), gj) for gj in inertias]
+        c = centre(gm)
+        near = [(float(np.linalg.norm(centre(gj) - c)), gj) for gj in inertias]
         near = [t for t in near if t[0] <= reach]
         if near:
             gj = min(near, key=lambda t: t[0])[1]

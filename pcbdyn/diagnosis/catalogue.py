@@ -211,12 +211,20 @@ def node_candidates(kind_name: str, layout, spacing: float | None = None) -> lis
                       prime=int(n) in prime) for n in nodes]
 
 
-def chain_candidate(kind_name: str, layout, label: str, chain: np.ndarray, key: str = "segment") -> Candidate:
-    """A candidate along a node chain (a boundary segment or a stiffener path); ``at`` is the
-    point of the chain halfway along its length."""
+def weighted_centre(candidates, values) -> np.ndarray:
+    """The magnitude-weighted centre (x, y) [m] of the candidates' points (their mean where the
+    magnitudes do not add up to a positive total): where shares of one effect put it."""
+    v = np.asarray(values, float)
+    xy = np.array([c.at for c in candidates], float)
+    w = v / v.sum() if v.sum() > 0 else np.full(v.size, 1.0 / v.size)
+    return w @ xy
+
+
+def chain_candidate(kind_name: str, layout, label: str, chain: np.ndarray) -> Candidate:
+    """A candidate along a node chain of a boundary segment; ``at`` is the point of the chain
+    halfway along its length."""
     p = layout.xy[chain]
     s = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))]
     mid = np.array([np.interp(0.5 * s[-1], s, p[:, 0]), np.interp(0.5 * s[-1], s, p[:, 1])])
-    geometry = {key: p[[0, -1]]} if key == "segment" else {key: p}
-    return Candidate(kind_name, f"{kind_name}@{label}", tuple(mid), chain, geometry,
+    return Candidate(kind_name, f"{kind_name}@{label}", tuple(mid), chain, {"segment": p[[0, -1]]},
                      {"edges": np.column_stack([chain[:-1], chain[1:]]), "length": float(s[-1])})

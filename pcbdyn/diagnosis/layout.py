@@ -4,7 +4,7 @@ boundary sides and support lines, prime-suspect points and part footprints.
 A :class:`Layout` is made from any ``fe.Model`` (:func:`from_model`) or from a board model
 (:func:`from_board`, which adds the measurement points and declared masses as prime suspects and
 the part footprints as regions). Candidate generators (the catalogue's plugins) only ask it
-geometric questions: grid nodes, boundary segments, cells inside a polygon, node paths.
+geometric questions: grid nodes, boundary segments, cells inside a polygon, the cells a line crosses.
 """
 
 from __future__ import annotations
@@ -12,9 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse as sp
 from matplotlib.path import Path as PolyPath
-from scipy.sparse.csgraph import dijkstra
 from scipy.spatial import cKDTree
 
 SHELLS = ("quad4", "tri3")
@@ -144,29 +142,6 @@ class Layout:
         W = np.zeros((len(mids), 2, 8))
         W[:, 0, :4], W[:, 1, 4:] = loc.weights[:-1], loc.weights[1:]
         return conn, W[keep], np.stack([pts[:-1], pts[1:]], axis=1)[keep]
-
-    def node_path(self, p0, p1) -> np.ndarray:
-        """The chain of shell nodes from the node nearest ``p0`` to the node nearest ``p1`` that
-        follows the straight line between them (shortest path over element edges, each edge
-        weighted by its length plus four times its midpoint's distance from the line)."""
-        nodes = self.shell_nodes()
-        xy = self.xy
-        a = nodes[np.linalg.norm(xy[nodes] - p0, axis=1).argmin()]
-        b = nodes[np.linalg.norm(xy[nodes] - p1, axis=1).argmin()]
-        e = _edges([c for _, c in self.cells()])
-        u = (xy[b] - xy[a]) / max(np.linalg.norm(xy[b] - xy[a]), 1e-300)
-        mid = 0.5 * (xy[e[:, 0]] + xy[e[:, 1]]) - xy[a]
-        off = np.abs(mid[:, 0] * u[1] - mid[:, 1] * u[0])
-        w = np.linalg.norm(xy[e[:, 0]] - xy[e[:, 1]], axis=1) + 4.0 * off
-        n = xy.shape[0]
-        G = sp.coo_matrix((np.r_[w, w], (np.r_[e[:, 0], e[:, 1]], np.r_[e[:, 1], e[:, 0]])), shape=(n, n)).tocsr()
-        _, pred = dijkstra(G, indices=a, return_predecessors=True)
-        path = [b]
-        while path[-1] != a:
-            if pred[path[-1]] < 0:
-                raise ValueError("no mesh path between the two points (the plate is not connected there)")
-            path.append(pred[path[-1]])
-        return np.array(path[::-1], dtype=np.int64)
 
 
 def _edges(conns) -> np.ndarray:

@@ -32,7 +32,7 @@ from ..board import build_model
 from ..fe.modal import solve_modes
 from ..fe.probe import model_probe
 from .bodies import as_bodies
-from .catalogue import generate
+from .catalogue import generate, weighted_centre
 from .layout import from_board
 from ..correlation.mac import mac
 from .residual import ModalResidual, Observation, paired_mac
@@ -346,12 +346,10 @@ def _merged(chosen, values, cov, group) -> dict:
     d = c.describe()
     v = np.asarray(values, float)[group]
     if len(group) > 1:
-        xy = np.array([chosen[k].at for k in group])
-        w = v / v.sum() if v.sum() > 0 else np.full(v.size, 1.0 / v.size)
         if not lines:
-            d["at_mm"] = np.round(1e3 * (w @ xy), 3).tolist()
+            d["at_mm"] = np.round(1e3 * weighted_centre([chosen[k] for k in group], v), 3).tolist()
         d["name"] = "+".join(chosen[k].name for k in group)
-        d["merged_at_mm"] = np.round(1e3 * xy, 3).tolist()
+        d["merged_at_mm"] = np.round(1e3 * np.array([chosen[k].at for k in group]), 3).tolist()
     var = float(np.sum(cov[np.ix_(group, group)])) if cov.size else 0.0
     d.update(magnitude=float(v.sum()), uncertainty=float(np.sqrt(max(var, 0.0))), kind=c.kind)
     return d

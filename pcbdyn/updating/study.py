@@ -38,7 +38,7 @@ from .sensitivity import frequencies_hz, solve_modes
 from .solvers import RankDeficiencyWarning, solve_ls
 from .subset import qr_basic_solution, svd_qr, threshold_selection, tls_qrf
 from .success import add_noise, success_ratio, success_statistics
-from .weighting import tls_column_weight_from_noise, unit_row_weights, weight_rows
+from .weighting import NOISE_REDRAWS, tls_column_weight_from_noise, unit_row_weights, weight_rows
 
 #: the thesis' simulated free PCB (section 5.4.4, Table 5.10): 162 x 178 x 2.8 mm, E 26 GPa,
 #: rho 2640 kg/m^3 on a 6 x 7 mesh; element thicknesses [mm] of the model ("pa") and of the
@@ -97,7 +97,17 @@ def _weighted(blk):
     return weight_rows(A, b, unit_row_weights(A))
 
 
-class SimulatedFreePCB:
+class _Case:
+    """What :func:`run_study` asks of a case: ``measure`` (noisy test data), ``build`` (weighted
+    equations from data), hence ``equations``."""
+
+    def equations(self, kind: str, level_pct: float, rng):
+        """Weighted (A, b) of equation type ``kind`` from test data with ``level_pct`` % uniform
+        noise (eqs. 5.72-5.74)."""
+        return self.build(kind, self.measure(kind, level_pct, rng))
+
+
+class SimulatedFreePCB(_Case):
     """The thesis' simulated free PCB (section 5.4.4, Tables 5.10-5.11, Fig. 5.41).
 
     162 x 178 x 2.8 mm glass-epoxy plate (E 26 GPa, rho 2640, nu 0.35), 6 x 7 quad4 shells, one
@@ -228,12 +238,8 @@ class SimulatedFreePCB:
             self.K, c["M"], c["omegas"], H, self.excitation, self.dKs, self.dMs, self.p_a))
             for c, H in zip(self.configs, data)]))
 
-    def equations(self, kind: str, level_pct: float, rng):
-        """Weighted (A, b) of equation type ``kind`` from test data with ``level_pct`` % noise."""
-        return self.build(kind, self.measure(kind, level_pct, rng))
 
-
-class BoardCase:
+class BoardCase(_Case):
     """A success-ratio case from any board.toml: its ``[[parameters]]`` (or ``params``) at their
     board values are the model, ``truth`` ({name: value, SI or a string with units}) the
     simulated structure, measured at the points of ``points_csv`` (first ``n_modes`` elastic
@@ -305,9 +311,6 @@ class BoardCase:
         build = qms_equations if kind == "qms" else fbm_equations
         return _weighted(build(self.K, self.M, *data, self.dKs, self.dMs, self.p_a))
 
-    def equations(self, kind: str, level_pct: float, rng):
-        """Weighted (A, b) from data with ``level_pct`` % uniform noise (eqs. 5.72-5.73)."""
-        return self.build(kind, self.measure(kind, level_pct, rng))
 
 
 CASES = {"simulated_free_pcb": SimulatedFreePCB, "board": BoardCase}
@@ -318,10 +321,6 @@ _CASE = None
 def _init(case):
     global _CASE
     _CASE = case
-
-
-#: redraws of the stated noise on a shot's data that measure its effect on A and b (TLS weight)
-NOISE_REDRAWS = 3
 
 
 def _run_batch(kind, level, shots, methods, seed, rank, case=None):

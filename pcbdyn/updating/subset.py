@@ -201,12 +201,13 @@ def tls_qrf(
     )
 
 
-def noise_out_of_range(A, b, redraws) -> float:
-    """The part of b's noise outside range(A), relative to ||b|| (rms over ``redraws``, equations
-    rebuilt with the stated noise drawn again): what the 5.2.3 check must tolerate before it
-    says the parameters cannot explain the data."""
+def explain_tol_from_noise(A, b, redraws) -> float:
+    """The 5.2.3 check's tolerance for a stated noise: twice the part of b's noise outside
+    range(A), relative to ||b|| (rms over ``redraws``, equations rebuilt with that noise drawn
+    again), and never below :data:`EXPLAIN_TOL`: noise alone must not make the parameters look
+    unable to explain the data."""
     A, b = np.asarray(A, float), np.asarray(b, float)
     U = np.linalg.svd(A, full_matrices=False)[0]
     out = [np.asarray(bd, float) - b for _, bd in redraws]
     out = [d - U @ (U.T @ d) for d in out]
-    return float(np.sqrt(np.mean([d @ d for d in out])) / np.linalg.norm(b))
+    return max(EXPLAIN_TOL, 2.0 * float(np.sqrt(np.mean([d @ d for d in out])) / np.linalg.norm(b)))

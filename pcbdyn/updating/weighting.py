@@ -43,6 +43,10 @@ def tls_column_weight(A, b, precision_ratio: float = 1.0) -> float:
     return precision_ratio * np.linalg.norm(A) / nb
 
 
+#: redraws of the stated noise on measured data that measure its effect on A and b
+NOISE_REDRAWS = 3
+
+
 def tls_column_weight_from_noise(A, b, redraws) -> float | None:
     """t_{n+1} of eq. 4.43 with the precision coefficients taken from the measurement noise
     itself: ``redraws`` are equations (A_d, b_d) built again from the measured data with the

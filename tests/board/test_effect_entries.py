@@ -113,7 +113,7 @@ def same_mesh_diagnosis(bmE, kind, effect):
         return base, dg.kind(kind).candidate(layout, "c", pts[0], pts[-1])
     pieces = [bmE.mesh.chain_on_segment(a, b) for a, b in zip(pts[:-1], pts[1:])]
     chain = np.concatenate([pieces[0]] + [p[1:] for p in pieces[1:]])
-    return base, chain_candidate(kind, layout, "c", chain, key="segment")
+    return base, chain_candidate(kind, layout, "c", chain)
 
 
 @pytest.mark.parametrize("kind", list(CASES))

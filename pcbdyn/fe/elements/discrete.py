@@ -29,10 +29,9 @@ def spring_matrices(xyz: np.ndarray, prop):
 def mass_matrices(xyz: np.ndarray, prop):
     """A rigid body of mass m and rotary inertia J at a cell's first node, or at the first sample
     point of ``prop.footprint``. A one-node cell carries it on that node's six DOFs. A cell of
-    three or more nodes (a footprint) moves the body with
-    the least-squares rigid motion of the translations of points sampling the footprint (the nodes
-    themselves, or ``prop.footprint``'s interpolation weights), as an RBE3 link that adds no
-    stiffness: u_s = u_b + theta_b x r_s, so M = G^T diag(m, m, m, J) G with G the pseudo-inverse of
+    three or more nodes (a footprint) moves the body with the least-squares rigid motion of the
+    translations of points sampling the footprint (the nodes themselves, or ``prop.footprint``'s
+    interpolation weights), as an RBE3 link that adds no stiffness: u_s = u_b + theta_b x r_s, so M = G^T diag(m, m, m, J) G with G the pseudo-inverse of
     that map; a rotary inertia then acts on the slope of the footprint, which converges with the
     mesh, not on one node's rotations, which a refined shell mesh decouples."""
     n_cells, nn, _ = xyz.shape
