@@ -28,11 +28,13 @@ from .spec import BoardError, RibSection
 
 def rib_property(EI: float, plate_thickness: float, section: RibSection = RibSection()) -> BeamProperty:
     """The stiffener's beam section for bending stiffness ``EI`` [N m^2] on a plate of thickness
-    ``plate_thickness`` (the diagnosis kind's RibSection.prop)."""
+    ``plate_thickness`` (the diagnosis kind's RibSection.prop); its bending is linear, as the
+    shell's it is tied to (on a node row or embedded across cells alike)."""
     b = 12.0 * EI / (section.E * section.h**3)
     inertia = b * section.h**3 / 12.0
     return BeamProperty(section.E, section.nu, section.rho, b * section.h, inertia, inertia, 4.0 * inertia,
-                        orientation=(0.0, 0.0, 1.0), offset=(0.0, 0.0, 0.5 * (plate_thickness + section.h)))
+                        orientation=(0.0, 0.0, 1.0), offset=(0.0, 0.0, 0.5 * (plate_thickness + section.h)),
+                        linear_bending=True)
 
 
 def edge_spring_property(k_rot: float) -> EdgeSpringProperty:

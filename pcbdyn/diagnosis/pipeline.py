@@ -220,11 +220,16 @@ def diagnose(board, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_size=
                          after=out["parameters_only"], **out)
     say("generating the candidate effects")
     options = {k: v * h if k == "path_spacing" else v for k, v in CANDIDATE_OPTIONS.items() if k in _options(kinds)}
-    cands = generate(from_board(models.bms[0]), kinds, **options)
+    layout = from_board(models.bms[0])
+    cands = generate(layout, kinds, **options)
     say(f"searching {len(cands)} candidate effects")
     sel = search(res, cands, p0, models.bounds, max_effects=max_effects, shortlist=2, alpha=alpha, base=base)
     if any(_movable(cands[i]) for i in sel.chosen):
         say("refining where the effects along the sides begin and end and where stiffeners run")
+        sel = refine(res, cands, sel, _local_moves(cands), models.bounds, alpha=alpha)
+    if any(LINE.match(cands[i].name) for i in sel.chosen):
+        say("placing the stiffeners found to a quarter of an element")
+        cands = cands + _finer_lines(layout, cands, sel.chosen, h)
         sel = refine(res, cands, sel, _local_moves(cands), models.bounds, alpha=alpha)
     if {"point_mass", "point_inertia"} <= {cands[i].kind for i in sel.chosen}:
         say("fitting a part found as a mass with an inertia beside it as one body")
@@ -286,6 +291,26 @@ def _local_moves(cands):
         return []
 
     return neighbours
+
+
+#: [element sizes] where a stiffener found on the one-element grid of lines may move to next
+FINER_LINE_OFFSETS = (-0.75, -0.5, -0.25, 0.25, 0.5, 0.75)
+
+
+def _finer_lines(layout, cands, chosen, h: float) -> list:
+    """Lines parallel to the chosen stiffeners at :data:`FINER_LINE_OFFSETS` (new names only), so
+    that :func:`.select.refine` can walk a rib found between grid lines to where it runs."""
+    from .catalogue import kind
+
+    taken = {c.name for c in cands}
+    out = []
+    for i in chosen:
+        if LINE.match(cands[i].name):
+            for c in kind("stiffener").parallel(layout, cands[i], h * np.asarray(FINER_LINE_OFFSETS)):
+                if c.name not in taken:
+                    taken.add(c.name)
+                    out.append(c)
+    return out
 
 
 #: kinds that act at one node: an effect between nodes is shared by its neighbours

@@ -38,17 +38,30 @@ class _Stiffener:
         """Full-span rows (along x) and columns (along y) every ``path_spacing`` [m]."""
         if not path_spacing > 0:
             raise ValueError(f"path_spacing must be > 0 m, got {path_spacing}")
-        xy = layout.xy[layout.shell_nodes()]
-        lo, hi = xy.min(axis=0), xy.max(axis=0)
+        lo, hi = _extent(layout)
         out = []
-        for axis, label in ((1, "y"), (0, "x")):
+        for axis in (1, 0):
             n = max(1, int(round((hi[axis] - lo[axis]) / path_spacing)))
-            for v in lo[axis] + (np.arange(n) + 0.5) * (hi[axis] - lo[axis]) / n:
-                p0, p1 = lo.copy(), hi.copy()
-                p0[axis] = p1[axis] = v
-                c = self.candidate(layout, f"{label}={1e3 * v:.4g}mm", p0, p1)
-                if c is not None:
-                    out.append(c)
+            out += self._lines(layout, axis, lo[axis] + (np.arange(n) + 0.5) * (hi[axis] - lo[axis]) / n)
+        return out
+
+    def parallel(self, layout, candidate, offsets) -> list:
+        """Full-span lines parallel to ``candidate`` (a row or column of :meth:`generate`), moved
+        across by ``offsets`` [m]: finer places around a rib found on the first grid."""
+        (x0, y0), (x1, y1) = candidate.geometry["path"]
+        axis = 0 if abs(x1 - x0) < abs(y1 - y0) else 1  # a column x = const, else a row y = const
+        return self._lines(layout, axis, (x0, y0)[axis] + np.asarray(offsets, float))
+
+    def _lines(self, layout, axis: int, values) -> list:
+        """Full-span lines x = v (``axis`` 0) or y = v (1) that cross the plate."""
+        lo, hi = _extent(layout)
+        out = []
+        for v in values:
+            p0, p1 = lo.copy(), hi.copy()
+            p0[axis] = p1[axis] = v
+            c = self.candidate(layout, f"{'xy'[axis]}={1e3 * v:.4g}mm", p0, p1)
+            if c is not None:
+                out.append(c)
         return out
 
     def candidate(self, layout, label: str, p0, p1):
@@ -80,6 +93,11 @@ class _Stiffener:
         m = copy_model(model)
         m.add(f"effects.{candidate.name}", "embedded_beam2", candidate.data["conn"], self._property(value, candidate))
         return m
+
+
+def _extent(layout):
+    xy = layout.xy[layout.shell_nodes()]
+    return xy.min(axis=0), xy.max(axis=0)
 
 
 KIND = _Stiffener()

@@ -58,7 +58,9 @@ class BeamProperty:
     ``offset`` [m] is the vector from each node to the beam's axis (a rib's centroid above a plate).
     ``shear_area_y``/``shear_area_z`` switch on Timoshenko shear (None: Euler-Bernoulli).
     ``rotary_inertia`` switches the section's rotary inertia in bending; the twisting inertia
-    rho (Iy + Iz) is always kept so that no DOF is left without mass.
+    rho (Iy + Iz) is always kept so that no DOF is left without mass. ``linear_bending``: the
+    bending stiffness of the linear Timoshenko beam (for a beam tied to a Mindlin shell, whose w
+    and theta are interpolated independently; see :mod:`.elements.beam`).
     """
 
     E: float
@@ -73,6 +75,7 @@ class BeamProperty:
     shear_area_y: float | None = None
     shear_area_z: float | None = None
     rotary_inertia: bool = True
+    linear_bending: bool = False
 
     @property
     def G(self) -> float:

@@ -135,13 +135,7 @@ def judge(case, truth: dict, data: dict) -> list:
 
 # ---------------------------------------------------------------------------------------- tests
 #: cases where diagnose misses the acceptance today, and why (strict: a fix turns them into passes)
-KNOWN = {
-    "stiffener_row": "the rib is found 1 mm from the true row (EI +5 %), but the max frequency error after is "
-                     "0.62 % (mode 1): the embedded rib is stiffer on the model's mesh than on the truth's (O(h), "
-                     "tests/fe/test_rib.py), which the mesh correction of the plain card does not hold; redoing that "
-                     "correction with the effects in the model brought it to 0.30 % but moved two other cases above "
-                     "0.5 % (0.67 and 0.93 %), so it is not adopted",
-}
+KNOWN: dict = {}
 
 
 def cases():

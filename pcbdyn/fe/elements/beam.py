@@ -6,6 +6,8 @@ displacement and quadratic rotation tied together by the shear factor
 phi = 12 E I / (G A_s L^2). With phi = 0 it is the Hermite cubic Euler-Bernoulli element
 (the thesis' cantilever of section 5.4.1 and appendix D.1, ANSYS BEAM4 with consistent mass); with phi > 0 its stiffness is the
 shear-flexible matrix of Przemieniecki and its mass the consistent mass of the same shape functions.
+A section with ``linear_bending`` takes the linear Timoshenko beam's bending stiffness instead
+(w and theta linear, shear at mid-element), the kinematics of the Mindlin shell it is tied to.
 Stiffness and mass are integrated with 4-point Gauss quadrature, which is exact for these
 polynomials.
 
@@ -104,8 +106,20 @@ def _skew(a: np.ndarray) -> np.ndarray:
     return np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
 
 
+def _linear_bending(L: np.ndarray, EI: float, GAs: float) -> np.ndarray:
+    """Planar bending K (n, 4, 4) for DOFs (w1, theta1, w2, theta2) with w and theta linear: EI on
+    d(theta)/dx and G A_s on the shear strain dw/dx - theta at the middle (one point: no locking)."""
+    d = np.array([0.0, -1.0, 0.0, 1.0])  # theta2 - theta1
+    Kb = (EI / L)[:, None, None] * np.outer(d, d)
+    half = np.full_like(L, 0.5)
+    g = np.stack([-1.0 / L, -half, 1.0 / L, -half], axis=-1)
+    return Kb + (GAs * L)[:, None, None] * g[:, :, None] * g[:, None, :]
+
+
 def local_matrices(L: np.ndarray, prop):
-    """K and M (n, 12, 12) in the local frame, DOFs (u, v, w, rx, ry, rz) at node 1 then node 2."""
+    """K and M (n, 12, 12) in the local frame, DOFs (u, v, w, rx, ry, rz) at node 1 then node 2.
+    With ``prop.linear_bending`` the bending stiffness is the linear Timoshenko beam's
+    (:func:`_linear_bending`; shear areas 5/6 A where not given), the mass unchanged."""
     n = L.size
     G = prop.G
     K = np.zeros((n, 12, 12))
@@ -119,15 +133,16 @@ def local_matrices(L: np.ndarray, prop):
     put([0, 6], *_rod(L, prop.E * prop.A, prop.rho * prop.A))
     put([3, 9], *_rod(L, G * prop.J, prop.rho * (prop.Iy + prop.Iz)))
     ri = bool(prop.rotary_inertia)
-    # bending in the local x-y plane about z (Iz, shear in y): theta_z = dv/dx
-    phi_y = 12 * prop.E * prop.Iz / (G * prop.shear_area_y * L**2) if prop.shear_area_y else np.zeros(n)
-    Kp, Mp = _bending(L, prop.E * prop.Iz, phi_y, prop.rho * prop.A, prop.rho * prop.Iz * ri)
-    put([1, 5, 7, 11], Kp, Mp)
-    # bending in the local x-z plane about y (Iy, shear in z): theta_y = -dw/dx
-    phi_z = 12 * prop.E * prop.Iy / (G * prop.shear_area_z * L**2) if prop.shear_area_z else np.zeros(n)
-    Kp, Mp = _bending(L, prop.E * prop.Iy, phi_z, prop.rho * prop.A, prop.rho * prop.Iy * ri)
     s = np.array([1.0, -1.0, 1.0, -1.0])
-    put([2, 4, 8, 10], Kp * s[:, None] * s[None, :], Mp * s[:, None] * s[None, :])
+    # bending in the local x-y plane about z (Iz, shear in y): theta_z = dv/dx;
+    # in the local x-z plane about y (Iy, shear in z): theta_y = -dw/dx
+    for idx, EI, As, sign in (([1, 5, 7, 11], prop.E * prop.Iz, prop.shear_area_y, np.ones(4)),
+                              ([2, 4, 8, 10], prop.E * prop.Iy, prop.shear_area_z, s)):
+        phi = 12 * EI / (G * As * L**2) if As else np.zeros(n)
+        Kp, Mp = _bending(L, EI, phi, prop.rho * prop.A, prop.rho * EI / prop.E * ri)
+        if prop.linear_bending:
+            Kp = _linear_bending(L, EI, G * (As or 5.0 / 6.0 * prop.A))
+        put(idx, Kp * sign[:, None] * sign[None, :], Mp * sign[:, None] * sign[None, :])
     return K, M
 
 

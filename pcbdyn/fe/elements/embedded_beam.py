@@ -2,7 +2,12 @@
 each end's translations and rotations interpolated from the cell's nodes with the shell's shape
 functions (a tie that adds no stiffness of its own): K = T^T K_beam T, M = T^T M_beam T with T
 the (12, 6 nodes) interpolation of the two ends. A cell lists the host nodes of both ends (a
-triangle's repeated node with weight 0 is allowed)."""
+triangle's repeated node with weight 0 is allowed).
+
+Inside a Mindlin shell's cell w and theta are interpolated independently: a section with
+``linear_bending`` (w and theta linear, as the host's) suits it; a Hermite cubic between the
+interpolated end values takes their mismatch for curvature (a rib across the six-part card was
+1 % too stiff at 6.75 mm against 1.7 mm, with linear bending 0.4 %)."""
 
 from __future__ import annotations
 
