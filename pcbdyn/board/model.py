@@ -133,7 +133,7 @@ def build_model(board: Board, config: str | None = None, mesh_size: float | None
         raise BoardError(f"{board.path.name}: board.mesh_size: meshing failed ({exc})") from None
     point_nodes = {name: int(n) for (name, _), n in zip(named, mesh.point_nodes)}
 
-    q = {}
+    q = {parts.SHEAR_KEY: 1.0}
     if board.isotropic is not None:
         q.update({"board.E": board.isotropic.E, "board.rho": board.isotropic.rho, "board.thickness": board.plate.t})
     q.update(parts.initial_quantities(board))

@@ -220,6 +220,8 @@ class Board:
         """(current value in SI, unit) of a parameter target such as ``components.U1.thickness``;
         None when the target does not exist."""
         parts = target.split(".")
+        if target == "board.transverse_shear":  # a factor on every shell's transverse shear stiffness
+            return 1.0, "1"
         if len(parts) == 2 and parts[0] == "board" and self.isotropic is not None:
             attr = {"E": ("E", "Pa"), "rho": ("rho", "kg/m^3")}
             if parts[1] in attr:
@@ -694,7 +696,7 @@ def _parameter(r, p, where, board) -> ParameterSpec:
         if q is None:
             r.fail(f"{where}.target", f"'{t}' is not a quantity of this board; use e.g. components.<ref>.thickness "
                                       "(equivalent_thickness parts), components.<ref>.mass, components.<ref>.E/rho "
-                                      "(smeared_local parts), board.E, board.rho, board.thickness, "
+                                      "(smeared_local parts), board.E, board.rho, board.thickness, board.transverse_shear, "
                                       "fixtures.<name>.k_rot (wedge_lock with a stiffness), fixtures.<name>.k "
                                       "(standoff or point_spring), fixtures.<name>.k_rot (edge_spring), masses.<name>.mass, "
                                       "line_masses.<name>.mass, stiffeners.<name>.EI, "

@@ -32,17 +32,27 @@ import numpy as np
 from ..fe import MassProperty, ShellProperty
 
 
+#: the quantity that multiplies every shell's transverse shear stiffness (1: the laminate's own
+#: estimate, 5/6 G t of the isotropic board): a glass-epoxy board's interlaminar shear modulus is
+#: rarely known, and it sets the twisting modes near free edges (a Kirchhoff plate is its limit)
+SHEAR_KEY = "board.transverse_shear"
+
+
 def board_keys(board) -> tuple:
     """Quantities the bare board's property depends on."""
-    return ("board.E", "board.rho", "board.thickness") if board.isotropic is not None else ()
+    return (("board.E", "board.rho", "board.thickness") if board.isotropic is not None else ()) + (SHEAR_KEY,)
+
+
+def _sheared(prop, q: dict):
+    return replace(prop, shear_factor=prop.shear_factor * q.get(SHEAR_KEY, 1.0))
 
 
 def base_property(board, q: dict, nsm: float = 0.0):
     """The bare board's shell property (isotropic material or equivalent laminate)."""
     if board.isotropic is not None:
         m = board.isotropic
-        return ShellProperty(q["board.E"], m.nu, q["board.rho"], q["board.thickness"], nsm=nsm)
-    return replace(board.plate, nsm=board.plate.nsm + nsm)
+        return _sheared(ShellProperty(q["board.E"], m.nu, q["board.rho"], q["board.thickness"], nsm=nsm), q)
+    return _sheared(replace(board.plate, nsm=board.plate.nsm + nsm), q)
 
 
 def board_isotropic(board, q: dict):
@@ -69,7 +79,7 @@ def region_keys(board, c) -> tuple:
         "smeared_local": (f"{key}.E", f"{key}.rho"),
         "equivalent_thickness": (f"{key}.thickness", f"{key}.mass"),
     }[c.model]
-    shared = board_keys(board) if c.model != "smeared_local" else ()
+    shared = board_keys(board) if c.model != "smeared_local" else (SHEAR_KEY,)
     return shared + own
 
 
@@ -82,10 +92,10 @@ def region_property(board, c, q: dict):
         return base_property(board, q, nsm=q[f"{key}.mass"] / c.area)
     E, nu, m_b, t_b = board_isotropic(board, q)
     if c.model == "smeared_local":
-        return ShellProperty(q[f"{key}.E"], nu, q[f"{key}.rho"], t_b)
+        return _sheared(ShellProperty(q[f"{key}.E"], nu, q[f"{key}.rho"], t_b), q)
     T = q[f"{key}.thickness"]
     rho = (q[f"{key}.mass"] + m_b * c.area) / (T * c.area)  # eq. 7.7
-    return ShellProperty(E, nu, rho, T)
+    return _sheared(ShellProperty(E, nu, rho, T), q)
 
 
 def lumped_mass(c, q: dict) -> MassProperty:

@@ -7,16 +7,20 @@ whether what remains is noise, and otherwise find, place and size the effects th
    of p / sqrt(3)), or, for shapes without a stated level, the part of each measured shape that no
    combination of the model's modes can represent (a measured shape projected on the span of as
    many modes as half the points; what is left over is noise). Model discretisation: the paired
-   frequencies of the modes the mesh resolves are corrected to a converged mesh by Richardson
-   extrapolation from the model and one meshed twice as fine (an O(h^2) element); what that
-   leaves uncertain, and the shapes' change (4/3 of it), is added to the noise in quadrature, so
-   that a coarse mesh is neither mistaken for an effect nor left in the error reported after.
+   frequencies are corrected to a converged mesh by Richardson extrapolation from the two
+   coarsest meshes (the model's, twice, four times as fine) that resolve the mode (an O(h^2)
+   element); what that leaves uncertain, and the shapes' change (4/3 of it), is added to the
+   noise in quadrature, so that a coarse mesh is neither mistaken for an effect nor left in the
+   error reported after. So is the plate theory's share of each frequency (Mindlin against
+   Kirchhoff: the board's transverse shear stiffness is a guess).
 3. The declared parameters alone are fitted; if chi^2 is within what noise gives (chi-square
    test, probability ``alpha``) the data lie in the range of the model (thesis section 5.2.3) and
    nothing is invented.
 4. Otherwise the catalogue's candidates are searched (:func:`.select.search`), the effects'
-   magnitudes estimated together with the declared parameters; runs along the sides are refined
-   (:func:`.select.refine`) and a mass with an inertia beside it refitted as one body
+   magnitudes estimated together with the declared parameters, each effect kept only if it
+   also predicts data it was not fitted to; runs along the sides, stiffener lines and
+   rectangular regions are walked to where they fit best (:func:`.select.refine`,
+   :class:`LocalMoves`) and a mass with an inertia beside it refitted as one body
    (:mod:`.bodies`).
 """
 
@@ -36,7 +40,7 @@ from .catalogue import generate, weighted_centre
 from .layout import from_board
 from ..correlation.mac import mac
 from .residual import ModalResidual, Observation, paired_mac
-from .select import ALPHA, estimate, refine, search
+from .select import ALPHA, estimate, refine, search, without_vanished
 
 #: where candidates go: sides cut into 16 pieces (every run of consecutive pieces is a candidate);
 #: stiffener rows and columns every element (``path_spacing`` in element sizes)
@@ -90,26 +94,67 @@ def _noise_sigmas(ob: Observation, freq_pct, shape_pct, basis_shapes):
 RESOLVED_SHAPE_CHANGE = 0.02
 
 
-def _discretisation(fine, ob, coarse_state):
-    """(frequency correction factor, its relative uncertainty, relative shape error, resolved) per
-    paired mode, from ``fine``, the model meshed twice as fine (its modes paired by MAC at the points). A resolved
-    mode (:data:`RESOLVED_SHAPE_CHANGE`) is corrected by Richardson extrapolation of an O(h^2)
-    element, f_0 = f_h/2 + (f_h/2 - f_h) / 3, whose own error (a third of the step) stays as noise;
-    any other mode (not yet in the asymptotic range, or no shapes to tell) takes the finer mesh's
-    frequency, the whole step counted as noise."""
-    modes = solve_modes(fine, n_modes=int(coarse_state.pairs.max()) + 4)
+def _follow(model, ob, u_prev, k_prev):
+    """(frequencies, shapes at the points, mode indices, shape change sqrt(1 - MAC)) of ``model``'s
+    modes paired by MAC at the points with the shapes ``u_prev`` (by index ``k_prev`` when there
+    are no measured shapes: no change can be told, it is inf)."""
+    modes = solve_modes(model, n_modes=int(k_prev.max()) + 4)
     if ob.shapes is None:
-        k = np.minimum(coarse_state.pairs, modes.frequencies.size - 1)
-        change = np.full(k.size, np.inf)
-    else:
-        U = np.asarray(model_probe(fine, ob.xyz, ob.directions, tol=0.02).P @ modes.shapes)
-        k = mac(coarse_state.u, U).argmax(axis=1)
-        change = np.sqrt(np.clip(1.0 - paired_mac(U[:, k], coarse_state.u), 0.0, None))
-    step = modes.frequencies[k] / (coarse_state.f_a / ob.f_scale) - 1.0
-    resolved = change <= RESOLVED_SHAPE_CHANGE
-    scale = 1.0 + step * np.where(resolved, 4.0 / 3.0, 1.0)
-    sigma = np.abs(step) * np.where(resolved, 1.0 / 3.0, 1.0)
-    return scale, sigma, np.where(np.isfinite(change), 4.0 / 3.0 * change, 0.0), resolved
+        k = np.minimum(k_prev, modes.frequencies.size - 1)
+        return modes.frequencies[k], None, k, np.full(k.size, np.inf)
+    U = np.asarray(model_probe(model, ob.xyz, ob.directions, tol=0.02).P @ modes.shapes)
+    k = mac(u_prev, U).argmax(axis=1)
+    U = U[:, k]
+    return modes.frequencies[k], U, k, np.sqrt(np.clip(1.0 - paired_mac(U, u_prev), 0.0, None))
+
+
+def _discretisation(finer, ob, coarse_state):
+    """(frequency correction factor, its relative uncertainty, relative shape error, resolved) per
+    paired mode. ``finer``: the model meshed twice, four times, ... as fine, taken one after the
+    other while some mode is not yet resolved (modes paired by MAC at the points, level to level).
+    A mode resolved between two levels (:data:`RESOLVED_SHAPE_CHANGE`) is corrected by Richardson
+    extrapolation of an O(h^2) element from them, f_0 = f_fine + (f_fine - f_coarse) / 3, whose own
+    error (a third of the step) stays as noise; a mode no level resolves (or with no shapes to
+    tell) takes the finest frequency, the last step counted as noise. The shape error is 4/3 of
+    the change from the model's mesh to the next."""
+    f0 = coarse_state.f_a / ob.f_scale
+    f_prev, u_prev, k_prev = f0, coarse_state.u, coarse_state.pairs
+    scale, sigma = np.ones(f0.size), np.zeros(f0.size)
+    resolved, todo, ds = np.zeros(f0.size, bool), np.ones(f0.size, bool), None
+    for model in finer:
+        f, U, k, change = _follow(model, ob, u_prev, k_prev)
+        ok = todo & (change <= RESOLVED_SHAPE_CHANGE)
+        scale = np.where(ok, (f + (f - f_prev) / 3.0) / f0, np.where(todo, f / f0, scale))
+        sigma = np.where(todo, np.abs(f - f_prev) / f0 / np.where(ok, 3.0, 1.0), sigma)
+        resolved |= ok
+        todo &= ~ok
+        if ds is None:
+            ds = np.where(np.isfinite(change), 4.0 / 3.0 * change, 0.0)
+        if not todo.any():
+            break
+        f_prev, u_prev, k_prev = f, U, k
+    return scale, sigma, ds, resolved
+
+
+#: the transverse shear factor (:data:`..components.models.SHEAR_KEY`) of the plate-theory bound:
+#: a shear this much stiffer is a Kirchhoff plate to within 0.1 % of the gap
+KIRCHHOFF_SHEAR = 1000.0
+
+
+def _plate_theory(bm, ob, state) -> np.ndarray:
+    """Relative uncertainty per paired mode of what the plate theory gives: the frequency change
+    of the model ``bm`` (a BoardModel) when its shells' transverse shear is made rigid (Kirchhoff).
+    A board's interlaminar shear modulus is rarely known, and codes differ (Kirchhoff plates,
+    Mindlin shells, solids): twisting modes near free edges move by up to about 1 % on a 2.8 mm
+    card. A model that leaves this to noise takes it neither for an effect nor for a parameter."""
+    from ..components.models import SHEAR_KEY
+
+    f, _, _, _ = _follow(bm.with_quantities({SHEAR_KEY: KIRCHHOFF_SHEAR}).model, ob, state.u, state.pairs)
+    return np.abs(f / (state.f_a / ob.f_scale) - 1.0)
+
+
+#: how many times the mesh is halved at most to correct the model's frequencies for it
+MESH_LEVELS = 2
 
 
 class _BoardModels:
@@ -150,22 +195,26 @@ def _observations(tests, bms) -> list:
 
 def _set_noise(board, models, h, obs, state, freq_pct, shape_pct) -> list:
     """Each observation's discretisation correction of the model frequencies, and its sigmas:
-    measurement noise and what remains of the discretisation error, in quadrature. Returns which
-    modes the mesh resolves, per observation."""
-    resolved = []
-    for ob, cs in zip(obs, state.configs):
+    measurement noise, what remains of the discretisation error and the plate theory's
+    uncertainty, in quadrature. Returns which modes the mesh resolves and the plate-theory
+    uncertainties, per observation."""
+    resolved, theory = [], []
+    for ob, cs, bm in zip(obs, state.configs, models.at(models.p0)):
         basis = None
         if ob.shapes is not None:  # rigid-body modes first: a free board's shapes hold them at the points
             wide = solve_modes(cs.model, n_modes=ob.shapes.shape[0] // 2)
             basis = np.asarray(ob.read @ np.column_stack([wide.rigid_shapes, wide.shapes]))
         sf, ss = _noise_sigmas(ob, freq_pct, shape_pct, basis)
-        fine = build_model(board, ob.name, h / 2.0, shared_mesh=True).with_parameters(
-            dict(zip(models.names, models.p0.tolist()))).model
-        ob.f_scale, df, ds, ok = _discretisation(fine, ob, cs)
-        ob.sigma_f = np.sqrt(sf**2 + df**2)
+        p0 = dict(zip(models.names, models.p0.tolist()))
+        finer = (build_model(board, ob.name, h / 2**j, shared_mesh=True).with_parameters(p0).model
+                 for j in range(1, MESH_LEVELS + 1))
+        ob.f_scale, df, ds, ok = _discretisation(finer, ob, cs)
+        dt = _plate_theory(bm, ob, cs)
+        ob.sigma_f = np.sqrt(sf**2 + df**2 + dt**2)
         ob.sigma_s = None if ss is None else np.sqrt(ss**2 + ds**2)
         resolved.append(ok.tolist())
-    return resolved
+        theory.append(np.round(100 * dt, 4).tolist())
+    return resolved, theory
 
 
 def _range_test(res, base, n_params, alpha) -> dict:
@@ -199,13 +248,13 @@ def diagnose(board, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_size=
         res = models.residual(obs)
         before = res.evaluate(p0)
     say("estimating the noise and the model's discretisation error")
-    resolved = _set_noise(board, models, h, obs, before, freq_noise_pct, shape_noise_pct)
+    resolved, theory = _set_noise(board, models, h, obs, before, freq_noise_pct, shape_noise_pct)
     before = res.evaluate(p0)
     say(f"fitting the {len(names)} declared parameter(s)" if names else "no declared parameters")
     base = estimate(res, p0, [], [], 10, models.bounds)
     stats = {"unpaired_test_modes": unmatched, "chi2_before": before.chi2, **_range_test(res, base, len(names), alpha),
              "mesh_correction_pct": [np.round(100 * (o.f_scale - 1.0), 4).tolist() for o in obs],
-             "mesh_resolved": resolved,
+             "mesh_resolved": resolved, "plate_theory_pct": theory,
              "sigma_f_pct": [np.round(100 * o.sigma_f, 4).tolist() for o in obs],
              "sigma_shape_pct": [None if o.sigma_s is None else np.round(100 * o.sigma_s, 4).tolist() for o in obs]}
     out = dict(before=before.summary(obs), parameters_only=base.state.summary(obs),
@@ -225,16 +274,13 @@ def diagnose(board, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_size=
     say(f"searching {len(cands)} candidate effects")
     sel = search(res, cands, p0, models.bounds, max_effects=max_effects, shortlist=2, alpha=alpha, base=base)
     if any(_movable(cands[i]) for i in sel.chosen):
-        say("refining where the effects along the sides begin and end and where stiffeners run")
-        sel = refine(res, cands, sel, _local_moves(cands), models.bounds, alpha=alpha)
-    if any(LINE.match(cands[i].name) for i in sel.chosen):
-        say("placing the stiffeners found to a quarter of an element")
-        cands = cands + _finer_lines(layout, cands, sel.chosen, h)
-        sel = refine(res, cands, sel, _local_moves(cands), models.bounds, alpha=alpha)
+        say("refining where the effects along the sides begin and end, where stiffeners run and what regions cover")
+        sel = refine(res, cands, sel, LocalMoves(layout, cands, h), models.bounds, alpha=alpha)
     if {"point_mass", "point_inertia"} <= {cands[i].kind for i in sel.chosen}:
         say("fitting a part found as a mass with an inertia beside it as one body")
         sel = as_bodies(res, cands, sel, _neighbours([cands[i] for i in sel.chosen], MERGE_REACH * h),
                         MERGE_REACH * h, models.bounds, alpha=alpha)
+    sel = without_vanished(res, cands, sel, models.bounds, alpha=alpha)
     stats.update(chi2_after=sel.chi2[-1], candidates=len(cands))
     for n, v in zip(names, sel.p):
         out["parameters"][n]["final"] = float(v)
@@ -259,58 +305,74 @@ LINE = re.compile(r"^(?P<base>.+@[xy])=(?P<v>[-0-9.e]+)mm$")
 
 
 def _movable(cand) -> bool:
-    """A candidate :func:`_local_moves` can move (a run of pieces of a side, a stiffener line)."""
-    return bool(RUN.match(cand.name) or LINE.match(cand.name))
+    """A candidate :class:`LocalMoves` can move (a run of pieces of a side, a stiffener line, a
+    rectangular region)."""
+    return bool(RUN.match(cand.name) or LINE.match(cand.name) or _rectangle(cand) is not None)
 
 
-def _local_moves(cands):
-    """neighbours(i) for :func:`.select.refine`: the candidates of the same kind and side as
-    candidate i whose run of pieces starts and ends at most one piece from its own, or the
-    stiffener lines next to it in the same direction (none for other candidates)."""
-    runs: dict = {}
-    lines: dict = {}
-    for k, c in enumerate(cands):
+def _rectangle(cand):
+    """(x0, y0, x1, y1) [m] of a region candidate whose polygon is an axis-aligned rectangle, else None."""
+    if cand.kind != "region_stiffness":
+        return None
+    poly = np.asarray(cand.geometry["polygon"], float)
+    lo, hi = poly.min(axis=0), poly.max(axis=0)
+    on_box = np.all(np.isclose(poly[:, :1], [lo[0], hi[0]]).any(axis=1) & np.isclose(poly[:, 1:], [lo[1], hi[1]]).any(axis=1))
+    return (*lo, *hi) if len(poly) == 4 and on_box else None
+
+
+class LocalMoves:
+    """neighbours(i) for :func:`.select.refine`: for a run of pieces of a side, the runs of the
+    same kind and side that start and end at most one piece from its own; for a stiffener line,
+    the lines a quarter element (:data:`LINE_STEP`) to either side; for a rectangular region, the
+    rectangles with one side moved by one element (:data:`RECT_STEP`) in or out. Lines and
+    rectangles are made on demand and appended to ``cands`` (the first grid places an effect
+    within a grid step; these walk it to where it is)."""
+
+    def __init__(self, layout, cands: list, h: float):
+        self.layout, self.cands, self.h = layout, cands, h
+        self.index = {c.name: k for k, c in enumerate(cands)}
+        self.runs: dict = {}
+        for k, c in enumerate(cands):
+            if m := RUN.match(c.name):
+                self.runs.setdefault(m["base"], {})[(int(m["i"]), int(m["j"] or m["i"]))] = k
+
+    def _add(self, made) -> list:
+        out = []
+        for c in made:
+            if c.name not in self.index:
+                self.index[c.name] = len(self.cands)
+                self.cands.append(c)
+            out.append(self.index[c.name])
+        return out
+
+    def __call__(self, k) -> list:
+        from .catalogue import kind
+
+        c = self.cands[k]
         if m := RUN.match(c.name):
-            i = int(m["i"])
-            runs.setdefault(m["base"], {})[(i, int(m["j"] or i))] = k
-        elif m := LINE.match(c.name):
-            lines.setdefault(m["base"], []).append((float(m["v"]), k))
-    order = {b: [k for _, k in sorted(v)] for b, v in lines.items()}
-
-    def neighbours(k):
-        if m := RUN.match(cands[k].name):
-            i = int(m["i"])
-            j = int(m["j"] or i)
-            side = runs[m["base"]]
+            i, j = int(m["i"]), int(m["j"] or m["i"])
+            side = self.runs[m["base"]]
             return [side[(a, b)] for a in (i - 1, i, i + 1) for b in (j - 1, j, j + 1)
                     if (a, b) != (i, j) and (a, b) in side]
-        if m := LINE.match(cands[k].name):
-            row = order[m["base"]]
-            at = row.index(k)
-            return [row[t] for t in (at - 1, at + 1) if 0 <= t < len(row)]
+        if LINE.match(c.name):
+            return self._add(kind("stiffener").parallel(self.layout, c, LINE_STEP * self.h * np.array([-1.0, 1.0])))
+        if (box := _rectangle(c)) is not None:
+            lo, hi = self.layout.xy[self.layout.shell_nodes()].min(axis=0), self.layout.xy[self.layout.shell_nodes()].max(axis=0)
+            step, made = RECT_STEP * self.h, []
+            for side in range(4):
+                for d in (-step, step):
+                    b = np.array(box)
+                    b[side] = np.clip(b[side] + d, lo[side % 2], hi[side % 2])
+                    if b[2] - b[0] >= step and b[3] - b[1] >= step and not np.allclose(b, box):
+                        made.append(kind("region_stiffness").rectangle(self.layout, *b))
+            return self._add([r for r in made if r is not None])
         return []
 
-    return neighbours
 
-
-#: [element sizes] where a stiffener found on the one-element grid of lines may move to next
-FINER_LINE_OFFSETS = (-0.75, -0.5, -0.25, 0.25, 0.5, 0.75)
-
-
-def _finer_lines(layout, cands, chosen, h: float) -> list:
-    """Lines parallel to the chosen stiffeners at :data:`FINER_LINE_OFFSETS` (new names only), so
-    that :func:`.select.refine` can walk a rib found between grid lines to where it runs."""
-    from .catalogue import kind
-
-    taken = {c.name for c in cands}
-    out = []
-    for i in chosen:
-        if LINE.match(cands[i].name):
-            for c in kind("stiffener").parallel(layout, cands[i], h * np.asarray(FINER_LINE_OFFSETS)):
-                if c.name not in taken:
-                    taken.add(c.name)
-                    out.append(c)
-    return out
+#: [element sizes] how far a stiffener line moves in one step of the local search
+LINE_STEP = 0.25
+#: [element sizes] how far a side of a rectangular region moves in one step of the local search
+RECT_STEP = 1.0
 
 
 #: kinds that act at one node: an effect between nodes is shared by its neighbours
@@ -324,9 +386,17 @@ def _linked(a, b, reach: float) -> bool:
     """Two chosen effects that are one: point effects of one kind within ``reach`` [m] (a mass or a
     spring between nodes is fitted as shares on the nodes around it), or a point mass within
     ``reach`` of a line mass (a mass spread over part of an edge is fitted as a line plus points),
-    or line masses whose segments overlap or lie within ``reach``."""
+    line masses whose segments overlap or lie within ``reach``, parallel stiffeners within
+    ``reach`` (a rib between two lines is fitted as shares on both), or overlapping rectangular
+    regions (a region between two is fitted as both)."""
     if a.kind == b.kind and a.kind in POINT_KINDS:
         return np.hypot(a.at[0] - b.at[0], a.at[1] - b.at[1]) <= reach
+    if a.kind == b.kind == "region_stiffness" and None not in (ra := _rectangle(a), rb := _rectangle(b)):
+        return min(ra[2], rb[2]) > max(ra[0], rb[0]) and min(ra[3], rb[3]) > max(ra[1], rb[1])  # they overlap
+    if a.kind == b.kind == "stiffener":
+        da, db = (np.diff(np.asarray(c.geometry["path"], float)[[0, -1]], axis=0)[0] for c in (a, b))
+        parallel = abs(da[0] * db[1] - da[1] * db[0]) <= 1e-6 * np.linalg.norm(da) * np.linalg.norm(db)
+        return parallel and _segment_gap(a.geometry["path"], b.geometry["path"]) <= reach
     if a.kind == b.kind == "line_mass":  # masses along one stretch of a side add up
         return _segment_gap(a.geometry["segment"], b.geometry["segment"]) <= reach
     if {a.kind, b.kind} == {"point_mass", "line_mass"}:
@@ -364,8 +434,9 @@ def _neighbours(chosen, reach: float) -> list:
 
 def _merged(chosen, values, cov, group) -> dict:
     """One effect entry (JSON-ready) for a group: the magnitudes summed at their weighted centre (on
-    line masses: the place and extent of the largest), the uncertainty of the sum from the fit's
-    covariance."""
+    line masses: the place and extent of the largest; parallel stiffeners: their weighted mean
+    path; overlapping regions: the area-weighted mean change over their bounding rectangle), the
+    uncertainty of the sum from the fit's covariance."""
     lines = [k for k in group if chosen[k].kind == "line_mass"]
     c = chosen[max(lines, key=lambda k: values[k]) if lines else group[0]]
     d = c.describe()
@@ -373,6 +444,20 @@ def _merged(chosen, values, cov, group) -> dict:
     if len(group) > 1:
         if not lines:
             d["at_mm"] = np.round(1e3 * weighted_centre([chosen[k] for k in group], v), 3).tolist()
+        if c.kind == "stiffener":
+            w = v / v.sum() if v.sum() > 0 else np.full(v.size, 1.0 / v.size)
+            paths = np.array([np.asarray(chosen[k].geometry["path"], float)[[0, -1]] for k in group])
+            d["path_mm"] = np.round(1e3 * np.einsum("g,gij->ij", w, paths), 3).tolist()
+        if c.kind == "region_stiffness":  # the mean change over the union's bounding rectangle
+            boxes = np.array([_rectangle(chosen[k]) for k in group])
+            x0, y0, x1, y1 = (*boxes[:, :2].min(axis=0), *boxes[:, 2:].max(axis=0))
+            w = (boxes[:, 2] - boxes[:, 0]) * (boxes[:, 3] - boxes[:, 1]) / ((x1 - x0) * (y1 - y0))
+            d["polygon_mm"] = np.round(1e3 * np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]]), 3).tolist()
+            d["at_mm"] = np.round(1e3 * np.array([x0 + x1, y0 + y1]) / 2.0, 3).tolist()
+            var = float(w @ cov[np.ix_(group, group)] @ w) if cov.size else 0.0
+            d.update(name="+".join(chosen[k].name for k in group), magnitude=float(w @ v),
+                     uncertainty=float(np.sqrt(max(var, 0.0))), kind=c.kind)
+            return d
         d["name"] = "+".join(chosen[k].name for k in group)
         d["merged_at_mm"] = np.round(1e3 * np.array([chosen[k].at for k in group]), 3).tolist()
     var = float(np.sum(cov[np.ix_(group, group)])) if cov.size else 0.0

@@ -104,6 +104,15 @@ class _RegionStiffness:
         polys += list(layout.footprints.items())
         return [c for label, poly in polys if (c := _candidate(layout, label, poly)) is not None]
 
+    def candidate(self, layout, label: str, polygon):
+        """The region over ``polygon`` [[x, y], ...] [m] (None where it holds no cell centroid)."""
+        return _candidate(layout, label, polygon)
+
+    def rectangle(self, layout, x0: float, y0: float, x1: float, y1: float):
+        """The region over the rectangle [x0, x1] x [y0, y1] [m], named by its corners in mm."""
+        label = "rect[" + ",".join(f"{1e3 * v:.4g}" for v in (x0, y0, x1, y1)) + "]mm"
+        return _candidate(layout, label, [[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
+
     def blocks(self, model, candidates) -> list:
         """Element stiffness of the regions' cells with their base properties in ``model``; one
         kernel call per (element type, property) over all candidates."""

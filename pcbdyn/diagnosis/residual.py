@@ -145,6 +145,16 @@ class ModalResidual:
         self.n_rows = sum(o.n_rows for o in self.observations)
         self._at = (None, None, {})  # last p, its [(model, K, M)], {(config, candidate): (dK, dM)}
 
+    def row_groups(self) -> tuple:
+        """(configuration index, mode index) of every row: the blocks cross-validation leaves out."""
+        cfg, mode = [], []
+        for k, ob in enumerate(self.observations):
+            m = ob.f.size
+            n_pts = 0 if ob.shapes is None else ob.shapes.shape[0]
+            cfg.append(np.full(m * (1 + n_pts), k))
+            mode.append(np.r_[np.arange(m), np.repeat(np.arange(m), n_pts)])
+        return np.concatenate(cfg), np.concatenate(mode)
+
     # --- states ----------------------------------------------------------------------------
     def _assembled(self, p):
         if self._at[0] is None or not np.array_equal(self._at[0], p):

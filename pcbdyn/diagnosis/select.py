@@ -16,7 +16,9 @@ A new effect is kept only if its chi^2 drop exceeds the penalty
 (n rows, P candidates: the best of P noise-only columns removes less than q with probability
 1 - ALPHA, Bonferroni; ln n is BIC's term), both in the stated noise units and in units of the
 variance left after the fit, chi^2 / (n - k): noise or model error larger than stated must not
-turn into effects. After each addition an earlier effect that the others make redundant is
+turn into effects; and it must predict data it was not fitted to (:func:`held_out_share`: left-out
+configurations, or modes), so that a model error confined to one configuration or mode is not
+taken for an effect. After each addition an earlier effect that the others make redundant is
 dropped (backward check).
 """
 
@@ -150,7 +152,8 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
         st = fit.state
         A = res.effect_columns(st, candidates) * scale
         P = res.param_columns(st)
-        Q = _orth(np.hstack([P, res.effect_columns(st, [candidates[i] for i in sel.chosen])]))
+        held = np.hstack([P, res.effect_columns(st, [candidates[i] for i in sel.chosen]) * scale[sel.chosen]])
+        Q = _orth(held)
         A_p, r_p = A - Q @ (Q.T @ A), st.r - Q @ (Q.T @ st.r)
         norm2 = np.einsum("ij,ij->j", A_p, A_p)
         ok = norm2 > 1e-12 * norm2.max()
@@ -170,6 +173,8 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
         new = estimate(res, fit.p, [candidates[i] for i in idx], fits[best].values, newton_steps, bounds)
         if not _worth(sel.chi2[-1], new.chi2, n, p0.size + len(idx), pen):
             break
+        if held_out_share(res, st.r, held, A[:, idx[-1]]) < HELD_OUT_SHARE:
+            break
         idx, fit = _prune(res, candidates, idx, new, newton_steps, bounds, pen, p0.size)
         adopt(sel, idx, fit, pen)
     return sel
@@ -184,6 +189,18 @@ def adopt(sel: Selection, idx: list, fit: Fit, pen: float) -> Selection:
     sel.chi2.append(fit.chi2)
     sel.criterion.append(fit.chi2 + len(idx) * pen)
     return sel
+
+
+def without_vanished(res, candidates, sel: Selection, bounds=None, newton_steps: int = 8,
+                     alpha: float = ALPHA) -> Selection:
+    """``sel`` without the effects that later steps left within one standard deviation of zero
+    (a companion that the refined others made needless), the rest re-estimated."""
+    keep = [k for k, (v, s) in enumerate(zip(sel.values, sel.sigma)) if abs(v) > s]
+    if len(keep) == len(sel.chosen):
+        return sel
+    idx = [sel.chosen[k] for k in keep]
+    fit = estimate(res, sel.p, [candidates[i] for i in idx], np.asarray(sel.values)[keep], newton_steps, bounds)
+    return adopt(sel, idx, fit, penalty(res.n_rows, len(candidates), alpha))
 
 
 def refine(res, candidates, sel: Selection, neighbours, bounds=None, newton_steps: int = 8,
@@ -225,6 +242,41 @@ def _worth(chi2_before, chi2_after, n, k, pen) -> bool:
     """The drop exceeds the penalty in stated noise units and in units of the variance left."""
     drop = chi2_before - chi2_after
     return drop > pen and drop / max(chi2_after / max(n - k, 1), 1.0) > pen
+
+
+def held_out_share(res, r, held, column) -> float:
+    """How well an effect predicts data it was not fitted to, linearised where it is not yet in
+    (residual ``r``, columns ``held`` of the declared parameters and the effects already chosen,
+    the new effect's ``column``): the rows are split into folds (one per configuration when there
+    are several, else one per mode); on each, the held columns with and without the new one are
+    fitted to the other folds and the fold's rows predicted. Returns the share of folds whose
+    prediction the effect improves (:data:`HELD_OUT_SHARE` at least to keep the effect). A real effect
+    improves nearly all; one that explains a structured model error of one configuration or mode
+    does not (issue 7, step 5: selection checked by cross-validation across modes and
+    configurations). Counting folds, not adding their chi^2, keeps one fold that a large effect's
+    linearisation overshoots (a mode it moves onto another) from outvoting the rest."""
+    cfg, mode = res.row_groups()
+    folds = cfg if np.unique(cfg).size > 1 else mode
+    better = []
+    for f in np.unique(folds):
+        test = folds == f
+        err = []
+        for A in (held, np.column_stack([held, column])):
+            d = np.linalg.lstsq(A[~test], r[~test], rcond=CV_RCOND)[0] if A.shape[1] else np.zeros(0)
+            e = r[test] - A[test] @ d
+            err.append(float(e @ e))
+        better.append(err[1] < err[0] - 1.0)  # by more than a unit of chi^2: the noise's own scale
+    return float(np.mean(better))
+
+
+#: the share of held-out folds an effect must predict better to be kept (real effects of the
+#: bench and hold-out cases: 7 of 8 folds or more; effects fitted to another code's model-form
+#: error: 2 of 3 configurations, 4 of 8 modes)
+HELD_OUT_SHARE = 0.75
+#: fits on part of the data drop the directions of the columns (declared parameters, effects at
+#: their typical size) weaker than this part of the strongest: parts' thicknesses that one
+#: configuration cannot tell apart must not extrapolate wildly to another
+CV_RCOND = 1e-3
 
 
 def _orth(A):

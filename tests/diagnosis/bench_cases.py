@@ -6,7 +6,7 @@ examples/six_part_card, free, or the same card in wedge-lock guides of examples/
 their declared [[parameters]]), the TRUE structure (the same board with its declared parameters at
 true values a little off the nominal ones, plus the hidden :class:`Effect`, added at FE level with
 :func:`pcbdyn.diagnosis.add_effect` on a candidate built on the truth mesh at the wanted place),
-the configurations tested, the truth mesh size (half the model's: the data carry the model's
+the configurations tested, the truth mesh size (a quarter of the model's: the data carry the model's
 discretisation error, as a real test does) and the noise. :func:`make_case` writes the handed board.toml, one UFF test per
 configuration (modes below 1 kHz, z at a 10 x 10 grid of points + the excitation point, 0.2 %
 frequency and 2 % shape noise, fixed seeds, FRFs at the shaker point) and ``truth.json``.
@@ -32,7 +32,7 @@ CARD = ROOT / "examples" / "six_part_card" / "board.toml"
 WEDGE = ROOT / "examples" / "wedge_locked" / "board.toml"
 F_MAX = 1000.0
 MODEL_MESH = 6.75e-3  # the mesh of both example boards
-FINE_MESH = 3.375e-3  # half of it
+FINE_MESH = MODEL_MESH / 4.0  # the truths are meshed four times finer
 SHAKER = (0.135, 0.06357)  # the card's shaker point (its 13 g force transducer)
 
 
@@ -69,7 +69,7 @@ class Case:
     transducer is left out of the handed board and is the hidden effect of the truth. ``true_values``: the truth's
     declared parameters {name: SI value}; ``handed_values``: nominal values of the handed board
     that differ from the example's (k_guides). ``configs``: tested configurations (None: base).
-    ``truth_mesh``: mesh of the truth model [m]: half the model's, so that the data carry the
+    ``truth_mesh``: mesh of the truth model [m]: a quarter of the model's, so that the data carry the
     model's discretisation error as a real test does (None: the model's own mesh)."""
 
     name: str
@@ -246,9 +246,7 @@ def candidate(layout, effect: Effect):
         assert c is not None, f"{k}: path {effect.path} misses the plate"
         return c
     if k == "region_stiffness":
-        from pcbdyn.diagnosis.region_stiffness import _candidate
-
-        c = _candidate(layout, "hidden", [list(p) for p in effect.polygon])
+        c = kind(k).candidate(layout, "hidden", [list(p) for p in effect.polygon])
         assert c is not None, "the region holds no cell centroid"
         return c
     raise ValueError(f"unknown effect kind {k}")

@@ -27,7 +27,7 @@ MAG_TOL = 0.30
 AFTER_MAX_PCT = 0.5
 PARAMS_ONLY_MIN_PCT = 2.0
 # what parameters alone leave on noise-only data: noise, plus the discretisation error of the model
-# mesh against a truth mesh of half its size (about 1 % on the guided card, whose two parameters
+# mesh against a truth mesh of a quarter its size (about 1 % on the guided card, whose two parameters
 # cannot absorb it)
 NOISE_PARAMS_ONLY_MAX_PCT = 1.5
 
@@ -135,7 +135,11 @@ def judge(case, truth: dict, data: dict) -> list:
 
 # ---------------------------------------------------------------------------------------- tests
 #: cases where diagnose misses the acceptance today, and why (strict: a fix turns them into passes)
-KNOWN: dict = {}
+KNOWN: dict = {
+    "line_mass_top_cfg": "the 20 g line mass is found in place and size (20.1 g), but two modes of configuration c2 "
+                         "(a body at the edge) stay 0.62 % off after: the parameters cannot absorb how the body "
+                         "and the connector share the edge's twisting",
+}
 
 
 def cases():

@@ -35,7 +35,7 @@ def correction(board, config, reference_mesh):
     state = models.residual([ob]).evaluate(models.p0).configs[0]
     p = dict(zip(models.names, models.p0.tolist()))
     fine = build_model(board, config, board.mesh_size / 2.0, shared_mesh=True).with_parameters(p).model
-    scale, sigma, _, resolved = _discretisation(fine, ob, state)
+    scale, sigma, _, resolved = _discretisation([fine], ob, state)
     return state.f_a, scale, sigma, resolved, rm.frequencies
 
 

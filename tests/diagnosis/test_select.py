@@ -87,7 +87,7 @@ def test_refine_moves_a_segment_found_too_short_to_the_true_run(card):
     """A line mass over two pieces of a free side, first fitted on one of them: the local search
     on the run's ends (:func:`refine` with the pipeline's neighbours) moves it to the true run and
     recovers its mass."""
-    from pcbdyn.diagnosis.pipeline import RUN, _local_moves
+    from pcbdyn.diagnosis.pipeline import RUN, LocalMoves
     from pcbdyn.diagnosis.residual import ModalResidual, Observation
     from pcbdyn.diagnosis.select import Selection, estimate, refine
 
@@ -100,7 +100,7 @@ def test_refine_moves_a_segment_found_too_short_to_the_true_run(card):
     fit = estimate(res, np.zeros(0), [cands[start]], [0.03], 8)
     assert fit.chi2 > 10.0  # the wrong run cannot explain the data
     sel = Selection(chosen=[start], values=fit.values, p=fit.p, chi2=[fit.chi2], state=fit.state)
-    sel = refine(res, cands, sel, _local_moves(cands))
+    sel = refine(res, cands, sel, LocalMoves(dg.from_model(m), cands, 0.01))
     assert [cands[i].name for i in sel.chosen] == [cands[truth].name]
     assert sel.values[0] == pytest.approx(0.03, rel=1e-3)
     assert sel.chi2[-1] < 1e-3
@@ -137,3 +137,85 @@ def test_a_mass_with_an_inertia_beside_it_is_refitted_as_one_body(card):
     assert np.linalg.norm(np.subtract(cands[sel.chosen[0]].at, centre[:2])) < 2e-4
     assert sel.values == pytest.approx([0.04, 4e-6], rel=0.005)
     assert sel.chi2[-1] < 1e-2 * fit.chi2
+
+
+def test_refine_walks_a_region_found_on_the_patch_grid_to_the_true_rectangle(card):
+    """A stiffened rectangle off the patch grid, first fitted on the patch that overlaps it most:
+    moving one side by one element at a time (:class:`LocalMoves`) reaches the true rectangle and
+    its stiffness change."""
+    from pcbdyn.diagnosis.pipeline import LocalMoves, _rectangle
+    from pcbdyn.diagnosis.residual import ModalResidual, Observation
+    from pcbdyn.diagnosis.select import Selection, estimate, refine
+
+    m, cands = card
+    layout = dg.from_model(m)
+    step = 0.16 / NX
+    truth = dg.kind("region_stiffness").rectangle(layout, 3 * step, 4 * 0.18 / NY, 7 * step, 9 * 0.18 / NY)
+    f_test = solve_modes(dg.add_effect(m, truth, 1.5), n_modes=N_MODES).frequencies
+    res = ModalResidual([Observation(None, f_test, np.full(N_MODES, SIGMA))], lambda p: [m])
+    cands = list(cands)
+    patches = [i for i, c in enumerate(cands) if c.kind == "region_stiffness" and _rectangle(c) is not None]
+    start = min(patches, key=lambda i: np.hypot(*np.subtract(cands[i].at, truth.at)))
+    fit = estimate(res, np.zeros(0), [cands[start]], [1.0], 8)
+    assert fit.chi2 > 10.0  # the patch cannot explain the data
+    sel = Selection(chosen=[start], values=fit.values, p=fit.p, chi2=[fit.chi2], state=fit.state)
+    sel = refine(res, cands, sel, LocalMoves(layout, cands, step))
+    found = cands[sel.chosen[0]]
+    assert np.array_equal(found.nodes, truth.nodes)  # the same cells
+    assert sel.values[0] == pytest.approx(1.5, rel=1e-3)
+
+
+def test_held_out_share_tells_an_effect_every_fold_sees_from_one_fitted_to_one_fold():
+    """Cross-validation over folds (:func:`held_out_share`): a column that shapes the residual of
+    every mode predicts each left-out mode; one that matches a single mode's error (beside what
+    the held columns explain) predicts none of the others."""
+    from pcbdyn.diagnosis.select import held_out_share
+
+    class Rows:  # one configuration: the folds are its modes
+        def row_groups(self):
+            return np.zeros(80, int), np.repeat(np.arange(8), 10)
+
+    rng = np.random.default_rng(0)
+    held = rng.standard_normal((80, 2))
+    effect = rng.standard_normal(80)
+    noise = rng.standard_normal(80)
+    assert held_out_share(Rows(), 30.0 * effect + held @ [1.0, -2.0] + noise, held, effect) == 1.0
+    mode3 = np.repeat(np.arange(8), 10) == 3
+    local = np.where(mode3, rng.standard_normal(80), 0.0)
+    held[mode3] = 0.0  # an error of mode 3 alone, beside what the held columns explain
+    assert held_out_share(Rows(), 30.0 * local + noise, held, local) == 0.0
+
+
+def test_parallel_stiffeners_side_by_side_are_reported_as_one_rib(card):
+    """Two parallel ribs within reach are one rib fitted as shares: their stiffnesses add and the
+    path lies between them, weighted; a crossing rib stays apart."""
+    from pcbdyn.diagnosis.pipeline import _merged, _neighbours
+
+    m, cands = card
+    layout = dg.from_model(m)
+    rib = dg.kind("stiffener")
+    a = rib.candidate(layout, "x=60mm", np.array([0.06, 0.0]), np.array([0.06, 0.18]))
+    b, cross = rib.parallel(layout, a, [0.01])[0], rib.candidate(layout, "y=90mm", np.array([0.0, 0.09]),
+                                                                    np.array([0.16, 0.09]))
+    groups = _neighbours([a, b, cross], 0.02)
+    assert sorted(map(sorted, groups)) == [[0, 1], [2]]
+    d = _merged([a, b, cross], np.array([3.0, 1.0, 2.0]), np.zeros((0, 0)), [0, 1])
+    assert d["magnitude"] == pytest.approx(4.0)
+    assert np.allclose(np.asarray(d["path_mm"])[:, 0], 62.5)
+
+
+def test_overlapping_regions_are_reported_as_one_with_their_mean_change(card):
+    """Two overlapping rectangles fitted to one stiffened region are one effect: the bounding
+    rectangle, with the stiffness change they add over it (area-weighted)."""
+    from pcbdyn.diagnosis.pipeline import _merged, _neighbours
+
+    m, _ = card
+    layout = dg.from_model(m)
+    region = dg.kind("region_stiffness")
+    a, b = region.rectangle(layout, 0.02, 0.02, 0.06, 0.06), region.rectangle(layout, 0.04, 0.04, 0.08, 0.08)
+    far = region.rectangle(layout, 0.10, 0.10, 0.14, 0.14)
+    assert sorted(map(sorted, _neighbours([a, b, far], 0.02))) == [[0, 1], [2]]
+    d = _merged([a, b], np.array([2.0, 1.0]), np.zeros((0, 0)), [0, 1])
+    assert np.allclose(np.asarray(d["polygon_mm"]).min(axis=0), [20.0, 20.0])
+    assert np.allclose(np.asarray(d["polygon_mm"]).max(axis=0), [80.0, 80.0])
+    assert d["magnitude"] == pytest.approx((2.0 * 16.0 + 1.0 * 16.0) / 36.0)

@@ -1,0 +1,220 @@
+"""Hold-out modal data from an independent FE code: a :class:`pcbdyn.fe.Model` converted to
+OpenSees (openseespy) and solved there, so that pcbdyn's diagnosis can be tested on modes that
+pcbdyn's own elements and solver never produced.
+
+Conversion (OpenSees node tag = pcbdyn node index + 1; the model's fixed DOFs become ``fix``):
+
+- quad4 / tri3 shells: ``ShellDKGQ`` / ``ShellDKGT`` by default, or ``ShellMITC4`` (with
+  ``ShellDKGT``) or ``ASDShellQ4`` (with ``ASDShellT3``), on an ``ElasticMembranePlateSection``
+  with rho_eff = rho + nsm / t. A ``ScaledShell`` (stiffness x factor, mass unchanged) is
+  E x factor with rho unchanged. Shell mass is translational only (no rotary inertia
+  rho t^3 / 12). DKGQ is a Kirchhoff plate (no transverse shear, unlike pcbdyn's shell): on the
+  free card it is 0.2-1.3 % stiffer than pcbdyn, and stays so with mesh refinement (twist near
+  free edges); ASDShellQ4 reproduces pcbdyn to 0.1 %.
+- beam2: ``elasticBeamColumn`` (``ElasticTimoshenkoBeam`` if shear areas are given) with
+  consistent mass rho A, local axes through ``vecxz`` = pcbdyn's local z (OpenSees: y = vecxz x x,
+  so OpenSees' y, z and Iy, Iz are pcbdyn's). An offset section runs between extra axis nodes at
+  node + offset, each tied to its node by ``rigidLink('beam')`` (OpenSees' ``-jntOffset`` offsets
+  the stiffness but leaves the mass at the nodes). Not modelled: the section's rotary inertia in
+  bending and torsion (pcbdyn keeps rho (Iy + Iz)), so a bare beam lacks its torsion modes.
+- spring: ``zeroLength`` to a new fixed node (1-node cells) or between the nodes (2-node cells),
+  one ``Elastic`` material per nonzero term in the spring's principal axes (a 6x6 k must have
+  no translation-rotation coupling).
+- edge_spring: LUMPED, k L / 2 per cell end as a ``zeroLength`` to ground oriented in the edge
+  frame (pcbdyn integrates it consistently along the edge).
+- mass: m on the body's node; its rotary inertia shared equally, as nodal rotary inertia, by the
+  nodes of its footprint (pcbdyn ties the body to the least-squares rigid motion of the
+  footprint; one node's rotations alone would carry a large inertia as a local rocking mode on
+  a fine mesh).
+- embedded_beam2 and multi-point constraints: not supported (NotImplementedError).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import openseespy.opensees as ops
+
+SHELLS = {"ShellDKGQ": "ShellDKGT", "ShellMITC4": "ShellDKGT", "ASDShellQ4": "ASDShellT3"}
+RIGID_HZ = 1.0  # free models: modes below this are rigid-body modes
+
+
+class _Tags:
+    def __init__(self):
+        self.n = 0
+
+    def __call__(self) -> int:
+        self.n += 1
+        return self.n
+
+
+def _shell_section(prop, tag: int) -> None:
+    factor = 1.0
+    if hasattr(prop, "base") and hasattr(prop, "factor"):  # pcbdyn.board.effects.ScaledShell
+        prop, factor = prop.base, prop.factor
+    for a in ("E", "nu", "rho", "t"):
+        if not hasattr(prop, a):
+            raise NotImplementedError(f"shell property {type(prop).__name__} is not an isotropic ShellProperty")
+    ops.section("ElasticMembranePlateSection", tag, prop.E * factor, prop.nu, prop.t,
+                prop.rho + getattr(prop, "nsm", 0.0) / prop.t)
+
+
+def _ground(xyz, ground_tag: _Tags) -> int:
+    t = ground_tag()
+    ops.node(t, *np.asarray(xyz, float).tolist())
+    ops.fix(t, 1, 1, 1, 1, 1, 1)
+    return t
+
+
+def _zero_length(tags, mat_tags, nodes, k6, R) -> None:
+    """zeroLength between ``nodes`` with stiffness k6 (6,) along the rows of R (local x, y, z)."""
+    dirs = [i for i in range(6) if k6[i] != 0.0]
+    if not dirs:
+        return
+    mats = []
+    for i in dirs:
+        mats.append(mat_tags())
+        ops.uniaxialMaterial("Elastic", mats[-1], float(k6[i]))
+    ops.element("zeroLength", tags(), *nodes, "-mat", *mats, "-dir", *[i + 1 for i in dirs],
+                "-orient", *R[0].tolist(), *R[1].tolist())
+
+
+def _principal(k) -> list:
+    """[(k6, R)]: a spring's diagonal values and local axes (rows of R)."""
+    k = np.asarray(k, dtype=float)
+    if k.shape == (6,):
+        return [(k, np.eye(3))]
+    if np.any(k[:3, 3:] != 0.0):
+        raise NotImplementedError("spring with translation-rotation coupling")
+    out = []
+    for blk, sl in ((k[:3, :3], slice(0, 3)), (k[3:, 3:], slice(3, 6))):
+        w, V = np.linalg.eigh(blk)
+        k6 = np.zeros(6)
+        k6[sl] = w
+        out.append((k6, V.T))
+    return out
+
+
+def _beams(model, es, ele, trf, extra) -> None:
+    """Beam cells on axis nodes at node + offset, each tied to its node by a rigid link (OpenSees'
+    ``-jntOffset`` leaves the element mass at the nodes, which is wrong for an offset rib)."""
+    p, X = es.prop, model.nodes
+    G = p.E / (2.0 * (1.0 + p.nu))
+    off = np.asarray(p.offset, dtype=float)
+    axis = {}
+    for a in np.unique(es.conn):
+        if np.any(off != 0.0):
+            axis[a] = extra()
+            ops.node(axis[a], *(X[a] + off).tolist())
+            ops.rigidLink("beam", int(a) + 1, axis[a])
+        else:
+            axis[a] = int(a) + 1
+    for c in es.conn:
+        x = X[c[1]] - X[c[0]]
+        x /= np.linalg.norm(x)
+        y = np.asarray(p.orientation, float) - (x @ p.orientation) * x
+        z = np.cross(x, y / np.linalg.norm(y))  # pcbdyn's local z, in OpenSees' local x-z plane
+        t = trf()
+        ops.geomTransf("Linear", t, *z.tolist())
+        ends = [axis[c[0]], axis[c[1]]]
+        if p.shear_area_y or p.shear_area_z:
+            Ay = p.shear_area_y or 1e6 * p.A  # None: no shear flexibility in that plane
+            Az = p.shear_area_z or 1e6 * p.A
+            ops.element("ElasticTimoshenkoBeam", ele(), *ends, p.E, G, p.A, p.J, p.Iy, p.Iz, Ay, Az, t,
+                        "-mass", p.rho * p.A, "-cMass")
+        else:
+            ops.element("elasticBeamColumn", ele(), *ends, p.A, p.E, G, p.J, p.Iy, p.Iz, t,
+                        "-mass", p.rho * p.A, "-cMass")
+
+
+def build_opensees(model, shell: str = "ShellDKGQ") -> None:
+    """Build ``model`` in the (wiped) OpenSees domain."""
+    if model.mpcs:
+        raise NotImplementedError("multi-point constraints (model.mpcs) are not converted")
+    if shell not in SHELLS:
+        raise ValueError(f"shell must be one of {sorted(SHELLS)}")
+    ops.wipe()
+    ops.model("basic", "-ndm", 3, "-ndf", 6)
+    ops.constraints("Transformation")  # rigid links of offset beams
+    n = model.n_nodes
+    X = model.nodes
+    for i in range(n):
+        ops.node(i + 1, *X[i].tolist())
+    ele, mat, sec, trf = _Tags(), _Tags(), _Tags(), _Tags()
+    ground = _Tags()
+    ground.n = n
+    mass = np.zeros((n, 6))
+    stiff = np.zeros(n, dtype=bool)  # nodes held by some element
+    for es in model.sets.values():
+        conn, prop = es.conn, es.prop
+        if es.etype in ("quad4", "tri3"):
+            s = sec()
+            _shell_section(prop, s)
+            name = shell if es.etype == "quad4" else SHELLS[shell]
+            for c in conn:
+                ops.element(name, ele(), *(c + 1).tolist(), s)
+        elif es.etype == "beam2":
+            _beams(model, es, ele, trf, ground)
+        elif es.etype == "spring":
+            for k6, R in _principal(prop.k):
+                for c in conn:
+                    nodes = [int(c[0]) + 1, _ground(X[c[0]], ground)] if c.size == 1 else (c + 1).tolist()
+                    _zero_length(ele, mat, nodes, k6, R)
+        elif es.etype == "edge_spring":
+            k = np.asarray(prop.k, dtype=float)
+            for c in conn:
+                d = X[c[1]] - X[c[0]]
+                L = np.linalg.norm(d)
+                e1 = d / L
+                e3 = np.asarray(prop.normal, float) - (e1 @ prop.normal) * e1
+                e3 /= np.linalg.norm(e3)
+                R = np.stack([e1, np.cross(e3, e1), e3])
+                for a in c:
+                    _zero_length(ele, mat, [int(a) + 1, _ground(X[a], ground)], 0.5 * L * k, R)
+        elif es.etype == "mass":
+            J = np.asarray(prop.inertia, float)
+            J = np.diag(J) if J.ndim == 1 else J
+            if np.any(J != np.diag(np.diag(J))):
+                raise NotImplementedError("mass with off-diagonal inertia")
+            J = np.diag(J)
+            for c in conn:  # a footprint cell lists the body's own node first
+                mass[c[0], :3] += prop.m
+                mass[c, 3:] += J / c.size
+        elif es.etype == "embedded_beam2":
+            raise NotImplementedError("embedded_beam2 is not converted")
+        else:
+            raise NotImplementedError(f"element type {es.etype}")
+        if es.etype != "mass":
+            stiff[np.unique(conn)] = True
+    for i in np.flatnonzero(mass.any(axis=1)):
+        ops.mass(int(i) + 1, *mass[i].tolist())
+    flags = np.zeros((n, 6), dtype=int)
+    fixed = np.fromiter(model.fixed, dtype=np.int64, count=len(model.fixed))
+    flags.flat[fixed] = 1
+    loose = ~stiff & mass.any(axis=1)
+    if np.any(loose):
+        raise ValueError(f"nodes {np.flatnonzero(loose)[:5].tolist()} carry mass but no element")
+    flags[~stiff] = 1  # nodes of no element: held (their shapes are zero)
+    for i in np.flatnonzero(flags.any(axis=1)):
+        ops.fix(int(i) + 1, *flags[i].tolist())
+
+
+def solve_opensees(model, n_modes: int, shell: str = "ShellDKGQ", solver: str = "-genBandArpack"):
+    """(frequencies [Hz] (n_modes,), shapes (n_nodes, 6, n_modes), not mass-normalised) of the
+    first ``n_modes`` elastic modes of ``model`` computed by OpenSees (ARPACK, MUMPS factorisation);
+    a free model's rigid-body modes (below ``RIGID_HZ``) are dropped."""
+    build_opensees(model, shell)
+    # MUMPS: fastest measured (UmfPack, ProfileSPD 4-5x slower, BandGen 2x); with the default
+    # system, DKGQ's massless drilling DOFs gave spurious modes
+    ops.system("Mumps")
+    n_ask = n_modes + (6 if model.free else 0)
+    lam = np.asarray(ops.eigen(solver, n_ask), dtype=float)
+    f = np.sqrt(np.abs(lam)) / (2.0 * np.pi)
+    keep = np.flatnonzero(f >= RIGID_HZ if model.free else np.ones(f.size, bool))[:n_modes]
+    if keep.size < n_modes:
+        raise RuntimeError(f"OpenSees gave {keep.size} elastic modes of {n_modes} wanted: {f}")
+    shapes = np.zeros((model.n_nodes, 6, keep.size))
+    for j, m in enumerate(keep):
+        for i in range(model.n_nodes):
+            shapes[i, :, j] = ops.nodeEigenvector(i + 1, int(m) + 1)
+    ops.wipe()
+    return f[keep], shapes

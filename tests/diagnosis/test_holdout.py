@@ -1,0 +1,83 @@
+"""Issue 7 acceptance on hold-out data (:mod:`holdout_cases`): ``pcbdyn diagnose`` on modal tests
+computed by another FE code (OpenSees, Kirchhoff plate elements) on a mesh four times finer than
+the model's, with the bench's noise (0.2 % frequency, 2 % shape), judged as the bench is
+(:func:`test_diagnose_bench.judge`): the effect's type, place and size, the error after, and no
+effect on noise-only data. On noise-only data the two codes' models still differ (plate theory,
+how a body with rotary inertia is attached) by more than the stated noise where configurations
+carry large masses, so diagnose may say the residual is not noise (``noise_only`` false), but it
+must not invent an effect for it."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import bench_cases as bc  # noqa: E402
+import holdout_cases as hc  # noqa: E402
+from test_diagnose_bench import judge, run_diagnose  # noqa: E402
+
+
+def make_holdout(case, folder: Path):
+    """(board.toml handed to diagnose, [UFF per configuration], truth dict) in ``folder``: the
+    stored clean modes of ``holdout/<case>.json`` with the case's noise (fixed seeds)."""
+    from pcbdyn.fe.modal import Modes as ModelModes
+    from pcbdyn.testdata.data import Dofs, Points
+    from pcbdyn.testdata.noise import Noise
+    from pcbdyn.testdata.simulate import simulate_test
+    from pcbdyn.testdata.uff import write_uff
+
+    data = json.loads((hc.HERE / f"{case.name}.json").read_text())
+    folder.mkdir(parents=True, exist_ok=True)
+    board = folder / "board.toml"
+    board.write_text(bc.handed_text(case))
+    xy = 1e-3 * np.asarray(data["points_mm"], float)
+    ids = np.arange(1, len(xy) + 1)
+    points = Points(ids, np.column_stack([xy, np.zeros(len(xy))]))
+    dofs = Dofs(ids, np.tile([0.0, 0.0, 1.0], (len(ids), 1)))
+    uffs = []
+    for k, cfg in enumerate(case.configs):
+        c = data["configs"][cfg or "base"]
+        shapes = np.asarray(c["shapes_z"], float)
+        modes = ModelModes(np.asarray(c["frequencies_hz"], float), shapes, np.zeros((len(ids), 0)), None)
+        test = simulate_test(modes, points, dofs, np.eye(len(ids)), zeta=0.01,
+                             noise=Noise(frequency_pct=case.noise[0], shape_pct=case.noise[1]),
+                             seed=1000 * case.seed + k)
+        uffs.append(folder / f"test_{cfg or 'base'}.uff")
+        write_uff(uffs[-1], test)
+    return board, uffs, data
+
+
+#: hold-out cases diagnose misses today, and why (strict: a fix turns them into passes)
+KNOWN: dict = {
+    "ho_spring_wedge": "standoff found in place and size; 0.501 % after (limit 0.5 %): the guided card's code-to-code "
+                       "floor is 0.29 % (ho_noise_wedge)",
+    "ho_rib_card": "rib found in place and size; 0.60 % after, at the card's code-to-code floor: with no effect at "
+                   "all, the declared parameters leave 0.65 % (ho_noise_card)",
+    "ho_line_mass_card": "connector found in place and size; 0.62 % after, at the card's code-to-code floor "
+                         "(0.65 % on ho_noise_card)",
+    "ho_transducer_cfg": "transducer found in place and size; 1.8 % after: the configurations' large bodies with "
+                         "rotary inertia are attached differently in the two codes (0.93 % with no effect, "
+                         "ho_noise_card_cfg)",
+}
+
+
+def cases():
+    return [pytest.param(c, id=c.name, marks=[pytest.mark.xdist_group(c.name)] + (
+        [pytest.mark.xfail(strict=True, reason=KNOWN[c.name])] if c.name in KNOWN else [])) for c in hc.CASES]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("case", cases())
+def test_diagnose_holdout(case, tmp_path):
+    board, uffs, truth = make_holdout(case, tmp_path / "case")
+    data = run_diagnose(case, board, uffs, tmp_path)
+    print(json.dumps({k: data.get(k) for k in ("effects", "noise_only", "before", "parameters_only", "after")}, indent=1))
+    bad = judge(case, truth, data)
+    if case.noise_only:
+        bad = [b for b in bad if not b.startswith("noise_only is")]
+    assert not bad, f"{case.name}: " + "; ".join(bad)
