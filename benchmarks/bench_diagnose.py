@@ -1,5 +1,6 @@
 """Diagnosis benchmark (issue 7): ``pcbdyn diagnose`` on every case of the test bench
-(tests/diagnosis/bench_cases.py): wall time per case and the outcome against the acceptance
+(tests/diagnosis/bench_cases.py) and of the hold-out data computed by another FE code
+(tests/diagnosis/holdout_cases.py, names ho_*): wall time per case and the outcome against the acceptance
 (effect type, location within 15 mm, magnitude within 30 %, max frequency error after < 0.5 %
 where the parameters-only update left > 2 %; noise-only cases: nothing reported).
 
@@ -22,7 +23,11 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "diagnosis"))
 
 import bench_cases as bc  # noqa: E402
+import holdout_cases as hc  # noqa: E402
 from test_diagnose_bench import judge, match  # noqa: E402
+from test_holdout import judge_holdout, make_holdout  # noqa: E402
+
+CASES = {**bc.BY_NAME, **hc.BY_NAME}
 
 
 def one(case, out: Path) -> dict:
@@ -31,7 +36,10 @@ def one(case, out: Path) -> dict:
     from pcbdyn.cli import main
 
     t0 = time.perf_counter()
-    board, uffs, truth = bc.make_case(case, out / case.name)
+    if case.name in hc.BY_NAME:
+        board, uffs, truth = make_holdout(case, out / case.name / "case")
+    else:
+        board, uffs, truth = bc.make_case(case, out / case.name)
     t_make = time.perf_counter() - t0
     js = out / case.name / "diagnose.json"
     js.unlink(missing_ok=True)
@@ -45,7 +53,7 @@ def one(case, out: Path) -> dict:
         last = (r.output.strip().splitlines() or [repr(r.exception)])[-1]
         return {**row, "outcome": "ERROR", "why": last[:200]}
     data = json.loads(js.read_text())
-    bad = judge(case, truth, data)
+    bad = (judge_holdout if case.name in hc.BY_NAME else judge)(case, truth, data)
     found = []
     for tr in truth["effects"]:
         e, d = match(data.get("effects", []), tr)
@@ -64,19 +72,19 @@ def fmt(x) -> str:
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--cases", default=None, help="comma-separated case names (default: all): " + ",".join(bc.BY_NAME))
+    ap.add_argument("--cases", default=None, help="comma-separated case names (default: all): " + ",".join(CASES))
     ap.add_argument("--out", default=str(ROOT / "out" / "diagnosis_bench"))
     ap.add_argument("--json", default=None, help="write the rows as JSON")
     a = ap.parse_args(argv)
-    names = a.cases.split(",") if a.cases else list(bc.BY_NAME)
-    unknown = [n for n in names if n not in bc.BY_NAME]
+    names = a.cases.split(",") if a.cases else list(CASES)
+    unknown = [n for n in names if n not in CASES]
     if unknown:
-        ap.error(f"unknown case(s) {unknown}; known: {', '.join(bc.BY_NAME)}")
+        ap.error(f"unknown case(s) {unknown}; known: {', '.join(CASES)}")
     out = Path(a.out)
     print(f"{'case':<26} {'diag [s]':>8} {'before%':>8} {'param%':>7} {'after%':>7} {'#eff':>4}  outcome")
     rows = []
     for n in names:
-        r = one(bc.BY_NAME[n], out)
+        r = one(CASES[n], out)
         rows.append(r)
         print(f"{n:<26} {r['diagnose_s']:>8.1f} {fmt(r.get('before_pct')):>8} {fmt(r.get('params_only_pct')):>7} "
               f"{fmt(r.get('after_pct')):>7} {r.get('n_effects', '-'):>4}  {r['outcome']}"

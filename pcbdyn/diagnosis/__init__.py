@@ -1,6 +1,8 @@
 """Diagnosis: find the effects a model lacks (issue 7). :mod:`.catalogue` is the registry of
 candidate effects (one plugin module per kind), :mod:`.layout` says where they can go,
-:mod:`.select` picks the effects that explain frequency residuals."""
+:mod:`.select` picks the effects that explain frequency residuals, :mod:`.model_form` bounds what
+the mesh and the plate theory leave between model and test, :mod:`.pipeline` runs the whole
+diagnosis."""
 
 from .catalogue import (
     KINDS,

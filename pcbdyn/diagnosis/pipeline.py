@@ -11,8 +11,8 @@ whether what remains is noise, and otherwise find, place and size the effects th
    coarsest meshes (the model's, twice, four times as fine) that resolve the mode (an O(h^2)
    element); what that leaves uncertain, and the shapes' change (4/3 of it), is added to the
    noise in quadrature, so that a coarse mesh is neither mistaken for an effect nor left in the
-   error reported after. So is the plate theory's share of each frequency (Mindlin against
-   Kirchhoff: the board's transverse shear stiffness is a guess).
+   error reported after. So is the plate theory's gap on the finest mesh (Mindlin against
+   Kirchhoff: the board's transverse shear stiffness is a guess; :mod:`.model_form`).
 3. The declared parameters alone are fitted; if chi^2 is within what noise gives (chi-square
    test, probability ``alpha``) the data lie in the range of the model (thesis section 5.2.3) and
    nothing is invented.
@@ -21,7 +21,8 @@ whether what remains is noise, and otherwise find, place and size the effects th
    also predicts data it was not fitted to; runs along the sides, stiffener lines and
    rectangular regions are walked to where they fit best (:func:`.select.refine`,
    :class:`LocalMoves`) and a mass with an inertia beside it refitted as one body
-   (:mod:`.bodies`).
+   (:mod:`.bodies`). Last, the plate theory's share is fitted with the effects found
+   (:func:`.model_form.fit_plate_share`; kept only where significant).
 """
 
 from __future__ import annotations
@@ -38,8 +39,8 @@ from ..fe.probe import model_probe
 from .bodies import as_bodies
 from .catalogue import generate, weighted_centre
 from .layout import from_board
-from ..correlation.mac import mac
-from .residual import ModalResidual, Observation, paired_mac
+from .model_form import MESH_LEVELS, discretisation, fit_plate_share, kirchhoff_shift
+from .residual import ModalResidual, Observation
 from .select import ALPHA, estimate, refine, search, without_vanished
 
 #: where candidates go: sides cut into 16 pieces (every run of consecutive pieces is a candidate);
@@ -89,74 +90,6 @@ def _noise_sigmas(ob: Observation, freq_pct, shape_pct, basis_shapes):
     return sf, np.maximum(np.sqrt(np.mean(var)) / rms, 1e-4)
 
 
-#: a mode is resolved by the model's mesh when the twice finer mesh changes its shape at the
-#: points by less than this (sqrt(1 - MAC)): only then is its frequency change an O(h^2) error
-RESOLVED_SHAPE_CHANGE = 0.02
-
-
-def _follow(model, ob, u_prev, k_prev):
-    """(frequencies, shapes at the points, mode indices, shape change sqrt(1 - MAC)) of ``model``'s
-    modes paired by MAC at the points with the shapes ``u_prev`` (by index ``k_prev`` when there
-    are no measured shapes: no change can be told, it is inf)."""
-    modes = solve_modes(model, n_modes=int(k_prev.max()) + 4)
-    if ob.shapes is None:
-        k = np.minimum(k_prev, modes.frequencies.size - 1)
-        return modes.frequencies[k], None, k, np.full(k.size, np.inf)
-    U = np.asarray(model_probe(model, ob.xyz, ob.directions, tol=0.02).P @ modes.shapes)
-    k = mac(u_prev, U).argmax(axis=1)
-    U = U[:, k]
-    return modes.frequencies[k], U, k, np.sqrt(np.clip(1.0 - paired_mac(U, u_prev), 0.0, None))
-
-
-def _discretisation(finer, ob, coarse_state):
-    """(frequency correction factor, its relative uncertainty, relative shape error, resolved) per
-    paired mode. ``finer``: the model meshed twice, four times, ... as fine, taken one after the
-    other while some mode is not yet resolved (modes paired by MAC at the points, level to level).
-    A mode resolved between two levels (:data:`RESOLVED_SHAPE_CHANGE`) is corrected by Richardson
-    extrapolation of an O(h^2) element from them, f_0 = f_fine + (f_fine - f_coarse) / 3, whose own
-    error (a third of the step) stays as noise; a mode no level resolves (or with no shapes to
-    tell) takes the finest frequency, the last step counted as noise. The shape error is 4/3 of
-    the change from the model's mesh to the next."""
-    f0 = coarse_state.f_a / ob.f_scale
-    f_prev, u_prev, k_prev = f0, coarse_state.u, coarse_state.pairs
-    scale, sigma = np.ones(f0.size), np.zeros(f0.size)
-    resolved, todo, ds = np.zeros(f0.size, bool), np.ones(f0.size, bool), None
-    for model in finer:
-        f, U, k, change = _follow(model, ob, u_prev, k_prev)
-        ok = todo & (change <= RESOLVED_SHAPE_CHANGE)
-        scale = np.where(ok, (f + (f - f_prev) / 3.0) / f0, np.where(todo, f / f0, scale))
-        sigma = np.where(todo, np.abs(f - f_prev) / f0 / np.where(ok, 3.0, 1.0), sigma)
-        resolved |= ok
-        todo &= ~ok
-        if ds is None:
-            ds = np.where(np.isfinite(change), 4.0 / 3.0 * change, 0.0)
-        if not todo.any():
-            break
-        f_prev, u_prev, k_prev = f, U, k
-    return scale, sigma, ds, resolved
-
-
-#: the transverse shear factor (:data:`..components.models.SHEAR_KEY`) of the plate-theory bound:
-#: a shear this much stiffer is a Kirchhoff plate to within 0.1 % of the gap
-KIRCHHOFF_SHEAR = 1000.0
-
-
-def _plate_theory(bm, ob, state) -> np.ndarray:
-    """Relative uncertainty per paired mode of what the plate theory gives: the frequency change
-    of the model ``bm`` (a BoardModel) when its shells' transverse shear is made rigid (Kirchhoff).
-    A board's interlaminar shear modulus is rarely known, and codes differ (Kirchhoff plates,
-    Mindlin shells, solids): twisting modes near free edges move by up to about 1 % on a 2.8 mm
-    card. A model that leaves this to noise takes it neither for an effect nor for a parameter."""
-    from ..components.models import SHEAR_KEY
-
-    f, _, _, _ = _follow(bm.with_quantities({SHEAR_KEY: KIRCHHOFF_SHEAR}).model, ob, state.u, state.pairs)
-    return np.abs(f / (state.f_a / ob.f_scale) - 1.0)
-
-
-#: how many times the mesh is halved at most to correct the model's frequencies for it
-MESH_LEVELS = 2
-
-
 class _BoardModels:
     """The board's configurations on one mesh, as functions of the declared parameters."""
 
@@ -193,28 +126,29 @@ def _observations(tests, bms) -> list:
     return obs
 
 
-def _set_noise(board, models, h, obs, state, freq_pct, shape_pct) -> list:
+def _set_noise(board, models, h, obs, state, freq_pct, shape_pct) -> tuple:
     """Each observation's discretisation correction of the model frequencies, and its sigmas:
-    measurement noise, what remains of the discretisation error and the plate theory's
-    uncertainty, in quadrature. Returns which modes the mesh resolves and the plate-theory
-    uncertainties, per observation."""
-    resolved, theory = [], []
-    for ob, cs, bm in zip(obs, state.configs, models.at(models.p0)):
+    measurement noise, what remains of the discretisation error and the plate theory's gap, in
+    quadrature (:mod:`.model_form`). Returns which modes the mesh resolves and the Kirchhoff
+    shifts and the frequency sigmas without them, per observation."""
+    resolved, shifts, plain = [], [], []
+    p0 = dict(zip(models.names, models.p0.tolist()))
+    for ob, cs in zip(obs, state.configs):
         basis = None
         if ob.shapes is not None:  # rigid-body modes first: a free board's shapes hold them at the points
             wide = solve_modes(cs.model, n_modes=ob.shapes.shape[0] // 2)
             basis = np.asarray(ob.read @ np.column_stack([wide.rigid_shapes, wide.shapes]))
         sf, ss = _noise_sigmas(ob, freq_pct, shape_pct, basis)
-        p0 = dict(zip(models.names, models.p0.tolist()))
-        finer = (build_model(board, ob.name, h / 2**j, shared_mesh=True).with_parameters(p0).model
-                 for j in range(1, MESH_LEVELS + 1))
-        ob.f_scale, df, ds, ok = _discretisation(finer, ob, cs)
-        dt = _plate_theory(bm, ob, cs)
-        ob.sigma_f = np.sqrt(sf**2 + df**2 + dt**2)
+        finer = [build_model(board, ob.name, h / 2**j, shared_mesh=True).with_parameters(p0)
+                 for j in range(1, MESH_LEVELS + 1)]
+        dt = kirchhoff_shift(finer[-1], ob, cs)
+        ob.f_scale, df, ds, ok = discretisation((bm.model for bm in finer), ob, cs)
+        plain.append(np.sqrt(sf**2 + df**2))
+        ob.sigma_f = np.sqrt(plain[-1] ** 2 + dt**2)
         ob.sigma_s = None if ss is None else np.sqrt(ss**2 + ds**2)
         resolved.append(ok.tolist())
-        theory.append(np.round(100 * dt, 4).tolist())
-    return resolved, theory
+        shifts.append(dt)
+    return resolved, shifts, plain
 
 
 def _range_test(res, base, n_params, alpha) -> dict:
@@ -248,13 +182,13 @@ def diagnose(board, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_size=
         res = models.residual(obs)
         before = res.evaluate(p0)
     say("estimating the noise and the model's discretisation error")
-    resolved, theory = _set_noise(board, models, h, obs, before, freq_noise_pct, shape_noise_pct)
+    resolved, shifts, plain = _set_noise(board, models, h, obs, before, freq_noise_pct, shape_noise_pct)
     before = res.evaluate(p0)
     say(f"fitting the {len(names)} declared parameter(s)" if names else "no declared parameters")
     base = estimate(res, p0, [], [], 10, models.bounds)
     stats = {"unpaired_test_modes": unmatched, "chi2_before": before.chi2, **_range_test(res, base, len(names), alpha),
              "mesh_correction_pct": [np.round(100 * (o.f_scale - 1.0), 4).tolist() for o in obs],
-             "mesh_resolved": resolved, "plate_theory_pct": theory,
+             "mesh_resolved": resolved, "plate_theory_pct": [np.round(100 * d, 4).tolist() for d in shifts],
              "sigma_f_pct": [np.round(100 * o.sigma_f, 4).tolist() for o in obs],
              "sigma_shape_pct": [None if o.sigma_s is None else np.round(100 * o.sigma_s, 4).tolist() for o in obs]}
     out = dict(before=before.summary(obs), parameters_only=base.state.summary(obs),
@@ -281,6 +215,9 @@ def diagnose(board, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_size=
         sel = as_bodies(res, cands, sel, _neighbours([cands[i] for i in sel.chosen], MERGE_REACH * h),
                         MERGE_REACH * h, models.bounds, alpha=alpha)
     sel = without_vanished(res, cands, sel, models.bounds, alpha=alpha)
+    say("fitting the plate theory's share with the effects")
+    sel, theta, theta_sigma = fit_plate_share(res, cands, sel, shifts, plain, models.bounds, alpha=alpha)
+    stats.update(plate_theory_share=theta, plate_theory_share_sigma=theta_sigma)
     stats.update(chi2_after=sel.chi2[-1], candidates=len(cands))
     for n, v in zip(names, sel.p):
         out["parameters"][n]["final"] = float(v)

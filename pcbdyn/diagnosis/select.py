@@ -171,7 +171,7 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
             break
         idx = sel.chosen + [int(order[best])]
         new = estimate(res, fit.p, [candidates[i] for i in idx], fits[best].values, newton_steps, bounds)
-        if not _worth(sel.chi2[-1], new.chi2, n, p0.size + len(idx), pen):
+        if not worth(sel.chi2[-1], new.chi2, n, p0.size + len(idx), pen):
             break
         if held_out_share(res, st.r, held, A[:, idx[-1]]) < HELD_OUT_SHARE:
             break
@@ -238,7 +238,7 @@ def refine(res, candidates, sel: Selection, neighbours, bounds=None, newton_step
     return adopt(sel, *_prune(res, candidates, idx, fit, newton_steps, bounds, pen, n_par), pen)
 
 
-def _worth(chi2_before, chi2_after, n, k, pen) -> bool:
+def worth(chi2_before, chi2_after, n, k, pen) -> bool:
     """The drop exceeds the penalty in stated noise units and in units of the variance left."""
     drop = chi2_before - chi2_after
     return drop > pen and drop / max(chi2_after / max(n - k, 1), 1.0) > pen

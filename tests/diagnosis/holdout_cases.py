@@ -1,13 +1,14 @@
 """Hold-out diagnosis cases: modal data from a different FE code at a much finer mesh.
 
-The bench of :mod:`bench_cases` makes its data with pcbdyn's own elements (at half the model's
-mesh). These cases guard against a diagnosis tuned to its own engine: the true boards (the
+The bench of :mod:`bench_cases` makes its data with pcbdyn's own elements (at a quarter of the
+model's mesh). These cases guard against a diagnosis tuned to its own engine: the true boards (the
 example boards with their declared parameters off the nominal values and the hidden effect
 declared as a board entry) are meshed four times finer than the model and solved in OpenSees with
 its Kirchhoff plate element ShellDKGQ (:mod:`opensees_truth`), whose free-edge twisting modes
 differ from pcbdyn's Mindlin shell by up to about 1 % however fine the mesh: a model-form error
 that no declared parameter absorbs entirely, as between any two FE codes or a code and a real
-board. Places and magnitudes differ from the bench's.
+board (the diagnosis fits the plate theory's share last, :mod:`pcbdyn.diagnosis.model_form`).
+Places and magnitudes differ from the bench's.
 
     python tests/diagnosis/holdout_cases.py [--cases a,b]
 

@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from pcbdyn.board import build_model, load_board
-from pcbdyn.diagnosis.pipeline import _BoardModels, _discretisation
+from pcbdyn.diagnosis.model_form import discretisation
+from pcbdyn.diagnosis.pipeline import _BoardModels
 from pcbdyn.diagnosis.residual import Observation
 from pcbdyn.fe.modal import solve_modes
 from pcbdyn.fe.probe import model_probe
@@ -35,7 +36,7 @@ def correction(board, config, reference_mesh):
     state = models.residual([ob]).evaluate(models.p0).configs[0]
     p = dict(zip(models.names, models.p0.tolist()))
     fine = build_model(board, config, board.mesh_size / 2.0, shared_mesh=True).with_parameters(p).model
-    scale, sigma, _, resolved = _discretisation([fine], ob, state)
+    scale, sigma, _, resolved = discretisation([fine], ob, state)
     return state.f_a, scale, sigma, resolved, rm.frequencies
 
 

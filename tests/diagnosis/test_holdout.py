@@ -52,16 +52,20 @@ def make_holdout(case, folder: Path):
     return board, uffs, data
 
 
+def judge_holdout(case, truth: dict, data: dict) -> list:
+    """:func:`test_diagnose_bench.judge`, except that noise-only data need not be called noise (the
+    codes' own difference may exceed the stated noise), only left without effects."""
+    bad = judge(case, truth, data)
+    return [b for b in bad if not b.startswith("noise_only is")] if case.noise_only else bad
+
+
 #: hold-out cases diagnose misses today, and why (strict: a fix turns them into passes)
 KNOWN: dict = {
-    "ho_spring_wedge": "standoff found in place and size; 0.501 % after (limit 0.5 %): the guided card's code-to-code "
-                       "floor is 0.29 % (ho_noise_wedge)",
-    "ho_rib_card": "rib found in place and size; 0.60 % after, at the card's code-to-code floor: with no effect at "
-                   "all, the declared parameters leave 0.65 % (ho_noise_card)",
-    "ho_line_mass_card": "connector found in place and size; 0.62 % after, at the card's code-to-code floor "
-                         "(0.65 % on ho_noise_card)",
+    "ho_rib_card": "rib found in place and size (x = 111.4 mm, EI 0.817 N m^2); 0.60 % after with the plate "
+                   "theory's share fitted (0 +- 0.2): the codes' ribs differ (here a linear Timoshenko beam "
+                   "embedded in the Mindlin shell, there OpenSees' beam on Kirchhoff plates)",
     "ho_transducer_cfg": "transducer found in place and size; 1.8 % after: the configurations' large bodies with "
-                         "rotary inertia are attached differently in the two codes (0.93 % with no effect, "
+                         "rotary inertia are attached differently in the two codes (1.1 % with no effect, "
                          "ho_noise_card_cfg)",
 }
 
@@ -77,7 +81,5 @@ def test_diagnose_holdout(case, tmp_path):
     board, uffs, truth = make_holdout(case, tmp_path / "case")
     data = run_diagnose(case, board, uffs, tmp_path)
     print(json.dumps({k: data.get(k) for k in ("effects", "noise_only", "before", "parameters_only", "after")}, indent=1))
-    bad = judge(case, truth, data)
-    if case.noise_only:
-        bad = [b for b in bad if not b.startswith("noise_only is")]
+    bad = judge_holdout(case, truth, data)
     assert not bad, f"{case.name}: " + "; ".join(bad)
