@@ -229,6 +229,10 @@ def diagnose(board, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_size=
     else:
         msg = ("the residual exceeds the noise but no candidate effect explains it beyond chance: "
                "nothing is reported (check the noise level, the pairing and the declared parameters)")
+    if theta > 0.0:
+        msg += (f"; the frequencies lie {100 * theta:.0f} +- {100 * theta_sigma:.0f} % of the way from the declared "
+                "Mindlin shells to the Kirchhoff limit (statistics.plate_theory_share): the board's transverse shear "
+                "is stiffer than declared (board.transverse_shear can be updated as a parameter)")
     if any(unmatched.values()):
         msg += f"; test modes with no model partner (MAC < 0.3), left out of the fit: {unmatched}"
     return Diagnosis(effects, False, msg, after=sel.state.summary(obs), evidence=_evidence(res, base.state, cands),
