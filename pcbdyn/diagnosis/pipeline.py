@@ -271,6 +271,8 @@ class LocalMoves:
 
     def __init__(self, layout, cands: list, h: float):
         self.layout, self.cands, self.h = layout, cands, h
+        plate = layout.xy[layout.shell_nodes()]
+        self.lo, self.hi = plate.min(axis=0), plate.max(axis=0)
         self.index = {c.name: k for k, c in enumerate(cands)}
         self.runs: dict = {}
         for k, c in enumerate(cands):
@@ -298,8 +300,7 @@ class LocalMoves:
         if LINE.match(c.name):
             return self._add(kind("stiffener").parallel(self.layout, c, LINE_STEP * self.h * np.array([-1.0, 1.0])))
         if (box := _rectangle(c)) is not None:
-            lo, hi = self.layout.xy[self.layout.shell_nodes()].min(axis=0), self.layout.xy[self.layout.shell_nodes()].max(axis=0)
-            step, made = RECT_STEP * self.h, []
+            lo, hi, step, made = self.lo, self.hi, RECT_STEP * self.h, []
             for side in range(4):
                 for d in (-step, step):
                     b = np.array(box)
@@ -342,22 +343,21 @@ def _linked(a, b, reach: float) -> bool:
         return _segment_gap(a.geometry["segment"], b.geometry["segment"]) <= reach
     if {a.kind, b.kind} == {"point_mass", "line_mass"}:
         line, point = (a, b) if a.kind == "line_mass" else (b, a)
-        p0, p1 = np.asarray(line.geometry["segment"], float)
-        t = np.clip(np.dot(np.subtract(point.at, p0), p1 - p0) / max(np.dot(p1 - p0, p1 - p0), 1e-300), 0.0, 1.0)
-        return np.linalg.norm(p0 + t * (p1 - p0) - np.asarray(point.at)) <= reach
+        return _to_segment(np.asarray(point.at, float)[:2], np.asarray(line.geometry["segment"], float)) <= reach
     return False
+
+
+def _to_segment(p, seg) -> float:
+    """Distance [m] from point ``p`` to the straight segment ``seg`` (2, 2)."""
+    d = seg[1] - seg[0]
+    u = np.clip(np.dot(p - seg[0], d) / max(np.dot(d, d), 1e-300), 0.0, 1.0)
+    return float(np.linalg.norm(seg[0] + u * d - p))
 
 
 def _segment_gap(s, t) -> float:
     """Shortest distance [m] between two straight segments (0 where they overlap or cross)."""
     s, t = np.asarray(s, float), np.asarray(t, float)
-
-    def to_segment(p, seg):
-        d = seg[1] - seg[0]
-        u = np.clip(np.dot(p - seg[0], d) / max(np.dot(d, d), 1e-300), 0.0, 1.0)
-        return float(np.linalg.norm(seg[0] + u * d - p))
-
-    return min([to_segment(p, t) for p in s] + [to_segment(p, s) for p in t])
+    return min([_to_segment(p, t) for p in s] + [_to_segment(p, s) for p in t])
 
 
 def _neighbours(chosen, reach: float) -> list:
@@ -377,32 +377,29 @@ def _merged(chosen, values, cov, group) -> dict:
     """One effect entry (JSON-ready) for a group: the magnitudes summed at their weighted centre (on
     line masses: the place and extent of the largest; parallel stiffeners: their weighted mean
     path; overlapping regions: the area-weighted mean change over their bounding rectangle), the
-    uncertainty of the sum from the fit's covariance."""
+    uncertainty of that combination from the fit's covariance."""
     lines = [k for k in group if chosen[k].kind == "line_mass"]
     c = chosen[max(lines, key=lambda k: values[k]) if lines else group[0]]
     d = c.describe()
     v = np.asarray(values, float)[group]
+    w = np.ones(v.size)  # the combination reported: a sum, or for regions an area-weighted mean
     if len(group) > 1:
-        if not lines:
-            d["at_mm"] = np.round(1e3 * weighted_centre([chosen[k] for k in group], v), 3).tolist()
-        if c.kind == "stiffener":
-            w = v / v.sum() if v.sum() > 0 else np.full(v.size, 1.0 / v.size)
-            paths = np.array([np.asarray(chosen[k].geometry["path"], float)[[0, -1]] for k in group])
-            d["path_mm"] = np.round(1e3 * np.einsum("g,gij->ij", w, paths), 3).tolist()
-        if c.kind == "region_stiffness":  # the mean change over the union's bounding rectangle
+        d["name"] = "+".join(chosen[k].name for k in group)
+        d["merged_at_mm"] = np.round(1e3 * np.array([chosen[k].at for k in group]), 3).tolist()
+        if c.kind == "region_stiffness":
             boxes = np.array([_rectangle(chosen[k]) for k in group])
             x0, y0, x1, y1 = (*boxes[:, :2].min(axis=0), *boxes[:, 2:].max(axis=0))
             w = (boxes[:, 2] - boxes[:, 0]) * (boxes[:, 3] - boxes[:, 1]) / ((x1 - x0) * (y1 - y0))
             d["polygon_mm"] = np.round(1e3 * np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]]), 3).tolist()
             d["at_mm"] = np.round(1e3 * np.array([x0 + x1, y0 + y1]) / 2.0, 3).tolist()
-            var = float(w @ cov[np.ix_(group, group)] @ w) if cov.size else 0.0
-            d.update(name="+".join(chosen[k].name for k in group), magnitude=float(w @ v),
-                     uncertainty=float(np.sqrt(max(var, 0.0))), kind=c.kind)
-            return d
-        d["name"] = "+".join(chosen[k].name for k in group)
-        d["merged_at_mm"] = np.round(1e3 * np.array([chosen[k].at for k in group]), 3).tolist()
-    var = float(np.sum(cov[np.ix_(group, group)])) if cov.size else 0.0
-    d.update(magnitude=float(v.sum()), uncertainty=float(np.sqrt(max(var, 0.0))), kind=c.kind)
+        elif not lines:
+            d["at_mm"] = np.round(1e3 * weighted_centre([chosen[k] for k in group], v), 3).tolist()
+        if c.kind == "stiffener":
+            share = v / v.sum() if v.sum() > 0 else np.full(v.size, 1.0 / v.size)
+            paths = np.array([np.asarray(chosen[k].geometry["path"], float)[[0, -1]] for k in group])
+            d["path_mm"] = np.round(1e3 * np.einsum("g,gij->ij", share, paths), 3).tolist()
+    var = float(w @ cov[np.ix_(group, group)] @ w) if cov.size else 0.0
+    d.update(magnitude=float(w @ v), uncertainty=float(np.sqrt(max(var, 0.0))), kind=c.kind)
     return d
 
 
