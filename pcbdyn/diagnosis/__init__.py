@@ -14,9 +14,10 @@ from .catalogue import (
     frequency_columns,
     generate,
     kind,
+    place,
 )
 from .layout import Layout, from_board, from_model
 from .select import Selection, forward_select
 
-__all__ = ["KINDS", "Candidate", "CatalogueError", "Layout", "Selection", "add_effect", "derivatives",
+__all__ = ["KINDS", "Candidate", "CatalogueError", "Layout", "Selection", "add_effect", "derivatives", "place",
            "eigenvalue_columns", "forward_select", "frequency_columns", "from_board", "from_model", "generate", "kind"]

@@ -11,7 +11,9 @@ plugin module of this package exposing an object (registered in :data:`KINDS`) w
 - ``generate(layout, **options) -> [Candidate]``: candidates on a mesh (:mod:`.layout`);
 - ``blocks(model, candidates) -> [Blocks]``: element matrices of dK/dp and dM/dp of all the
   candidates at once, vectorised over cells;
-- ``apply(model, candidate, value) -> Model``: a copy of the model carrying the effect.
+- ``apply(model, candidate, value) -> Model``: a copy of the model carrying the effect;
+- ``place(layout, candidate) -> Candidate``: the same effect (place and extent) on another
+  mesh's layout (a finer mesh, as a test bench's truth model is).
 
 Every effect enters K and M linearly in its parameter, so dK/dp and dM/dp are exact and the
 same at every value, and the first-order eigenvalue sensitivity (thesis eq. 3.11 with k = i)
@@ -135,6 +137,11 @@ def add_effect(model, candidate, value: float):
     return candidate.spec.apply(model, candidate, float(value))
 
 
+def place(layout, candidate) -> Candidate:
+    """``candidate`` (made on some mesh) placed on ``layout``'s mesh, under the same name."""
+    return replace(candidate.spec.place(layout, candidate), name=candidate.name, prime=candidate.prime)
+
+
 def bilinear_forms(model, basis: np.ndarray, shapes: np.ndarray, candidates):
     """(BK, BM), each (n_candidates, n_basis, n_shapes): phi_k^T dK/dp phi_i and phi_k^T dM/dp phi_i
     for full-length ``basis`` columns k and ``shapes`` columns i, summed over each candidate's
@@ -209,6 +216,12 @@ def node_candidates(kind_name: str, layout, spacing: float | None = None) -> lis
     xy = layout.xy
     return [Candidate(kind_name, f"{kind_name}@{prime.get(int(n), f'n{n}')}", tuple(xy[n]), np.array([n]),
                       prime=int(n) in prime) for n in nodes]
+
+
+def on_nearest_node(layout, candidate) -> Candidate:
+    """``candidate`` (of one node) on the node of ``layout`` nearest to its point, at that node."""
+    n = layout.nearest_node(candidate.at)
+    return replace(candidate, at=tuple(layout.xy[n]), nodes=np.array([n]))
 
 
 def weighted_centre(candidates, values) -> np.ndarray:

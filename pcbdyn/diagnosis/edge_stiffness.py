@@ -28,6 +28,10 @@ class _EdgeStiffness:
         return [chain_candidate(self.name, layout, f"{side}[{i}]", chain)
                 for side, i, chain in layout.segment_runs(segments)]
 
+    def place(self, layout, candidate):
+        """Along the side nearest to ``candidate``'s segment."""
+        return chain_candidate(self.name, layout, "placed", layout.side_chain(candidate.geometry["segment"]))
+
     def blocks(self, model, candidates) -> list:
         edges = [c.data["edges"] for c in candidates]
         conn = np.concatenate(edges)

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..fe import SpringProperty
-from .catalogue import Blocks, copy_model, node_candidates
+from .catalogue import Blocks, copy_model, node_candidates, on_nearest_node
 
 
 class _GroundSpring:
@@ -20,6 +20,9 @@ class _GroundSpring:
 
     def generate(self, layout, spacing: float | None = None) -> list:
         return node_candidates(self.name, layout, spacing)
+
+    def place(self, layout, candidate):
+        return on_nearest_node(layout, candidate)
 
     def blocks(self, model, candidates) -> list:
         nodes = np.array([c.nodes[0] for c in candidates], dtype=np.int64)

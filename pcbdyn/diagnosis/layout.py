@@ -88,6 +88,28 @@ class Layout:
                     out.append((name, f"{i}" if i == j else f"{i}-{j}", run))
         return out
 
+    def nearest_node(self, xy) -> int:
+        """The shell node nearest to the point ``xy`` [m]."""
+        nodes = self.shell_nodes()
+        return int(nodes[np.linalg.norm(self.xy[nodes] - np.asarray(xy, float), axis=1).argmin()])
+
+    def side_chain(self, segment, tol: float = 0.01) -> np.ndarray:
+        """The node chain of the side (or support line) that runs nearest to both ends of
+        ``segment`` [[x, y], [x, y]] [m], from the node nearest one end to the node nearest the
+        other; ValueError when no side passes within ``tol`` [m] of the ends."""
+        a, b = (np.asarray(p, float) for p in segment)
+        best = None
+        for chain in self.sides.values():
+            p = self.xy[chain]
+            da, db = np.linalg.norm(p - a, axis=1), np.linalg.norm(p - b, axis=1)
+            if best is None or da.min() + db.min() < best[0]:
+                i, j = sorted((int(da.argmin()), int(db.argmin())))
+                best = (da.min() + db.min(), chain[i:j + 1])
+        if best is None or best[0] > tol or best[1].size < 2:
+            raise ValueError(f"the segment {np.round(1e3 * np.array([a, b]), 2).tolist()} mm does not run along a "
+                             "side or support line of the plate")
+        return best[1]
+
     def cells_in(self, polygon) -> list:
         """[(set name, cell indices)] of the shell cells whose centroid lies in ``polygon`` [m]."""
         path = PolyPath(np.asarray(polygon, dtype=float))

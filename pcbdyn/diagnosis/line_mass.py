@@ -23,6 +23,10 @@ class _LineMass:
         return [chain_candidate(self.name, layout, f"{side}[{i}]", chain)
                 for side, i, chain in layout.segment_runs(segments)]
 
+    def place(self, layout, candidate):
+        """Along the side nearest to ``candidate``'s segment."""
+        return chain_candidate(self.name, layout, "placed", layout.side_chain(candidate.geometry["segment"]))
+
     def blocks(self, model, candidates) -> list:
         nodes = np.concatenate([c.nodes for c in candidates])
         w = np.concatenate([tributary_weights(model.nodes[c.nodes, :2]) for c in candidates])

@@ -9,12 +9,14 @@ eq. 3.11 with k = i and dK = 0 gives d lambda_i / dm = -lambda_i |phi_i(node)|^2
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from ..fe import MassProperty
 from ..fe.elements.discrete import mass_matrices
 from ..fixtures.supports import disc_footprint, mass_footprint
-from .catalogue import Blocks, copy_model, node_candidates
+from .catalogue import Blocks, copy_model, node_candidates, on_nearest_node
 
 
 class _Lumped:
@@ -27,6 +29,11 @@ class _Lumped:
 
     def generate(self, layout, spacing: float | None = None) -> list:
         return node_candidates(self.name, layout, spacing)
+
+    def place(self, layout, candidate):
+        """On the node nearest to ``candidate``'s point (a body keeps its centre and radius)."""
+        placed = on_nearest_node(layout, candidate)
+        return replace(placed, at=candidate.at) if "radius" in candidate.data else placed
 
     def footprint(self, model, candidate) -> tuple:
         """(cell nodes, sample weights or None) the candidate's body moves with: with

@@ -108,6 +108,13 @@ class _RegionStiffness:
         """The region over ``polygon`` [[x, y], ...] [m] (None where it holds no cell centroid)."""
         return _candidate(layout, label, polygon)
 
+    def place(self, layout, candidate):
+        """Over ``candidate``'s polygon (ValueError where it holds no cell centroid)."""
+        c = _candidate(layout, "placed", candidate.geometry["polygon"])
+        if c is None:
+            raise ValueError(f"{candidate.name}: its polygon holds no cell")
+        return c
+
     def rectangle(self, layout, x0: float, y0: float, x1: float, y1: float):
         """The region over the rectangle [x0, x1] x [y0, y1] [m], named by its corners in mm."""
         label = "rect[" + ",".join(f"{1e3 * v:.4g}" for v in (x0, y0, x1, y1)) + "]mm"

@@ -75,6 +75,13 @@ class _Stiffener:
                          {"path": pts[[0, -1]]},
                          {"conn": conn, "weights": weights, "length": length, "thickness": layout.thickness})
 
+    def place(self, layout, candidate):
+        """Along ``candidate``'s line (ValueError where it misses the plate)."""
+        c = self.candidate(layout, "placed", *candidate.geometry["path"])
+        if c is None:
+            raise ValueError(f"{candidate.name}: its line misses the plate")
+        return c
+
     def _property(self, value: float, candidate):
         return EmbeddedBeamProperty(rib_property(value, candidate.data["thickness"], self.section),
                                     candidate.data["weights"])

@@ -215,41 +215,14 @@ def write_points_csv(path: Path, points) -> None:
 
 
 # --------------------------------------------------------------------------------------- effects
-def _nearest(layout, xy) -> int:
-    nodes = layout.shell_nodes()
-    return int(nodes[np.linalg.norm(layout.xy[nodes] - np.asarray(xy), axis=1).argmin()])
-
-
 def candidate(layout, effect: Effect):
-    """The candidate of ``effect`` on ``layout`` (the truth mesh)."""
-    from pcbdyn.diagnosis.catalogue import Candidate, chain_candidate, kind
+    """The candidate of ``effect`` on ``layout`` (the truth mesh): the catalogue's own placement."""
+    from pcbdyn.diagnosis.catalogue import Candidate, place
 
-    k = effect.kind
-    if k in ("point_mass", "point_inertia", "ground_spring"):
-        n = _nearest(layout, effect.at)
-        return Candidate(k, f"{k}@hidden", tuple(layout.xy[n]), np.array([n]))
-    if k in ("edge_stiffness", "line_mass"):
-        a, b = (np.asarray(p) for p in effect.segment)
-        best = None
-        for side, chain in layout.sides.items():
-            p = layout.xy[chain]
-            da, db = np.linalg.norm(p - a, axis=1), np.linalg.norm(p - b, axis=1)
-            score = da.min() + db.min()
-            if best is None or score < best[0]:
-                i, j = sorted((int(da.argmin()), int(db.argmin())))
-                best = (score, side, chain[i:j + 1])
-        score, side, chain = best
-        assert score < 0.01 and chain.size > 1, f"{k}: segment {effect.segment} is not along a side"
-        return chain_candidate(k, layout, f"{side}[hidden]", chain)
-    if k == "stiffener":
-        c = kind(k).candidate(layout, "hidden", np.asarray(effect.path[0]), np.asarray(effect.path[1]))
-        assert c is not None, f"{k}: path {effect.path} misses the plate"
-        return c
-    if k == "region_stiffness":
-        c = kind(k).candidate(layout, "hidden", [list(p) for p in effect.polygon])
-        assert c is not None, "the region holds no cell centroid"
-        return c
-    raise ValueError(f"unknown effect kind {k}")
+    geometry = {key: np.asarray(v, float) for key, v in (("segment", effect.segment), ("path", effect.path),
+                                                         ("polygon", effect.polygon)) if v is not None}
+    at = effect.at if effect.at is not None else tuple(next(iter(geometry.values())).mean(axis=0))
+    return place(layout, Candidate(effect.kind, f"{effect.kind}@hidden", tuple(at), np.zeros(0, int), geometry))
 
 
 def expected(case: Case, cands) -> list:

@@ -190,3 +190,36 @@ def test_stiffener_across_an_unstructured_mesh_converges():
         ratio.append(solve_modes(dg.add_effect(bm.model, rib, 1.0), n_modes=6).frequencies / plain)
     assert ratio[1][0] > 1.03  # the rib matters: it stiffens the first mode by 5 %
     assert np.max(np.abs(ratio[0] / ratio[1] - 1.0)) < 0.005
+
+
+def _to_place(layout, cands, cols, kind):
+    """The candidate of ``kind`` with the largest column; a region over four coarse cells (a
+    polygon the coarse mesh resolves, so both meshes cover the same area); a point inertia as half
+    of a body (alone it acts on the cells around its node, whatever their size)."""
+    if kind == "region_stiffness":
+        return dg.kind(kind).candidate(layout, "square", [[0.02, 0.02], [0.06, 0.02], [0.06, 0.06], [0.02, 0.06]])
+    if kind == "point_inertia":
+        from pcbdyn.diagnosis.bodies import _body
+
+        home = next(c for c in cands if c.kind == "point_mass" and c.prime)
+        return _body(home, (*home.at, 0.0), 0.01)[1]
+    idx = [i for i, c in enumerate(cands) if c.kind == kind]
+    return cands[idx[int(np.argmax(np.linalg.norm(cols[:, idx], axis=0)))]]
+
+
+@pytest.mark.parametrize("kind", list(dg.KINDS))
+def test_placed_on_a_finer_mesh_the_effect_does_what_it_did(plate, kind):
+    """A candidate placed on its own layout is itself; placed on the plate meshed twice as finely
+    (as a test bench puts a hidden effect on its finer truth mesh) it changes the first
+    frequencies as it did on its own mesh, to within that mesh's error on the change."""
+    m, layout, cands, modes, cols = plate
+    c = _to_place(layout, cands, cols, kind)
+    same = dg.place(layout, c)
+    assert same.name == c.name and np.array_equal(same.nodes, c.nodes)
+    fine = cantilever(20, 16)
+    p = dg.place(dg.from_model(fine), c)
+    value = 0.5 * dg.kind(kind).scale
+    change = [frequencies(dg.add_effect(model, cand, value)) / frequencies(model) - 1.0
+              for model, cand in ((m, c), (fine, p))]
+    assert np.max(np.abs(change[1])) > 0.01  # the effect matters
+    assert np.max(np.abs(change[1] - change[0])) < 0.1 * np.max(np.abs(change[1]))
