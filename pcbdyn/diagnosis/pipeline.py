@@ -35,7 +35,7 @@ from scipy.stats import chi2 as chi2_dist
 
 from ..board import build_model
 from ..fe.modal import solve_modes
-from ..fe.probe import model_probe
+from ..fe.probe import model_probe, segment_parameter
 from .bodies import as_bodies
 from .catalogue import generate, weighted_centre
 from .layout import from_board
@@ -349,14 +349,20 @@ def _linked(a, b, reach: float) -> bool:
 
 def _to_segment(p, seg) -> float:
     """Distance [m] from point ``p`` to the straight segment ``seg`` (2, 2)."""
-    d = seg[1] - seg[0]
-    u = np.clip(np.dot(p - seg[0], d) / max(np.dot(d, d), 1e-300), 0.0, 1.0)
-    return float(np.linalg.norm(seg[0] + u * d - p))
+    a, b = seg[:1], seg[1:]
+    return float(np.linalg.norm(a + segment_parameter(p[None], a, b)[:, None] * (b - a) - p))
 
 
 def _segment_gap(s, t) -> float:
     """Shortest distance [m] between two straight segments (0 where they overlap or cross)."""
     s, t = np.asarray(s, float), np.asarray(t, float)
+
+    def side(a, b, p):  # sign of p's side of the line a-b
+        (u, v), (w, z) = b - a, p - a
+        return np.sign(u * z - v * w)
+
+    if side(*s, t[0]) * side(*s, t[1]) < 0 and side(*t, s[0]) * side(*t, s[1]) < 0:
+        return 0.0  # they cross
     return min([_to_segment(p, t) for p in s] + [_to_segment(p, s) for p in t])
 
 

@@ -80,8 +80,8 @@ def _project_quads(X, p):
     return w, np.linalg.norm(p - np.einsum("ma,mak->mk", w, X), axis=1)
 
 
-def _segment(p, a, b):
-    """Parameter t in [0, 1] of the closest point on segments a-b to p (all (m, 3))."""
+def segment_parameter(p, a, b):
+    """Parameter t in [0, 1] of the closest point on segments a-b to p (all (m, dim))."""
     d = b - a
     dd = (d * d).sum(1)
     return np.clip(((p - a) * d).sum(1) / np.where(dd > 0, dd, 1.0), 0.0, 1.0)
@@ -103,7 +103,7 @@ def _project_tris(X, p):
         o = ~inside
         cand = []
         for i, j in ((0, 1), (1, 2), (2, 0)):
-            u = _segment(p[o], X[o, i], X[o, j])
+            u = segment_parameter(p[o], X[o, i], X[o, j])
             wi = np.zeros((o.sum(), 3))
             wi[:, i] = 1 - u
             wi[:, j] = u

@@ -219,3 +219,14 @@ def test_overlapping_regions_are_reported_as_one_with_their_mean_change(card):
     assert np.allclose(np.asarray(d["polygon_mm"]).min(axis=0), [20.0, 20.0])
     assert np.allclose(np.asarray(d["polygon_mm"]).max(axis=0), [80.0, 80.0])
     assert d["magnitude"] == pytest.approx((2.0 * 16.0 + 1.0 * 16.0) / 36.0)
+
+
+def test_distances_to_segments_used_to_merge_effects():
+    """Point-to-segment and segment-to-segment distances (merging effects found side by side)."""
+    from pcbdyn.diagnosis.pipeline import _segment_gap, _to_segment
+
+    s = np.array([[0.0, 0.0], [1.0, 0.0]])
+    for p, want in (([0.5, 2.0], 2.0), ([-3.0, 4.0], 5.0), ([1.5, 0.0], 0.5), ([0.3, 0.0], 0.0)):
+        assert _to_segment(np.array(p), s) == pytest.approx(want, abs=1e-12)
+    assert _segment_gap(s, np.array([[2.0, 1.0], [3.0, 1.0]])) == pytest.approx(np.sqrt(2.0), abs=1e-12)
+    assert _segment_gap(s, np.array([[0.5, -1.0], [0.5, 1.0]])) == 0.0
