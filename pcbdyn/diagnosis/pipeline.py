@@ -21,8 +21,10 @@ whether what remains is noise, and otherwise find, place and size the effects th
    also predicts data it was not fitted to; runs along the sides, stiffener lines and
    rectangular regions are walked to where they fit best (:func:`.select.refine`,
    :class:`LocalMoves`) and a mass with an inertia beside it refitted as one body
-   (:mod:`.bodies`). Last, the plate theory's share is fitted with the effects found
-   (:func:`.model_form.fit_plate_share`; kept only where significant).
+   (:mod:`.bodies`). The masses found are then put on the finer meshes and the mesh correction
+   measured again (:func:`_with_masses`: they change the shapes it depends on). Last, the plate
+   theory's share is fitted with the effects found (:func:`.model_form.fit_plate_share`; kept
+   only where significant).
 """
 
 from __future__ import annotations
@@ -31,17 +33,21 @@ import re
 from dataclasses import dataclass, field
 
 import numpy as np
+import shapely
 from scipy.stats import chi2 as chi2_dist
 
 from ..board import build_model
 from ..fe.modal import solve_modes
 from ..fe.probe import model_probe, segment_parameter
 from .bodies import as_bodies
-from .catalogue import generate, weighted_centre
+from .catalogue import add_effect, generate, place, weighted_centre
 from .layout import from_board
 from .model_form import MESH_LEVELS, discretisation, fit_plate_share, kirchhoff_shift
 from .residual import ModalResidual, Observation
-from .select import ALPHA, estimate, refine, search, without_vanished
+from .select import ALPHA, adopt, estimate, penalty, refine, search, without_vanished
+
+#: kinds whose effects :func:`_with_masses` carries onto the finer meshes
+MASS_KINDS = ("point_mass", "point_inertia", "line_mass")
 
 #: where candidates go: sides cut into 16 pieces (every run of consecutive pieces is a candidate);
 #: stiffener rows and columns every element (``path_spacing`` in element sizes)
@@ -126,12 +132,18 @@ def _observations(tests, bms) -> list:
     return obs
 
 
+def _finer(board, name, h, p: dict) -> list:
+    """BoardModels of configuration ``name`` at parameters ``p`` on the meshes twice, four
+    times, ... as fine as ``h`` (:data:`.model_form.MESH_LEVELS`)."""
+    return [build_model(board, name, h / 2**j, shared_mesh=True).with_parameters(p) for j in range(1, MESH_LEVELS + 1)]
+
+
 def _set_noise(board, models, h, obs, state, freq_pct, shape_pct) -> tuple:
     """Each observation's discretisation correction of the model frequencies, and its sigmas:
     measurement noise, what remains of the discretisation error and the plate theory's gap, in
-    quadrature (:mod:`.model_form`). Returns which modes the mesh resolves and the Kirchhoff
-    shifts and the frequency sigmas without them, per observation."""
-    resolved, shifts, plain = [], [], []
+    quadrature (:mod:`.model_form`). Returns which modes the mesh resolves, and per observation
+    the Kirchhoff shifts, the frequency sigmas of the measurement alone and with the mesh's."""
+    resolved, shifts, measured, plain = [], [], [], []
     p0 = dict(zip(models.names, models.p0.tolist()))
     for ob, cs in zip(obs, state.configs):
         basis = None
@@ -139,8 +151,7 @@ def _set_noise(board, models, h, obs, state, freq_pct, shape_pct) -> tuple:
             wide = solve_modes(cs.model, n_modes=ob.shapes.shape[0] // 2)
             basis = np.asarray(ob.read @ np.column_stack([wide.rigid_shapes, wide.shapes]))
         sf, ss = _noise_sigmas(ob, freq_pct, shape_pct, basis)
-        finer = [build_model(board, ob.name, h / 2**j, shared_mesh=True).with_parameters(p0)
-                 for j in range(1, MESH_LEVELS + 1)]
+        finer = _finer(board, ob.name, h, p0)
         dt = kirchhoff_shift(finer[-1], ob, cs)
         ob.f_scale, df, ds, ok = discretisation((bm.model for bm in finer), ob, cs)
         plain.append(np.sqrt(sf**2 + df**2))
@@ -148,7 +159,34 @@ def _set_noise(board, models, h, obs, state, freq_pct, shape_pct) -> tuple:
         ob.sigma_s = None if ss is None else np.sqrt(ss**2 + ds**2)
         resolved.append(ok.tolist())
         shifts.append(dt)
-    return resolved, shifts, plain
+        measured.append(sf)
+    return resolved, shifts, measured, plain
+
+
+def _with_masses(board, models, res, h, p, masses, shifts, measured) -> tuple:
+    """The mesh correction measured again at the fitted parameters ``p`` on the model carrying the
+    masses found (``masses``: [(candidate, value)], :data:`MASS_KINDS`), on its own mesh and placed
+    on the finer ones: a mass changes the shapes, and so what the mesh does to the frequencies, of
+    the modes it sits on (a connector along an edge: a third less on the modes it localises).
+    Masses only, as they are the same on any mesh; a stiffness effect found on the model's mesh is
+    partly its discretisation, and is left out on both sides of the comparison. Sets the
+    observations' ``f_scale`` and sigmas; returns which modes the mesh resolves and the frequency
+    sigmas without the plate theory's gap, per observation."""
+    ref = res.evaluate(p, [c for c, _ in masses], [v for _, v in masses])
+    at = dict(zip(models.names, np.asarray(p, float).tolist()))
+    resolved, plain = [], []
+    for ob, cs, dt, sf in zip(res.observations, ref.configs, shifts, measured):
+        carried = []
+        for bm in _finer(board, ob.name, h, at):
+            layout, model = from_board(bm), bm.model
+            for c, v in masses:
+                model = add_effect(model, place(layout, c), v)
+            carried.append(model)
+        ob.f_scale, df, _, ok = discretisation(carried, ob, cs)
+        plain.append(np.sqrt(sf**2 + df**2))
+        ob.sigma_f = np.sqrt(plain[-1] ** 2 + dt**2)
+        resolved.append(ok.tolist())
+    return resolved, plain
 
 
 def _range_test(res, base, n_params, alpha) -> dict:
@@ -182,7 +220,7 @@ def diagnose(board, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_size=
         res = models.residual(obs)
         before = res.evaluate(p0)
     say("estimating the noise and the model's discretisation error")
-    resolved, shifts, plain = _set_noise(board, models, h, obs, before, freq_noise_pct, shape_noise_pct)
+    resolved, shifts, measured, plain = _set_noise(board, models, h, obs, before, freq_noise_pct, shape_noise_pct)
     before = res.evaluate(p0)
     say(f"fitting the {len(names)} declared parameter(s)" if names else "no declared parameters")
     base = estimate(res, p0, [], [], 10, models.bounds)
@@ -215,6 +253,13 @@ def diagnose(board, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_size=
         sel = as_bodies(res, cands, sel, _neighbours([cands[i] for i in sel.chosen], MERGE_REACH * h),
                         MERGE_REACH * h, models.bounds, alpha=alpha)
     sel = without_vanished(res, cands, sel, models.bounds, alpha=alpha)
+    masses = [(cands[i], v) for i, v in zip(sel.chosen, sel.values) if cands[i].kind in MASS_KINDS]
+    if masses:
+        say("measuring the mesh correction again with the masses found on the finer meshes")
+        stats["mesh_resolved"], plain = _with_masses(board, models, res, h, sel.p, masses, shifts, measured)
+        stats["mesh_correction_pct"] = [np.round(100 * (o.f_scale - 1.0), 4).tolist() for o in obs]
+        sel = adopt(sel, sel.chosen, estimate(res, sel.p, [cands[i] for i in sel.chosen], sel.values, 8, models.bounds),
+                    penalty(res.n_rows, len(cands), alpha))
     say("fitting the plate theory's share with the effects")
     sel, theta, theta_sigma = fit_plate_share(res, cands, sel, shifts, plain, models.bounds, alpha=alpha)
     stats.update(plate_theory_share=theta, plate_theory_share_sigma=theta_sigma)
@@ -382,8 +427,9 @@ def _neighbours(chosen, reach: float) -> list:
 def _merged(chosen, values, cov, group) -> dict:
     """One effect entry (JSON-ready) for a group: the magnitudes summed at their weighted centre (on
     line masses: the place and extent of the largest; parallel stiffeners: their weighted mean
-    path; overlapping regions: the area-weighted mean change over their bounding rectangle), the
-    uncertainty of that combination from the fit's covariance."""
+    path; overlapping regions: the mean change over the area they cover, their union, which keeps
+    the change's integral over the board), the uncertainty of that combination from the fit's
+    covariance."""
     lines = [k for k in group if chosen[k].kind == "line_mass"]
     c = chosen[max(lines, key=lambda k: values[k]) if lines else group[0]]
     d = c.describe()
@@ -393,11 +439,11 @@ def _merged(chosen, values, cov, group) -> dict:
         d["name"] = "+".join(chosen[k].name for k in group)
         d["merged_at_mm"] = np.round(1e3 * np.array([chosen[k].at for k in group]), 3).tolist()
         if c.kind == "region_stiffness":
-            boxes = np.array([_rectangle(chosen[k]) for k in group])
-            x0, y0, x1, y1 = (*boxes[:, :2].min(axis=0), *boxes[:, 2:].max(axis=0))
-            w = (boxes[:, 2] - boxes[:, 0]) * (boxes[:, 3] - boxes[:, 1]) / ((x1 - x0) * (y1 - y0))
-            d["polygon_mm"] = np.round(1e3 * np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]]), 3).tolist()
-            d["at_mm"] = np.round(1e3 * np.array([x0 + x1, y0 + y1]) / 2.0, 3).tolist()
+            boxes = [shapely.box(*_rectangle(chosen[k])) for k in group]
+            union = shapely.union_all(boxes)
+            w = np.array([b.area for b in boxes]) / union.area
+            d["polygon_mm"] = np.round(1e3 * np.asarray(union.exterior.coords)[:-1], 3).tolist()
+            d["at_mm"] = np.round(1e3 * np.asarray(union.centroid.coords)[0], 3).tolist()
         elif not lines:
             d["at_mm"] = np.round(1e3 * weighted_centre([chosen[k] for k in group], v), 3).tolist()
         if c.kind == "stiffener":

@@ -31,9 +31,16 @@ class _Lumped:
         return node_candidates(self.name, layout, spacing)
 
     def place(self, layout, candidate):
-        """On the node nearest to ``candidate``'s point (a body keeps its centre and radius)."""
+        """At ``candidate``'s point: a body keeps its centre and radius, a mass becomes a body of no
+        size there (interpolated in the cell that holds the point, so that it sits where it sat on
+        any mesh), an inertia goes on the nearest node (it turns with the cells around a node)."""
         placed = on_nearest_node(layout, candidate)
-        return replace(placed, at=candidate.at) if "radius" in candidate.data else placed
+        if "radius" in candidate.data:
+            return replace(placed, at=candidate.at)
+        if self.param == "mass":
+            centre = (*map(float, candidate.at[:2]), float(layout.model.nodes[placed.nodes[0], 2]))
+            return replace(placed, at=candidate.at, data={**candidate.data, "radius": 0.0, "centre": centre})
+        return placed
 
     def footprint(self, model, candidate) -> tuple:
         """(cell nodes, sample weights or None) the candidate's body moves with: with

@@ -223,3 +223,19 @@ def test_placed_on_a_finer_mesh_the_effect_does_what_it_did(plate, kind):
               for model, cand in ((m, c), (fine, p))]
     assert np.max(np.abs(change[1])) > 0.01  # the effect matters
     assert np.max(np.abs(change[1] - change[0])) < 0.1 * np.max(np.abs(change[1]))
+
+
+def test_a_mass_placed_on_another_mesh_sits_at_its_point():
+    """A point mass moved to a mesh with no node at its point keeps its mass and its place: the
+    placed dM/dm weighs 1 under a rigid heave and its first moments put it at the point."""
+    coarse, fine = cantilever(), cantilever(17, 13)  # fine has no node at the coarse nodes inside
+    layout = dg.from_model(coarse)
+    c = next(c for c in dg.generate(layout, kinds=["point_mass"])
+             if np.min(np.hypot(*(fine.nodes[:, :2] - c.at).T)) > 1e-3)
+    _, dM = dg.derivatives(fine, dg.place(dg.from_model(fine), c))
+    heave = np.zeros(fine.n_dof)
+    heave[2::6] = 1.0
+    tilt_x, tilt_y = heave.copy(), heave.copy()
+    tilt_x[2::6], tilt_y[2::6] = fine.nodes[:, 0], fine.nodes[:, 1]
+    assert heave @ dM @ heave == pytest.approx(1.0, rel=1e-12)
+    assert [heave @ dM @ tilt_x, heave @ dM @ tilt_y] == pytest.approx(c.at, abs=1e-12)

@@ -134,16 +134,6 @@ def judge(case, truth: dict, data: dict) -> list:
 
 
 # ---------------------------------------------------------------------------------------- tests
-#: cases where diagnose misses the acceptance today, and why (strict: a fix turns them into passes)
-KNOWN: dict = {
-    "line_mass_top_cfg": "the 20 g line mass is found in place and size (20.1 g), but modes 6-7 of configuration c2 "
-                         "(a body at the edge) stay 0.58 % off after: their mesh correction is measured on the model "
-                         "as given (-1.68 %), while at the true parameters with the connector on it is -1.21 %; "
-                         "carrying the effects found onto the finer meshes gives 0.37 % here but moves a region's "
-                         "cover and a point mass's node, which other cases pay for",
-}
-
-
 def cases():
     """One parameter per case, both tests of a case on one xdist worker (the data are made once)."""
     out = []
@@ -169,14 +159,8 @@ def test_bench_data(bench, case):
         assert np.allclose(np.abs(td.modes.dofs.directions), [0.0, 0.0, 1.0])
 
 
-def diagnose_cases():
-    """:func:`cases`, the known misses expected to fail (strictly: a fix must remove them here)."""
-    return [pytest.param(*p.values, marks=list(p.marks) + ([pytest.mark.xfail(strict=True, reason=KNOWN[p.id])]
-                                                           if p.id in KNOWN else []), id=p.id) for p in cases()]
-
-
 @pytest.mark.slow
-@pytest.mark.parametrize("case", diagnose_cases())
+@pytest.mark.parametrize("case", cases())
 def test_diagnose_bench(bench, case, tmp_path):
     """Acceptance per case (module docstring). The bench is physical too: the parameters-only fit
     leaves more than 2 % where the case says so (the effect matters), less than 1.5 % on noise-only

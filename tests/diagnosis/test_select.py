@@ -3,6 +3,7 @@ noise alone gives none."""
 
 import numpy as np
 import pytest
+import shapely
 
 from pcbdyn import diagnosis as dg
 from pcbdyn.diagnosis.select import forward_select
@@ -205,8 +206,9 @@ def test_parallel_stiffeners_side_by_side_are_reported_as_one_rib(card):
 
 
 def test_overlapping_regions_are_reported_as_one_with_their_mean_change(card):
-    """Two overlapping rectangles fitted to one stiffened region are one effect: the bounding
-    rectangle, with the stiffness change they add over it (area-weighted)."""
+    """Two overlapping rectangles fitted to one stiffened region are one effect: the area they
+    cover (their union, not its bounding box), with the mean change over it, so that the change's
+    integral over the board is what the two add."""
     from pcbdyn.diagnosis.pipeline import _merged, _neighbours
 
     m, _ = card
@@ -216,9 +218,12 @@ def test_overlapping_regions_are_reported_as_one_with_their_mean_change(card):
     far = region.rectangle(layout, 0.10, 0.10, 0.14, 0.14)
     assert sorted(map(sorted, _neighbours([a, b, far], 0.02))) == [[0, 1], [2]]
     d = _merged([a, b], np.array([2.0, 1.0]), np.zeros((0, 0)), [0, 1])
-    assert np.allclose(np.asarray(d["polygon_mm"]).min(axis=0), [20.0, 20.0])
-    assert np.allclose(np.asarray(d["polygon_mm"]).max(axis=0), [80.0, 80.0])
-    assert d["magnitude"] == pytest.approx((2.0 * 16.0 + 1.0 * 16.0) / 36.0)
+    union = shapely.Polygon(d["polygon_mm"])
+    assert union.bounds == pytest.approx((20.0, 20.0, 80.0, 80.0))
+    assert union.area == pytest.approx(2 * 40.0**2 - 20.0**2)
+    assert not union.contains(shapely.Point(70.0, 30.0))  # a corner of the bounding box neither covers
+    assert d["magnitude"] * union.area == pytest.approx((2.0 + 1.0) * 40.0**2)
+    assert d["at_mm"] == pytest.approx([50.0, 50.0])
 
 
 def test_distances_to_segments_used_to_merge_effects():
