@@ -4,7 +4,8 @@ optional rotary inertia about the two in-plane axes as a second, separate parame
 dM/dJ is the unit rotary inertia of a body moving with the cells around the node (the footprint
 of :func:`..fixtures.supports.mass_footprint`, as a board's [[masses]] entry of inertia alone).
 A candidate with ``data["radius"]`` is one half of a body (:mod:`.bodies`): its mass or inertia
-moves with the disc of that radius of gyration, as a [[masses]] entry with both. dK = 0 (thesis
+moves with the disc of that radius of gyration, as a [[masses]] entry with both (radius 0: a mass
+placed from another mesh, at its point between the nodes). dK = 0 (thesis
 eq. 3.11 with k = i and dK = 0 gives d lambda_i / dm = -lambda_i |phi_i(node)|^2)."""
 
 from __future__ import annotations
