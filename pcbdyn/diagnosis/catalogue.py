@@ -233,6 +233,21 @@ def weighted_centre(candidates, values) -> np.ndarray:
     return w @ xy
 
 
+class AlongSides:
+    """``generate`` and ``place`` of a kind acting along runs of a side or support line (a
+    subclass sets ``name``): every run of consecutive pieces of ``segments`` per side is a
+    candidate, and an effect goes to another mesh along the side nearest to its segment."""
+
+    options = ("segments",)
+
+    def generate(self, layout, segments: int = 4) -> list:
+        return [chain_candidate(self.name, layout, f"{side}[{i}]", chain)
+                for side, i, chain in layout.segment_runs(segments)]
+
+    def place(self, layout, candidate):
+        return chain_candidate(self.name, layout, "placed", layout.side_chain(candidate.geometry["segment"]))
+
+
 def chain_candidate(kind_name: str, layout, label: str, chain: np.ndarray) -> Candidate:
     """A candidate along a node chain of a boundary segment; ``at`` is the point of the chain
     halfway along its length."""

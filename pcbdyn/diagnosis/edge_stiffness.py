@@ -13,24 +13,15 @@ import numpy as np
 
 from ..board.effects import edge_spring_property
 from ..fe.elements import kernel
-from .catalogue import Blocks, chain_candidate, copy_model
+from .catalogue import AlongSides, Blocks, copy_model
 
 
-class _EdgeStiffness:
+class _EdgeStiffness(AlongSides):
     name = report_as = "edge_stiffness"
     param = "k_rot"
     unit = "N*m/rad/m"
     scale = 1e3
     lower = 0.0
-    options = ("segments",)
-
-    def generate(self, layout, segments: int = 4) -> list:
-        return [chain_candidate(self.name, layout, f"{side}[{i}]", chain)
-                for side, i, chain in layout.segment_runs(segments)]
-
-    def place(self, layout, candidate):
-        """Along the side nearest to ``candidate``'s segment."""
-        return chain_candidate(self.name, layout, "placed", layout.side_chain(candidate.geometry["segment"]))
 
     def blocks(self, model, candidates) -> list:
         edges = [c.data["edges"] for c in candidates]

@@ -8,24 +8,15 @@ import numpy as np
 
 from ..board.effects import tributary_weights
 from ..fe import MassProperty
-from .catalogue import Blocks, chain_candidate, copy_model
+from .catalogue import AlongSides, Blocks, copy_model
 
 
-class _LineMass:
+class _LineMass(AlongSides):
     name = report_as = "line_mass"
     param = "mass"
     unit = "kg"
     scale = 1e-2
     lower = 0.0
-    options = ("segments",)
-
-    def generate(self, layout, segments: int = 4) -> list:
-        return [chain_candidate(self.name, layout, f"{side}[{i}]", chain)
-                for side, i, chain in layout.segment_runs(segments)]
-
-    def place(self, layout, candidate):
-        """Along the side nearest to ``candidate``'s segment."""
-        return chain_candidate(self.name, layout, "placed", layout.side_chain(candidate.geometry["segment"]))
 
     def blocks(self, model, candidates) -> list:
         nodes = np.concatenate([c.nodes for c in candidates])

@@ -138,12 +138,36 @@ def _finer(board, name, h, p: dict) -> list:
     return [build_model(board, name, h / 2**j, shared_mesh=True).with_parameters(p) for j in range(1, MESH_LEVELS + 1)]
 
 
-def _set_noise(board, models, h, obs, state, freq_pct, shape_pct) -> tuple:
+@dataclass
+class _Form:
+    """What one observation's model form leaves: ``finer`` (:func:`_finer`, kept to measure the
+    correction again), ``shift`` (the Kirchhoff limit's relative change per mode), ``measured``
+    (the measurement's frequency sigmas), ``plain`` (with the mesh's uncertainty, without the
+    plate theory's gap) and ``resolved`` (the modes the mesh resolves)."""
+
+    finer: list
+    shift: np.ndarray
+    measured: np.ndarray
+    plain: np.ndarray = None
+    resolved: list = None
+
+
+def _correct(ob, cs, models, form: _Form):
+    """Sets ``ob``'s frequency correction from ``models`` (the finer meshes,
+    :func:`.model_form.discretisation`) and its frequency sigmas (measurement, the correction's
+    uncertainty and the plate theory's gap in quadrature), and ``form``'s ``plain`` and
+    ``resolved``; returns the shapes' relative error."""
+    ob.f_scale, df, ds, ok = discretisation(models, ob, cs)
+    form.plain, form.resolved = np.sqrt(form.measured**2 + df**2), ok.tolist()
+    ob.sigma_f = np.sqrt(form.plain**2 + form.shift**2)
+    return ds
+
+
+def _set_noise(board, models, h, obs, state, freq_pct, shape_pct) -> list:
     """Each observation's discretisation correction of the model frequencies, and its sigmas:
     measurement noise, what remains of the discretisation error and the plate theory's gap, in
-    quadrature (:mod:`.model_form`). Returns which modes the mesh resolves, and per observation
-    the Kirchhoff shifts, the frequency sigmas of the measurement alone and with the mesh's."""
-    resolved, shifts, measured, plain = [], [], [], []
+    quadrature (:mod:`.model_form`). Returns a :class:`_Form` per observation."""
+    forms = []
     p0 = dict(zip(models.names, models.p0.tolist()))
     for ob, cs in zip(obs, state.configs):
         basis = None
@@ -152,41 +176,30 @@ def _set_noise(board, models, h, obs, state, freq_pct, shape_pct) -> tuple:
             basis = np.asarray(ob.read @ np.column_stack([wide.rigid_shapes, wide.shapes]))
         sf, ss = _noise_sigmas(ob, freq_pct, shape_pct, basis)
         finer = _finer(board, ob.name, h, p0)
-        dt = kirchhoff_shift(finer[-1], ob, cs)
-        ob.f_scale, df, ds, ok = discretisation((bm.model for bm in finer), ob, cs)
-        plain.append(np.sqrt(sf**2 + df**2))
-        ob.sigma_f = np.sqrt(plain[-1] ** 2 + dt**2)
+        forms.append(_Form(finer, kirchhoff_shift(finer[-1], ob, cs), sf))
+        ds = _correct(ob, cs, (bm.model for bm in finer), forms[-1])
         ob.sigma_s = None if ss is None else np.sqrt(ss**2 + ds**2)
-        resolved.append(ok.tolist())
-        shifts.append(dt)
-        measured.append(sf)
-    return resolved, shifts, measured, plain
+    return forms
 
 
-def _with_masses(board, models, res, h, p, masses, shifts, measured) -> tuple:
+def _with_masses(models, res, p, masses, forms) -> None:
     """The mesh correction measured again at the fitted parameters ``p`` on the model carrying the
     masses found (``masses``: [(candidate, value)], :data:`MASS_KINDS`), on its own mesh and placed
     on the finer ones: a mass changes the shapes, and so what the mesh does to the frequencies, of
     the modes it sits on (a connector along an edge: a third less on the modes it localises).
     Masses only, as they are the same on any mesh; a stiffness effect found on the model's mesh is
     partly its discretisation, and is left out on both sides of the comparison. Sets the
-    observations' ``f_scale`` and sigmas; returns which modes the mesh resolves and the frequency
-    sigmas without the plate theory's gap, per observation."""
+    observations' ``f_scale`` and frequency sigmas and the ``forms``."""
     ref = res.evaluate(p, [c for c, _ in masses], [v for _, v in masses])
     at = dict(zip(models.names, np.asarray(p, float).tolist()))
-    resolved, plain = [], []
-    for ob, cs, dt, sf in zip(res.observations, ref.configs, shifts, measured):
+    for ob, cs, form in zip(res.observations, ref.configs, forms):
         carried = []
-        for bm in _finer(board, ob.name, h, at):
+        for bm in (b.with_parameters(at) for b in form.finer):
             layout, model = from_board(bm), bm.model
             for c, v in masses:
                 model = add_effect(model, place(layout, c), v)
             carried.append(model)
-        ob.f_scale, df, _, ok = discretisation(carried, ob, cs)
-        plain.append(np.sqrt(sf**2 + df**2))
-        ob.sigma_f = np.sqrt(plain[-1] ** 2 + dt**2)
-        resolved.append(ok.tolist())
-    return resolved, plain
+        _correct(ob, cs, carried, form)
 
 
 def _range_test(res, base, n_params, alpha) -> dict:
@@ -220,13 +233,14 @@ def diagnose(board, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_size=
         res = models.residual(obs)
         before = res.evaluate(p0)
     say("estimating the noise and the model's discretisation error")
-    resolved, shifts, measured, plain = _set_noise(board, models, h, obs, before, freq_noise_pct, shape_noise_pct)
+    forms = _set_noise(board, models, h, obs, before, freq_noise_pct, shape_noise_pct)
     before = res.evaluate(p0)
     say(f"fitting the {len(names)} declared parameter(s)" if names else "no declared parameters")
     base = estimate(res, p0, [], [], 10, models.bounds)
     stats = {"unpaired_test_modes": unmatched, "chi2_before": before.chi2, **_range_test(res, base, len(names), alpha),
              "mesh_correction_pct": [np.round(100 * (o.f_scale - 1.0), 4).tolist() for o in obs],
-             "mesh_resolved": resolved, "plate_theory_pct": [np.round(100 * d, 4).tolist() for d in shifts],
+             "mesh_resolved": [f.resolved for f in forms],
+             "plate_theory_pct": [np.round(100 * f.shift, 4).tolist() for f in forms],
              "sigma_f_pct": [np.round(100 * o.sigma_f, 4).tolist() for o in obs],
              "sigma_shape_pct": [None if o.sigma_s is None else np.round(100 * o.sigma_s, 4).tolist() for o in obs]}
     out = dict(before=before.summary(obs), parameters_only=base.state.summary(obs),
@@ -256,12 +270,14 @@ def diagnose(board, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_size=
     masses = [(cands[i], v) for i, v in zip(sel.chosen, sel.values) if cands[i].kind in MASS_KINDS]
     if masses:
         say("measuring the mesh correction again with the masses found on the finer meshes")
-        stats["mesh_resolved"], plain = _with_masses(board, models, res, h, sel.p, masses, shifts, measured)
+        _with_masses(models, res, sel.p, masses, forms)
+        stats["mesh_resolved"] = [f.resolved for f in forms]
         stats["mesh_correction_pct"] = [np.round(100 * (o.f_scale - 1.0), 4).tolist() for o in obs]
         sel = adopt(sel, sel.chosen, estimate(res, sel.p, [cands[i] for i in sel.chosen], sel.values, 8, models.bounds),
                     penalty(res.n_rows, len(cands), alpha))
     say("fitting the plate theory's share with the effects")
-    sel, theta, theta_sigma = fit_plate_share(res, cands, sel, shifts, plain, models.bounds, alpha=alpha)
+    sel, theta, theta_sigma = fit_plate_share(res, cands, sel, [f.shift for f in forms], [f.plain for f in forms],
+                                              models.bounds, alpha=alpha)
     stats.update(plate_theory_share=theta, plate_theory_share_sigma=theta_sigma)
     stats.update(chi2_after=sel.chi2[-1], candidates=len(cands))
     for n, v in zip(names, sel.p):
