@@ -175,6 +175,24 @@ def test_diagnose_bench(bench, case, tmp_path):
         assert po > PARAMS_ONLY_MIN_PCT
     bad = judge(case, truth, data)
     assert not bad, f"{case.name}: " + "; ".join(bad)
+    check_report(data, tmp_path / "diagnose")
+
+
+def check_report(data: dict, out: Path) -> None:
+    """What diagnose writes besides the effects' places and sizes: the JSON keys of the issue
+    (each effect's type, at_mm, magnitude, unit, uncertainty; before/after max_freq_error_pct and
+    mean_mac), the tables, the evidence map, and with effects an enriched board.toml that loads."""
+    from pcbdyn.board import load_board
+
+    for state in ("before", "parameters_only", "after"):
+        assert data[state]["max_freq_error_pct"] >= 0.0 and 0.0 < data[state]["mean_mac"] <= 1.0
+    for e in data["effects"]:
+        assert len(e["at_mm"]) == 2 and e["unit"] and np.isfinite(e["magnitude"]) and 0.0 <= e["uncertainty"] < np.inf
+    assert (out / "effects.txt").exists() and (out / "correlation.txt").exists()
+    if data["effects"]:
+        assert (out / "evidence.png").stat().st_size > 0
+        enriched = Path(data["enriched_board"])
+        assert enriched.name.endswith(".diagnosed.toml") and load_board(enriched).name
 
 
 def test_judge_on_truth_itself():
