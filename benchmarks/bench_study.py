@@ -10,7 +10,8 @@ import time
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-from pcbdyn.updating.study import SimulatedFreePCB, run_study, summarise  # noqa: E402
+from pcbdyn.problems.cases import SimulatedFreePCB  # noqa: E402
+from pcbdyn.updating.study import run_study, summarise  # noqa: E402
 
 LEVELS = [0.0, 0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 2.0]
 METHODS = ("tls-qrf", "svd-qr", "min-norm")

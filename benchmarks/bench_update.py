@@ -19,7 +19,8 @@ import numpy as np  # noqa: E402
 from pcbdyn.board import load_board  # noqa: E402
 from pcbdyn.fe.modal import solve_modes as fe_modes  # noqa: E402
 from pcbdyn.updating import build_equations, solve_bounded  # noqa: E402
-from pcbdyn.updating.board_problem import BoardProblem, MeasuredModes, config_pairing  # noqa: E402
+from pcbdyn.problems import UpdateProblem  # noqa: E402
+from pcbdyn.testdata import Modes  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -39,13 +40,13 @@ def big_board(path: Path) -> Path:
 
 
 def bench(name, board, n_modes, points=None):
-    prob = BoardProblem(board)
+    prob = UpdateProblem(board)
     sysm = prob.system(None)
     t = time.perf_counter()
-    modes = fe_modes(sysm.bm.model, n_modes=n_modes)
+    modes = fe_modes(sysm.pm.model, n_modes=n_modes)
     t_modal = time.perf_counter() - t
     p = prob.p0 * 1.0001
-    bm = sysm.board_model(p)
+    bm = sysm.at(p)
     t = time.perf_counter()
     for par in prob.names:
         dK, dM = bm.parameters[par].derivatives(bm)
@@ -54,9 +55,9 @@ def bench(name, board, n_modes, points=None):
     t = time.perf_counter()
     K, M, dKs, dMs = sysm.model(p)
     t_sens = time.perf_counter() - t
-    cfg = prob.configuration(None, MeasuredModes(modes.frequencies * 1.01), "freq")
+    cfg = prob.configuration(None, Modes.frequencies_only(modes.frequencies * 1.01), "freq")
     t = time.perf_counter()
-    (A, b), _, _ = build_equations([cfg], p, config_pairing([cfg]))  # model(p) cached: modes + equations
+    (A, b), _, _ = build_equations([cfg], p)  # model(p) cached: modes + equations
     t_eq = time.perf_counter() - t
     t = time.perf_counter()
     solve_bounded(A, b, np.log(prob.bounds[0] / p), prob.bounds[1] / p - 1)
@@ -74,11 +75,11 @@ def bench(name, board, n_modes, points=None):
 
         pts, dofs = read_points_csv(points)
         xyz = pts.xyz[pts.index(dofs.point_ids)]
-        shapes = np.asarray(model_probe(sysm.bm.model, xyz, dofs.directions).P @ modes.shapes)
-        meas = MeasuredModes(modes.frequencies * 1.01, shapes, xyz, dofs.directions)
+        shapes = np.asarray(model_probe(sysm.pm.model, xyz, dofs.directions).P @ modes.shapes)
+        meas = Modes(pts, dofs, modes.frequencies * 1.01, shapes)
         qms = prob.mode_configurations(None, meas, "qms")
         t = time.perf_counter()
-        build_equations(qms, p, config_pairing(qms))
+        build_equations(qms, p)
         print(f"  QMS equations, {len(qms)} modes at {len(xyz)} points (dynamic condensation per mode) "
               f"{time.perf_counter() - t:5.2f} s")
 

@@ -30,3 +30,17 @@ def atomic_path(path):
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+def write_checked(path, text: str, load, error=ValueError) -> Path:
+    """Write ``text`` to ``path`` atomically after ``load(temporary file)`` accepted it (the file is read
+    beside its destination, so relative paths in it resolve as they will); otherwise ``error`` says
+    why and nothing is written. Returns ``path``."""
+    path = Path(path)
+    with atomic_path(path) as tmp:
+        tmp.write_text(text, encoding="utf-8")
+        try:
+            load(tmp)
+        except ValueError as exc:
+            raise error(f"{path.name}: the file to write does not load ({exc}); nothing was written") from None
+    return path

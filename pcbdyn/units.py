@@ -53,3 +53,12 @@ def to_si(value, unit: str, where: str = "value") -> float:
             f"({dim or 'dimensionless'})"
         )
     return float(q.to_base_units().magnitude)
+
+
+def from_si(value: float, unit: str) -> float:
+    """A SI value expressed in ``unit`` (e.g. 0.0035 -> 3.5 for "mm"); "1" leaves it as it is."""
+    if unit in ("1", "dimensionless"):
+        return float(value)
+    ureg = registry()
+    q = ureg.Quantity(float(value), ureg.Quantity(1.0, unit).to_base_units().units)
+    return float(q.to(unit).magnitude)

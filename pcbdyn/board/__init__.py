@@ -1,7 +1,7 @@
 """Boards as domain objects: board.toml -> validated description -> mesh -> FE model with parameters."""
 
+from .board import Board, load_board, parse_board
+from .entries import BoardError
 from .model import BoardModel, build_model
-from .parameters import Parameter
-from .spec import Board, BoardError, load_board
 
-__all__ = ["Board", "BoardError", "BoardModel", "Parameter", "build_model", "load_board"]
+__all__ = ["Board", "BoardError", "BoardModel", "build_model", "load_board", "parse_board"]

@@ -23,7 +23,7 @@ import numpy as np
 from matplotlib.path import Path as PolyPath
 
 from ..fe import BeamProperty, EdgeSpringProperty, MassProperty, SpringProperty
-from .spec import BoardError, RibSection
+from .entries import BoardError, RibSection
 
 
 def rib_property(EI: float, plate_thickness: float, section: RibSection = RibSection()) -> BeamProperty:

@@ -1,5 +1,5 @@
-"""The enriched board.toml: the original file, unchanged, followed by a commented block declaring
-the effects a diagnosis found (issue 7), so that ``pcbdyn build`` of the new file gives the
+"""The enriched board.toml: the original file, its comments and layout kept, with the effects a
+diagnosis found declared as board entries (tomlkit), so that ``pcbdyn build`` of the new file gives the
 diagnosed model.
 
 An effect is a dict (the shape of ``pcbdyn.diagnosis.Candidate`` kind/name/at/geometry + a value)::
@@ -21,9 +21,12 @@ import re
 from pathlib import Path
 
 import numpy as np
+import tomlkit
 
-from ..atomic import atomic_path
-from .spec import BoardError, load_board, read_toml
+from .. import targets
+from ..atomic import write_checked
+from .board import load_board
+from .entries import BoardError
 
 TYPES = ("point_mass", "point_inertia", "ground_spring", "edge_stiffness", "line_mass", "stiffener",
          "region_stiffness")
@@ -35,40 +38,8 @@ def enriched_path(board_toml) -> Path:
     return p.with_name(f"{p.stem}.diagnosed{p.suffix}")
 
 
-def _num(v: float) -> str:
-    return f"{float(v):.12g}"
-
-
-def _mm(v: float) -> str:
-    return f'"{_num(1e3 * v)} mm"'
-
-
-def _point(p) -> str:
-    return f"[{_mm(p[0])}, {_mm(p[1])}]"
-
-
-def _points(ps) -> str:
-    return "[" + ", ".join(_point(p) for p in ps) + "]"
-
-
-def _str(s: str) -> str:
-    return '"' + s.replace("\\", "\\\\").replace('"', '\\"') + '"'
-
-
-class _Names:
-    """Entry names usable in parameter targets (no '.'), unique per array."""
-
-    def __init__(self, data: dict):
-        self.used = {key: {str(e.get("name", "")) for e in data.get(key, []) if isinstance(e, dict)}
-                     for key in ("fixtures", "masses", "line_masses", "stiffeners", "regions")}
-
-    def __call__(self, key: str, name: str) -> str:
-        base = re.sub(r"[^A-Za-z0-9_-]+", "_", name).strip("_") or key
-        out, k = base, 2
-        while out in self.used[key]:
-            out, k = f"{base}_{k}", k + 1
-        self.used[key].add(out)
-        return out
+def _point(p) -> list:
+    return [targets.quantity(v, "mm") for v in p[:2]]
 
 
 def _check(e: dict, i: int) -> None:
@@ -85,16 +56,25 @@ def _check(e: dict, i: int) -> None:
         raise BoardError(f"{where}.value: must be finite, got {e['value']!r}")
 
 
-def effect_block(effects, data: dict, date: str | None = None, source: str = "pcbdyn diagnose") -> str:
-    """The TOML text declaring ``effects`` after a board whose parsed content is ``data``."""
-    for i, e in enumerate(effects):
-        _check(e, i)
-    names = _Names(data)
-    date = date or _dt.date.today().isoformat()
-    kinds = ", ".join(f"{e['type']} {e['name']}" for e in effects) or "none"
-    out = ["\n# ---------------------------------------------------------------------------",
-           f"# effects found by {source} on {date}: {kinds}",
-           "# (each entry below was added to the original board above; values as estimated)"]
+class _Names:
+    """Entry names usable in parameter targets (no '.'), unique per array of the document."""
+
+    def __init__(self, doc):
+        self.used = {key: {targets.entry_name(key, e, i) for i, e in enumerate(doc.get(key, []))}
+                     for key in ("fixtures", "masses", "line_masses", "stiffeners", "regions")}
+
+    def __call__(self, key: str, name: str) -> str:
+        base = re.sub(r"[^A-Za-z0-9_-]+", "_", name).strip("_") or key
+        out, k = base, 2
+        while out in self.used[key]:
+            out, k = f"{base}_{k}", k + 1
+        self.used[key].add(out)
+        return out
+
+
+def _entries(effects, names) -> list:
+    """[(collection, note, {field: value})] declaring ``effects`` as board entries."""
+    out = []
     masses: list = []  # [at, mass, inertia, [names]]
     for e in effects:
         if e["type"] in ("point_mass", "point_inertia"):
@@ -105,53 +85,63 @@ def effect_block(effects, data: dict, date: str | None = None, source: str = "pc
                 masses.append(slot)
             slot[1 if e["type"] == "point_mass" else 2] += float(e["value"])
             slot[3].append(str(e["name"]))
+    kind = targets.KINDS
     for at, m, J, who in masses:
-        out += ["", f"# point mass ({' + '.join(who)}): {_num(m * 1e3)} g, rotary inertia {_num(J)} kg*m^2 "
-                    "about x and y", "[[masses]]", f"name = {_str(names('masses', who[0]))}", f"at = {_point(at)}",
-                f'mass = "{_num(m * 1e3)} g"']
+        fields = {"name": names("masses", who[0]), "at": _point(at), "mass": targets.formatted(kind["masses", "mass"], m)}
         if J:
-            out.append(f'inertia = "{_num(J)} kg*m^2"')
+            fields["inertia"] = targets.formatted(kind["masses", "inertia"], J)
+        out.append(("masses", f"point mass ({' + '.join(who)}), rotary inertia about x and y", fields))
     for e in effects:
         typ, v, name = e["type"], float(e["value"]), str(e["name"])
         if typ == "ground_spring":
-            out += ["", f"# {name}: spring to ground in z, {_num(v)} N/m", "[[fixtures]]",
-                    f"name = {_str(names('fixtures', name))}", 'type = "point_spring"', f"at = {_point(e['at'])}",
-                    f'k = "{_num(v)} N/m"']
+            out.append(("fixtures", f"{name}: spring to ground in z", {
+                "name": names("fixtures", name), "type": "point_spring", "at": _point(e["at"]),
+                "k": targets.formatted(kind["fixtures", "k"], v)}))
         elif typ == "edge_stiffness":
             a, b = e["segment"]
-            out += ["", f"# {name}: rotational stiffness about the segment, {_num(v)} N*m/rad/m", "[[fixtures]]",
-                    f"name = {_str(names('fixtures', name))}", 'type = "edge_spring"', f"from = {_point(a)}",
-                    f"to = {_point(b)}", f'k_rot = "{_num(v)} N*m/rad/m"']
+            out.append(("fixtures", f"{name}: rotational stiffness about the segment", {
+                "name": names("fixtures", name), "type": "edge_spring", "from": _point(a), "to": _point(b),
+                "k_rot": targets.formatted(kind["fixtures", "k_rot"], v)}))
         elif typ == "line_mass":
             a, b = e["segment"]
-            out += ["", f"# {name}: {_num(v * 1e3)} g spread along the segment", "[[line_masses]]",
-                    f"name = {_str(names('line_masses', name))}", f"from = {_point(a)}", f"to = {_point(b)}",
-                    f'mass = "{_num(v * 1e3)} g"']
+            out.append(("line_masses", f"{name}: mass spread along the segment", {
+                "name": names("line_masses", name), "from": _point(a), "to": _point(b),
+                "mass": targets.formatted(kind["line_masses", "mass"], v)}))
         elif typ == "stiffener":
-            out += ["", f"# {name}: rib of bending stiffness {_num(v)} N*m^2 (aluminium, 4 mm high)",
-                    "[[stiffeners]]", f"name = {_str(names('stiffeners', name))}", f"path = {_points(e['path'])}",
-                    f'EI = "{_num(v)} N*m^2"']
+            out.append(("stiffeners", f"{name}: rib (aluminium, 4 mm high)", {
+                "name": names("stiffeners", name), "path": [_point(p) for p in e["path"]],
+                "EI": targets.formatted(kind["stiffeners", "EI"], v)}))
         elif typ == "region_stiffness":
-            out += ["", f"# {name}: stiffness changed by {_num(100 * v)} %", "[[regions]]",
-                    f"name = {_str(names('regions', name))}", f"polygon = {_points(e['polygon'])}",
-                    f"stiffness_factor = {_num(1.0 + v)}"]
-    return "\n".join(out) + "\n"
+            out.append(("regions", f"{name}: stiffness changed by {100 * v:.4g} %", {
+                "name": names("regions", name), "polygon": [_point(p) for p in e["polygon"]],
+                "stiffness_factor": targets.formatted(kind["regions", "stiffness_factor"], 1.0 + v)}))
+    return out
+
+
+def enriched_text(text: str, effects, date: str | None = None, source: str = "pcbdyn diagnose") -> str:
+    """The board.toml ``text`` with ``effects`` declared as new entries, each with a comment saying where
+    it came from; everything the user wrote is kept."""
+    effects = list(effects)
+    for i, e in enumerate(effects):
+        _check(e, i)
+    doc = tomlkit.parse(text)
+    date = date or _dt.date.today().isoformat()
+    for collection, note, fields in _entries(effects, _Names(doc)):
+        table = tomlkit.table()
+        table.add(tomlkit.comment(f"found by {source} on {date}: {note}"))
+        for key, value in fields.items():
+            table.add(key, value)
+        if collection not in doc:
+            doc.add(collection, tomlkit.aot())
+        doc[collection].append(table)
+    return tomlkit.dumps(doc)
 
 
 def write_enriched(original_path, effects, out_path=None, date: str | None = None) -> Path:
-    """Write ``original_path``'s text unchanged followed by the declarations of ``effects`` to
-    ``out_path`` (default ``<stem>.diagnosed.toml`` beside the original), atomically; the result
-    is loaded with ``load_board`` before it replaces ``out_path``. Returns the path written."""
+    """Write ``original_path`` with the declarations of ``effects`` to ``out_path`` (default
+    ``<stem>.diagnosed.toml`` beside the original), atomically, after checking that it loads. Returns
+    the path written."""
     src = Path(original_path)
-    text, data = read_toml(src)
     dst = Path(out_path) if out_path is not None else enriched_path(src)
-    body = text if text.endswith("\n") or not text else text + "\n"
-    body += effect_block(list(effects), data, date)
-    with atomic_path(dst) as tmp:
-        tmp.write_text(body)
-        try:
-            load_board(tmp)  # beside the output: parts' packages are looked up from its folder
-        except BoardError as exc:
-            raise BoardError(f"{dst.name}: the enriched board does not load ({exc}); nothing was written") from None
-    return dst
-
+    text = enriched_text(src.read_text(encoding="utf-8"), effects, date)
+    return write_checked(dst, text, load_board, BoardError)

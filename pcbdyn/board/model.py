@@ -1,10 +1,7 @@
-"""Board description -> FE model with named quantities and bounded parameters.
-
-Every element set is made by a function of a dictionary of named quantities (``board.E``,
-``components.U1.thickness``, ``fixtures.left_guide.k_rot``, ``masses.transducer.mass``, ...) and
-records which quantities it depends on. A parameter is a named, bounded value shared by one or
-more quantities; changing it re-makes only the sets that depend on them, which is also how its
-dK/dp and dM/dp are formed (see :mod:`pcbdyn.board.parameters`).
+"""Board description -> FE model with named quantities and bounded parameters
+(:class:`pcbdyn.fe.parametric.ParametricModel`: each element set is a function of named quantities
+such as ``board.E``, ``components.U1.thickness``, ``fixtures.left_guide.k_rot``,
+``masses.transducer.mass``; a parameter re-makes only the sets that depend on its quantities).
 
 Element sets: ``board`` (bare board), ``components.<ref>`` (the elements under a part),
 ``components.<ref>.mass`` (lumped part), ``fixtures.<name>`` (wedge-lock springs, standoff
@@ -16,79 +13,42 @@ Triangles, where the mesher leaves any, go to a companion set named ``<set>.tri3
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from ..components import models as parts
 from ..fe import Model
+from ..fe.parametric import ParametricModel, SetMaker
 from ..fixtures import supports
 from . import effects
+from .entries import BoardError
 from .mesh import BoardMesh, mesh_board
-from .spec import Board, BoardError
 
 
 @dataclass
-class SetMaker:
-    etype: str
-    conn: np.ndarray
-    deps: tuple
-    make: object  # q -> property
+class BoardModel(ParametricModel):
+    """The FE model of one configuration of a board (a :class:`ParametricModel` with the board, its
+    mesh and the configuration's name)."""
+
+    board: object = None  # the Board
+    mesh: BoardMesh | None = None
+    configuration: str | None = None
+
+    def with_shear_factor(self, factor: float) -> "BoardModel":
+        """A copy whose shells' transverse shear stiffness is ``factor`` times the declared (a large
+        factor: the Kirchhoff plate)."""
+        return self.with_quantities({parts.SHEAR_KEY: self.quantities[parts.SHEAR_KEY] * factor})
+
+    def layout_hints(self) -> tuple:
+        """(suspects {name: node}, footprints {name: polygon [m]}, plate thickness [m]) for a diagnosis:
+        measurement points and declared masses are prime suspects, part footprints candidate regions."""
+        suspects = {n: v for n, v in self.point_nodes.items() if n.startswith(("points.", "masses."))}
+        footprints = {f"components.{c.ref}": c.corners() for c in self.board.components}
+        return suspects, footprints, self.board.thickness
 
 
-@dataclass
-class BoardModel:
-    """The FE model of one configuration of a board and how to re-make its sets."""
-
-    board: Board
-    mesh: BoardMesh
-    model: Model
-    quantities: dict
-    makers: dict
-    configuration: str | None
-    point_nodes: dict = field(default_factory=dict)  # name -> node index
-    parameters: dict = field(default_factory=dict)
-
-    def sets_depending_on(self, keys) -> list:
-        keys = set(keys)
-        return [n for n, mk in self.makers.items() if keys & set(mk.deps)]
-
-    def properties(self, values: dict) -> dict:
-        """{set name: property} of the sets touched when the quantities ``values`` change."""
-        q = {**self.quantities, **values}
-        return {n: self.makers[n].make(q) for n in self.sets_depending_on(values)}
-
-    def with_quantities(self, values: dict) -> "BoardModel":
-        """A copy whose quantities are changed (the FE model shares nodes and unchanged sets)."""
-        for k in values:
-            if k not in self.quantities:
-                raise BoardError(f"'{k}' is not a quantity of this model")
-        model = Model(self.model.nodes, dict(self.model.sets), dict(self.model.node_groups), set(self.model.fixed),
-                      list(self.model.mpcs), self.model.free)
-        for name, prop in self.properties(values).items():
-            es = model.sets[name]
-            model.sets[name] = type(es)(es.name, es.etype, es.conn, prop)
-        return BoardModel(self.board, self.mesh, model, {**self.quantities, **values}, self.makers,
-                          self.configuration, self.point_nodes, self.parameters)
-
-    def with_parameters(self, values: dict) -> "BoardModel":
-        """A copy with parameters {name: value [SI]} set (each value goes to all its targets)."""
-        q = {}
-        for name, v in values.items():
-            q.update(self.parameters[name].quantities(v))
-        return self.with_quantities(q)
-
-    def mass(self) -> float:
-        """Total translational mass [kg] from the assembled mass matrix (u = 1 in z everywhere)."""
-        from ..fe.assembly import assemble
-
-        _, M = assemble(self.model)
-        r = np.zeros(self.model.n_dof)
-        r[2::6] = 1.0
-        return float(r @ (M @ r))
-
-
-def mesh_points(board: Board, config, shared: bool = False) -> list:
+def mesh_points(board, config, shared: bool = False) -> list:
     """Named points that must be mesh nodes; ``shared``: those of every configuration, so that all
     configurations mesh alike."""
     pts = [(f"masses.{m.name}", m.at) for m in board.masses]
@@ -99,7 +59,7 @@ def mesh_points(board: Board, config, shared: bool = False) -> list:
     return pts
 
 
-def mesh_lines(board: Board) -> list:
+def mesh_lines(board) -> list:
     """Polylines element edges must follow: edge springs, line masses and stiffener paths."""
     lines = [np.array(f.segment) for f in board.fixtures if f.type == "edge_spring"]
     lines += [np.array(e.segment) for e in board.line_masses]
@@ -107,13 +67,11 @@ def mesh_lines(board: Board) -> list:
     return lines
 
 
-def build_model(board: Board, config: str | None = None, mesh_size: float | None = None,
+def build_model(board, config: str | None = None, mesh_size: float | None = None,
                 shared_mesh: bool = False) -> BoardModel:
     """The FE model of ``board`` in configuration ``config`` (None: the base configuration).
     ``shared_mesh``: every configuration's points are nodes, so that the models of all
     configurations share one mesh node for node (diagnosis places effects by node)."""
-    from .parameters import Parameter
-
     cfg = None
     if config is not None:
         cfg = board.configuration(config)
@@ -133,7 +91,7 @@ def build_model(board: Board, config: str | None = None, mesh_size: float | None
         raise BoardError(f"{board.path.name}: board.mesh_size: meshing failed ({exc})") from None
     point_nodes = {name: int(n) for (name, _), n in zip(named, mesh.point_nodes)}
 
-    q = {parts.SHEAR_KEY: 1.0}
+    q = {parts.SHEAR_KEY: board.transverse_shear}
     if board.isotropic is not None:
         q.update({"board.E": board.isotropic.E, "board.rho": board.isotropic.rho, "board.thickness": board.plate.t})
     q.update(parts.initial_quantities(board))
@@ -186,9 +144,8 @@ def build_model(board: Board, config: str | None = None, mesh_size: float | None
     for mk in effects.effect_sets(board, mesh, q, makers):
         add(*mk)
     model.free = not supported
-    for name, mk in makers.items():
-        model.add(name, mk.etype, mk.conn, mk.make(q))
     model.node_groups.update({name: np.array([n]) for name, n in point_nodes.items()})
-    bm = BoardModel(board, mesh, model, q, makers, config, point_nodes)
-    bm.parameters = {p.name: Parameter.from_spec(p, bm) for p in board.parameters}
+    bm = BoardModel.assemble_from(model, q, makers, point_nodes=point_nodes, board=board, mesh=mesh,
+                                  configuration=config)
+    bm.bind(board.parameters)
     return bm

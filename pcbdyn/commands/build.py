@@ -5,21 +5,19 @@ from __future__ import annotations
 from pathlib import Path
 
 import click
-import numpy as np
 
-from .common import done, fail, solve_board, step
+from .common import done, fail, solve_structure, step
 
 
 def analyse(board, config, out: Path | None, pictures: bool = True) -> dict:
     """Build and solve one configuration; print its table; write CSV/VTU/PNG under ``out``."""
+    from ..correlation import static_mass
     from ..report.files import write_text
     from ..report.modes import format_table, mode_table
 
     label = config or "base"
-    bm, modes, K, M = solve_board(board, config)
-    r = np.zeros(M.shape[0])
-    r[2::6] = 1.0
-    mass = float(r @ (M @ r))
+    bm, modes, K, M = solve_structure(board, config)
+    mass = static_mass(M)
     table = mode_table(bm, modes, M)
     click.echo(f"\n{board.name} [{label}]: {mass * 1e3:.2f} g, {bm.model.n_dof} DOFs, "
                f"{sum(len(es.conn) for es in bm.model.sets.values() if es.etype in ('quad4', 'tri3'))} shells"
@@ -62,17 +60,18 @@ def analyse(board, config, out: Path | None, pictures: bool = True) -> dict:
 @click.option("--no-pictures", is_flag=True, help="skip the PNG mode-shape pictures")
 def command(board_toml, config, all_configs, out, json_path, no_pictures):
     """Predict a board's resonances: frequencies, effective masses in z, mode shapes."""
-    from ..board import BoardError, load_board
+    from ..domain import StructureError
     from ..fe import ModelError
+    from ..problems import load_structure
     from ..report.files import write_json
 
     try:
-        board = load_board(board_toml)
+        board = load_structure(board_toml)
         if config is not None and all_configs:
             raise click.UsageError("give --config NAME or --all-configs, not both")
-        configs = [None] + [c.name for c in board.configurations] if all_configs else [config]
+        configs = [None] + board.configuration_names() if all_configs else [config]
         results = [analyse(board, c, out, pictures=not no_pictures) for c in configs]
-    except (BoardError, ModelError) as exc:
+    except (StructureError, ModelError) as exc:
         fail(str(exc))
     if json_path is not None:
         data = dict(results[0]) if len(results) == 1 else {**results[0], "configurations": results}

@@ -1,4 +1,4 @@
-"""Pieces shared by the commands: progress lines, solving one board configuration, option parsing."""
+"""Pieces shared by the commands: progress lines, solving one configuration of a structure, option parsing."""
 
 from __future__ import annotations
 
@@ -29,26 +29,25 @@ def fail(message: str, code: int = 2):
     sys.exit(code)
 
 
-def solve_board(board, config: str | None, n_modes: int | None = None, f_max: float | None = None):
-    """Build the FE model of one configuration of ``board`` and solve its modes, with progress.
+def solve_structure(structure, config: str | None, n_modes: int | None = None, f_max: float | None = None):
+    """Build the FE model of one configuration of ``structure`` and solve its modes, with progress.
 
-    Returns (board_model, modes, K, M). ``n_modes``/``f_max`` default to the board's [analysis].
+    Returns (built model, modes, K, M). ``n_modes``/``f_max`` default to the structure's [analysis].
     """
-    from ..board import build_model
     from ..fe.assembly import assemble
     from ..fe.modal import solve_modes
 
     label = config or "base"
-    n_modes = board.analysis.modes if n_modes is None else n_modes
-    f_max = board.analysis.f_max if f_max is None else f_max
+    n_modes = structure.analysis.modes if n_modes is None else n_modes
+    f_max = structure.analysis.f_max if f_max is None else f_max
     t0 = step(f"[{label}] meshing and building the model")
-    bm = build_model(board, config)
+    pm = structure.build(config)
     done(t0)
-    t0 = step(f"[{label}] solving {bm.model.n_dof} DOFs for {n_modes} modes")
-    K, M = assemble(bm.model)
-    modes = solve_modes(bm.model, n_modes=n_modes, f_max=f_max, K=K, M=M)
+    t0 = step(f"[{label}] solving {pm.model.n_dof} DOFs for {n_modes} modes")
+    K, M = assemble(pm.model)
+    modes = solve_modes(pm.model, n_modes=n_modes, f_max=f_max, K=K, M=M)
     done(t0)
-    return bm, modes, K, M
+    return pm, modes, K, M
 
 
 def number_pair(text: str, option: str, unit: str | None = None) -> tuple:
@@ -75,23 +74,6 @@ def number_pair(text: str, option: str, unit: str | None = None) -> tuple:
     return tuple(out)
 
 
-def points_on_board(board, points, source, board_toml) -> None:
-    """Raise TestDataError naming the points (by id) of ``source`` that lie off the outline or in a
-    hole of the board, before any meshing."""
-    from ..testdata import TestDataError
-
-    off = ~board.outline.contains(points.xyz[:, :2], tol=1e-6)
-    if off.any():
-        listed = ", ".join(f"{int(i)} ({x * 1e3:g}, {y * 1e3:g} mm)"
-                           for i, (x, y) in zip(points.ids[off][:10], points.xyz[off, :2][:10]))
-        lo, hi = board.outline.bbox
-        raise TestDataError(
-            f"{source}: {int(off.sum())} point(s) lie off the board of {board_toml.name}: {listed}"
-            f"{' ...' if off.sum() > 10 else ''}. The board frame runs from ({lo[0] * 1e3:g}, {lo[1] * 1e3:g}) to "
-            f"({hi[0] * 1e3:g}, {hi[1] * 1e3:g}) mm; give the points in that frame and state their unit in the "
-            "header (e.g. 'x [mm]')")
-
-
 def parse_extra(items) -> list:
     """NAME=FILE arguments -> [(configuration name, Path)]."""
     from pathlib import Path
@@ -108,21 +90,11 @@ def parse_extra(items) -> list:
     return out
 
 
-def measured_configurations(board, test_uff, extras) -> list:
-    """[(configuration name or None, MeasuredModes)] of the base test and every NAME=FILE; a
-    BoardError for a configuration board.toml does not declare."""
-    from ..board import BoardError
-    from ..updating.board_problem import MeasuredModes
-    from .correlate import load_test_modes
+def measured_configurations(structure, test_uff, extras) -> list:
+    """[(configuration name or None, Modes)] of the base test and every NAME=FILE of ``extras``."""
+    from ..testdata.measured import read_tests
 
-    extra = parse_extra(extras)  # usage errors before any file is read
-    data = [(None, MeasuredModes.from_test(load_test_modes(test_uff)))]
-    for name, path in extra:
-        if board.configuration(name) is None:
-            raise BoardError(f"{board.path.name}: configuration '{name}' (from {name}={path}) is not in "
-                             "[[configurations]]")
-        data.append((name, MeasuredModes.from_test(load_test_modes(path))))
-    return data
+    return read_tests(structure, test_uff, parse_extra(extras))  # usage errors before any file is read
 
 
 def parse_noise(text):

@@ -10,7 +10,7 @@ from pathlib import Path
 import click
 import numpy as np
 
-from .common import PROBE_TOL, done, fail, points_on_board, solve_board, step
+from .common import PROBE_TOL, done, fail, solve_structure, step
 
 HEADER = ("test mode", "model mode", "f_test [Hz]", "f_model [Hz]", "df [%]", "MAC")
 
@@ -36,18 +36,6 @@ def comac_csv(labels, xyz, values) -> str:
     lines = ["dof,x [m],y [m],z [m],COMAC"]
     lines += [f"{lab},{x!r},{y!r},{z!r},{float(c)!r}" for lab, (x, y, z), c in zip(labels, xyz.tolist(), values)]
     return "\n".join(lines) + "\n"
-
-
-def load_test_modes(path: Path):
-    """The measured modes of a UFF file; a clear error when there are none."""
-    from ..testdata import TestDataError, read_uff
-
-    data = read_uff(path)
-    if data.modes is None or data.modes.n_modes == 0:
-        what = " (it holds FRFs only: identify modes from them first)" if data.frfs is not None else ""
-        raise TestDataError(f"{path}: no mode shapes (UFF dataset 55) in the file{what}; export the test's mode "
-                            "shapes as dataset 55, or write a test with 'pcbdyn simulate-test'")
-    return data.modes
 
 
 def z_rows(test_modes):
@@ -94,20 +82,20 @@ def write_outputs(out: Path, board, bm, modes, test_modes, corr) -> list:
               help="write pairs, unpaired test modes and COMAC as JSON")
 def command(board_toml, test_uff, config, min_mac, n_modes, out, json_path):
     """Correlate a board model with a modal test (UFF): pair table, COMAC, pictures."""
-    from ..board import BoardError, load_board
     from ..correlation import correlate
+    from ..domain import StructureError
     from ..fe import ModelError
+    from ..problems import load_structure
     from ..report.files import write_json
-    from ..testdata import Points, TestDataError
+    from ..testdata import TestDataError
+    from ..testdata.measured import read_modes
 
     try:
-        board = load_board(board_toml)
-        test_modes = load_test_modes(test_uff)
-        used = test_modes.points.index(np.unique(test_modes.dofs.point_ids))
-        points_on_board(board, Points(test_modes.points.ids[used], test_modes.points.xyz[used]), test_uff,
-                        board_toml)
+        board = load_structure(board_toml)
+        test_modes = read_modes(test_uff)
+        board.check_points(test_modes.measured_points(), test_uff)
         n_model = n_modes or max(board.analysis.modes, math.ceil(1.5 * test_modes.n_modes))
-        bm, modes, _, _ = solve_board(board, config, n_modes=n_model)
+        bm, modes, _, _ = solve_structure(board, config, n_modes=n_model)
         t0 = step(f"reading the model at {len(test_modes.dofs)} test DOFs and pairing {test_modes.n_modes} test "
                   f"with {modes.frequencies.size} model modes")
         try:
@@ -115,7 +103,7 @@ def command(board_toml, test_uff, config, min_mac, n_modes, out, json_path):
         except ModelError as exc:
             raise TestDataError(f"{test_uff}: the test points do not lie on the model of {board_toml.name}: {exc}")
         done(t0)
-    except (BoardError, ModelError, TestDataError) as exc:
+    except (StructureError, ModelError, TestDataError) as exc:
         fail(str(exc))
     pairing = corr.pairing
     if not pairing.pairs:

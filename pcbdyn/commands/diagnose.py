@@ -32,8 +32,9 @@ from .common import done, fail, measured_configurations, parse_noise, step
 @click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None)
 def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size, out, json_path):
     """Find the effects a board model lacks from modal tests (UFF with mode shapes)."""
-    from ..board import BoardError, load_board
     from ..board.enrich import write_enriched
+    from ..domain import StructureError
+    from ..problems import load_structure
     from ..diagnosis import KINDS
     from ..diagnosis.pipeline import diagnose
     from ..report import diagnosis_report as rep
@@ -49,14 +50,14 @@ def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size,
         if bad:
             raise click.BadParameter(f"unknown kind(s) {bad}; use {', '.join(KINDS)}", param_hint="--kinds")
     try:
-        board = load_board(board_toml)
+        board = load_structure(board_toml)
         tests = measured_configurations(board, test_uff, configs)
         ms = to_si(mesh_size, "mm", "--mesh-size") if mesh_size else None
         t0 = step("diagnosing")
         d = diagnose(board, tests, freq_pct, shape_pct, mesh_size=ms, kinds=chosen, max_effects=max_effects,
                      progress=lambda msg: click.echo(f"    {msg}", err=True))
         done(t0)
-    except (BoardError, TestDataError, KeyError, ValueError) as exc:
+    except (StructureError, TestDataError, KeyError, ValueError) as exc:
         fail(str(exc))
     click.echo(f"\n{board.name}: {d.message}\n")
     click.echo(rep.format_effects(d.effects))
@@ -67,7 +68,7 @@ def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size,
         try:
             enriched = write_enriched(board_toml, rep.enriched_effects(d))
             click.echo(f"\nboard with the effects declared written to {enriched}", err=True)
-        except BoardError as exc:
+        except StructureError as exc:
             click.echo(f"\nnote: the enriched board.toml was not written: {exc}", err=True)
     if out is not None:
         write_text(out / "effects.txt", rep.format_effects(d.effects) + "\n")

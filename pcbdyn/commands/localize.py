@@ -15,92 +15,10 @@ from __future__ import annotations
 from pathlib import Path
 
 import click
-import numpy as np
 
 from .common import done, fail, measured_configurations, parse_extra, parse_noise, step
 
 METHOD_CHOICES = ["tls-qrf", "svd-qr", "qr", "min-norm"]
-
-
-def evidence(method, A, b, names, rank=None, alpha=0.8, redraws=()) -> tuple:
-    """(dict for JSON, the TLS/QR-F Subset). The 5.2.3 check, condition curve and rank always come
-    from TLS/QR-F; selection and solution from ``method``. ``redraws``: equations rebuilt with the
-    stated noise drawn again (:func:`noise_redraws`); with them b is weighted for TLS by the errors
-    the noise makes (else eq. 4.43 with k_A = k_b) and b counts as explained up to the part of
-    those errors outside range(A)."""
-    from ..updating.study import localise
-    from ..updating.subset import EXPLAIN_TOL, explain_tol_from_noise, tls_qrf
-    from ..updating.weighting import tls_column_weight_from_noise
-
-    r = None if rank is None else (rank if rank >= 0 else A.shape[1] + rank)
-    t_b = tls_column_weight_from_noise(A, b, redraws) if redraws else None
-    tol = explain_tol_from_noise(A, b, redraws) if redraws else EXPLAIN_TOL
-    tls = tls_qrf(A, b, rank=r, alpha=alpha, t_b=t_b, explain_tol=tol)
-    if method == "tls-qrf":
-        sel, order, ratios = tls.selected, tls.order, tls.descending_ratio
-    else:
-        sel, order, ratios = localise(method, A, b, rank, t_b), np.zeros(0, int), np.zeros(0)
-    x = np.zeros(A.shape[1])
-    if sel.size:
-        x[sel] = np.linalg.lstsq(A[:, sel], b, rcond=None)[0]
-    data = {
-        "method": method,
-        "tls_weight": t_b,
-        "explain_tol_pct": 100.0 * tol,
-        "selected": [names[i] for i in sel],
-        "order": [names[i] for i in order],
-        "descending_ratio": [float(v) for v in ratios],
-        "solution": {names[i]: float(x[i]) for i in sel},
-        "rank": int(tls.rank),
-        "condition_curve": [float(v) if np.isfinite(v) else None for v in tls.condition_curve],
-        "explains_data": bool(tls.explains_data),
-        "out_of_range_pct": 100.0 * float(tls.out_of_range),
-        "message": tls.message,
-    }
-    return data, tls
-
-
-def noise_redraws(problem, tests, eq_type, matching, shape, freq_pct, shape_pct, seed: int = 0) -> list:
-    """Equations (A_d, b_d) rebuilt from the measured data with the stated noise drawn again
-    (eqs. 5.72-5.73), those that pair like the data (``shape`` of A): what the noise does to the
-    equations, for the TLS weight of b and the 5.2.3 check."""
-    from dataclasses import replace
-
-    from ..updating.board_problem import config_pairing
-    from ..updating.iteration import build_equations
-    from ..updating.success import add_noise
-    from ..updating.weighting import NOISE_REDRAWS
-
-    rng = np.random.default_rng(seed)
-    redraws = []
-    for _ in range(NOISE_REDRAWS):
-        cfgs = [problem.configuration(name, replace(
-            m, frequencies=add_noise(m.frequencies, freq_pct or 0.0, rng),
-            shapes=None if m.shapes is None else add_noise(m.shapes, shape_pct or 0.0, rng)), eq_type,
-            matching=matching) for name, m in tests]
-        (Ad, bd), _, _ = build_equations(cfgs, problem.p0, config_pairing(cfgs))
-        if Ad.shape == shape:
-            redraws.append((Ad, bd))
-    return redraws
-
-
-def fbm_map(path, cfg, state, xy):
-    """FBM residual forces (eq. 5.2) of the base configuration's measured modes: the shapes are
-    expanded to the model (eq. 2.25), the residuals read back at the measured points (the
-    expansion leaves none elsewhere), scaled per mode to a maximum of 1, summed over the modes
-    and drawn over the measured points (as thesis Fig. 5.1, on the board)."""
-    from ..report.localisation_plots import save_map
-    from ..updating import matching
-    from ..updating.indicators import fbm_residuals
-
-    K, M, used = state["K"], state["M"], state["used"]
-    om = 2 * np.pi * np.asarray(cfg.f_x, float)[used]
-    phi = matching.expand(K, M, cfg.P, np.asarray(cfg.phi_x)[:, used], om)
-    res = np.abs(np.asarray(cfg.P @ fbm_residuals(K, M, om, phi)))
-    peak = res.max(axis=0)
-    values = (res / np.where(peak > 0, peak, 1.0)).sum(axis=1)
-    save_map(path, xy, None, values, "FBM residual forces at the test points (eq. 5.2)")
-    return values
 
 
 @click.command("localize")
@@ -126,33 +44,31 @@ def command(board_toml, test_uff, config_tests, method, eq_type, params, rank, a
             json_path):
     """Localise model errors among the board's parameters from one or more modal tests
     (extra tests as CONFIG=test.uff for configurations of board.toml)."""
-    from ..board import load_board
+    from ..domain import StructureError
+    from ..problems import UpdateProblem, load_structure
+    from ..problems.localize import evidence, noise_redraws
     from ..report.files import write_json
     from ..testdata import TestDataError
-    from ..board import BoardError
-    from ..updating.board_problem import BoardProblem, config_pairing
     from ..updating.iteration import build_equations
 
     extra = parse_extra(config_tests)
     freq_pct, shape_pct = parse_noise(noise)
     try:
-        board = load_board(board_toml)
+        board = load_structure(board_toml)
         names = [n.strip() for n in params.split(",")] if params else None
         t0 = step("building the model and its parameter derivatives")
-        problem = BoardProblem(board, names)
+        problem = UpdateProblem(board, names)
         configs = []
         tests = measured_configurations(board, test_uff, config_tests)
         for (name, measured), (_, path) in zip(tests, [(None, test_uff)] + extra):
             if eq_type in ("qms", "fbm") and measured.shapes is None:
                 raise ValueError(f"{path.name}: --equations {eq_type} needs mode shapes")
             configs.append(problem.configuration(name, measured, eq_type, matching=matching))
-            if name is None:
-                measured_xy = None if measured.xyz is None else measured.xyz[:, :2]
-        (A, b), _, states = build_equations(configs, problem.p0, config_pairing(configs))
+        (A, b), _, states = build_equations(configs, problem.p0)
         redraws = [] if noise is None else noise_redraws(problem, tests, eq_type, matching, A.shape, freq_pct,
                                                           shape_pct)
         done(t0)
-    except (ValueError, KeyError, TestDataError, BoardError) as exc:
+    except (ValueError, KeyError, TestDataError, StructureError) as exc:
         fail(str(exc).strip("'\""))
     data, tls = evidence(method, A, b, problem.names, rank, alpha, redraws)
     data["configurations"] = ["base"] + [n for n, _ in extra]
@@ -166,13 +82,17 @@ def command(board_toml, test_uff, config_tests, method, eq_type, params, rank, a
     if not data["explains_data"]:
         click.echo("warning: " + data["message"])
     if out is not None:
-        from ..report.localisation_plots import localisation_figure
+        from ..problems.localize import fbm_map
+        from ..report.localisation_plots import localisation_figure, save_map
 
         out.mkdir(parents=True, exist_ok=True)
         localisation_figure(out / "localisation.png", tls, problem.names)
-        if eq_type in ("qms", "fbm") and measured_xy is not None:
-            fbm = fbm_map(out / "fbm_map.png", configs[0], states[0], measured_xy)
-            data["fbm_peak_mm"] = [1e3 * float(v) for v in measured_xy[int(np.argmax(fbm))]]
+        measured = tests[0][1]
+        if eq_type in ("qms", "fbm") and measured.shapes is not None:
+            xy = measured.xyz[:, :2]
+            fbm, peak = fbm_map(configs[0], states[0])
+            save_map(out / "fbm_map.png", xy, None, fbm, "FBM residual forces at the test points (eq. 5.2)")
+            data["fbm_peak_mm"] = [1e3 * float(v) for v in xy[peak]]
         drawn = ", fbm_map.png" if "fbm_peak_mm" in data else ""
         click.echo(f"wrote {out}/localisation.png{drawn}", err=True)
     if json_path is not None:

@@ -9,9 +9,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import click
-import numpy as np
 
-from .common import PROBE_TOL, done, fail, number_pair, points_on_board, solve_board, step
+from .common import PROBE_TOL, done, fail, number_pair, solve_structure, step
 
 
 def check_band(f_range, df: float) -> None:
@@ -21,12 +20,6 @@ def check_band(f_range, df: float) -> None:
     if f_range is not None and not (0 <= f_range[0] < f_range[1]):
         raise click.BadParameter(f"{f_range[0]:g},{f_range[1]:g} is not a range 0 <= f_lo < f_hi in Hz",
                                  param_hint="--f-range")
-
-
-def frequency_axis(f_range, df: float, f_top: float) -> np.ndarray:
-    """Lines from f_lo to f_hi every ``df`` Hz; without a range, 0 to 1.2 times ``f_top``."""
-    lo, hi = f_range if f_range is not None else (0.0, df * np.ceil(1.2 * f_top / df))
-    return lo + df * np.arange(int(np.floor((hi - lo) / df + 1e-9)) + 1)
 
 
 @click.command("simulate-test")
@@ -51,11 +44,12 @@ def frequency_axis(f_range, df: float, f_top: float) -> np.ndarray:
               help="write a summary (frequencies, points, excitation, noise) as JSON")
 def command(board_toml, points_csv, config, excite, noise, seed, f_range, df, damping, kind, n_modes, out, json_path):
     """Simulate a modal test on a board model: modes and FRFs at measurement points, with noise."""
-    from ..board import BoardError, load_board
+    from ..domain import StructureError
+    from ..problems import load_structure
     from ..fe import ModelError
     from ..report.files import write_json
-    from ..testdata import Noise, TestDataError, read_points_csv, write_uff
-    from ..testdata.simulate import simulate_on_model
+    from ..testdata import Noise, Points, TestDataError, read_points_csv, write_uff
+    from ..testdata.simulate import frequency_axis, simulate_on_model
 
     xy = number_pair(excite, "--excite", "mm")
     band = number_pair(f_range, "--f-range") if f_range is not None else None
@@ -67,13 +61,11 @@ def command(board_toml, points_csv, config, excite, noise, seed, f_range, df, da
     if not 0 <= damping < 1:
         raise click.BadParameter(f"{damping} is not a damping ratio in [0, 1)", param_hint="--damping")
     try:
-        board = load_board(board_toml)
+        board = load_structure(board_toml)
         points, dofs = read_points_csv(points_csv)
-        points_on_board(board, points, points_csv, board_toml)
-        if not board.outline.contains(np.array(xy))[0]:
-            raise click.BadParameter(f"{xy[0] * 1e3:g},{xy[1] * 1e3:g} mm is not on the board outline of "
-                                     f"{board_toml.name}; give a point on the board", param_hint="--excite")
-        bm, modes, _, _ = solve_board(board, config, n_modes=n_modes)
+        board.check_points(points, points_csv)
+        board.check_points(Points([0], [[xy[0], xy[1], 0.0]]), "--excite")
+        bm, modes, _, _ = solve_structure(board, config, n_modes=n_modes)
         f_axis = frequency_axis(band, df, float(modes.frequencies.max()))
         t0 = step(f"reading the model at {len(dofs)} DOFs and summing {modes.frequencies.size} modes "
                   f"over {f_axis.size} lines")
@@ -81,7 +73,7 @@ def command(board_toml, points_csv, config, excite, noise, seed, f_range, df, da
                                  zeta=damping, kind=kind, noise=noise_levels, seed=seed, tol=PROBE_TOL)
         done(t0)
         write_uff(out, data)
-    except (BoardError, ModelError, TestDataError) as exc:
+    except (StructureError, ModelError, TestDataError) as exc:
         fail(str(exc))
     ref_id = int(data.frfs.reference.point_ids[0])
     click.echo(f"\n{board.name} [{config or 'base'}]: simulated test, {len(dofs)} response DOFs, "

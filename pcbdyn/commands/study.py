@@ -48,7 +48,8 @@ CASE_KEYS = {
 
 def read_spec(path: Path) -> dict:
     """The [study] and [case] tables of ``path``, checked; ValueError names the bad field."""
-    from ..updating.study import CASES, METHODS
+    from ..problems.cases import CASES
+    from ..updating.study import METHODS
 
     try:
         doc = tomllib.loads(path.read_text())
@@ -88,7 +89,7 @@ def read_spec(path: Path) -> dict:
                 raise ValueError(f"[study] {key}: case 'board' needs board = \"board.toml\" and points = \"points.csv\"")
             if not (path.parent / s[key]).is_file():
                 raise ValueError(f"[study] {key} = {s[key]!r}: no such file next to {path.name}")
-        opts.update(board_toml=path.parent / s["board"], points_csv=path.parent / s["points"],
+        opts.update(path=path.parent / s["board"], points_csv=path.parent / s["points"],
                     truth=doc.get("truth", {}))
     out = s.get("out")
     return {
@@ -108,7 +109,9 @@ def command(study_toml: Path, json_path: Path | None, quiet: bool):
     """Judge localisation methods by their success ratio over noisy random shots (thesis eq. 5.65-5.66)."""
     from ..report.files import write_json, write_text
     from ..testdata import TestDataError
-    from ..updating.study import CASES, run_study, summarise
+    from ..domain import StructureError
+    from ..problems.cases import CASES
+    from ..updating.study import run_study, summarise
     from .common import done, fail, step
 
     try:
@@ -118,7 +121,7 @@ def command(study_toml: Path, json_path: Path | None, quiet: bool):
         done(t0)
         df = run_study(case, spec["levels"], spec["shots"], spec["methods"], spec["equations"], seed=spec["seed"],
                        rank=spec["rank"], workers=spec["workers"], progress=not quiet)
-    except (ValueError, TypeError, KeyError, TestDataError) as exc:
+    except (ValueError, TypeError, KeyError, TestDataError, StructureError) as exc:
         fail(f"{study_toml.name}: {str(exc).strip(chr(34) + chr(39))}")
     summary = summarise(df)
     true = [case.parameter_names[i] for i in case.true_errors]

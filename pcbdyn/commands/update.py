@@ -31,31 +31,8 @@ import numpy as np
 
 from .common import done, fail, measured_configurations, parse_extra, step
 
-BASE_NAMES = ("base", "c1", "")
 #: SI unit of the JSON values for the display units board.toml quantities use (others are SI already)
 SI_UNITS = {"mm": "m", "g": "kg"}
-
-
-def read_frequency_table(path: Path, board) -> list:
-    """[(configuration or None, MeasuredModes)] from a CSV of measured frequencies."""
-    import pandas as pd
-
-    from ..updating.board_problem import MeasuredModes
-
-    df = pd.read_csv(path, comment="#")
-    need = {"configuration", "mode", "frequency_hz"}
-    if not need <= set(df.columns):
-        raise click.BadParameter(f"{path}: needs columns {sorted(need)}, found {list(df.columns)}",
-                                 param_hint="--frequencies")
-    out = []
-    known = [c.name for c in board.configurations]
-    for name, g in df.groupby("configuration", sort=False):
-        cfg = None if str(name) in BASE_NAMES else str(name)
-        if cfg is not None and cfg not in known:
-            raise click.BadParameter(f"{path}: configuration '{name}' is not in {board.path.name} "
-                                     f"(known: base/c1, {', '.join(known) or 'none'})", param_hint="--frequencies")
-        out.append((cfg, MeasuredModes(g["frequency_hz"].to_numpy(float), mode_numbers=g["mode"].to_numpy(int))))
-    return out
 
 
 def parse_frf_freqs(text):
@@ -68,42 +45,6 @@ def parse_frf_freqs(text):
     if vals.size == 0 or np.any(vals <= 0):
         raise click.BadParameter(f"'{text}': give positive frequencies in Hz (e.g. 150,230,410)", param_hint="--frf-freqs")
     return vals
-
-
-def frf_data(problem, board, test_uff, configs, method, frf_freqs, damping):
-    """(check, cfgs) for the FRF methods: the frequency configurations of the before/after tables and
-    the FRF configurations of every UFF file (base + NAME=FILE)."""
-    from ..board import BoardError
-    from ..testdata import TestDataError, read_uff
-    from ..updating.board_problem import MeasuredFRFs, MeasuredModes, resonance_lines
-
-    freqs = None if frf_freqs is None else parse_frf_freqs(frf_freqs)
-    files = [(None, test_uff)]
-    for name, path in parse_extra(configs):
-        if board.configuration(name) is None:
-            raise BoardError(f"{board.path.name}: configuration '{name}' (from {name}={path}) is not in [[configurations]]")
-        files.append((name, path))
-    check, cfgs = [], []
-    for name, path in files:
-        td = read_uff(path)
-        if td.frfs is None:
-            raise TestDataError(f"{path}: no FRFs (UFF dataset 58) in the file; --method {method} needs measured FRFs "
-                                "(write them with 'pcbdyn simulate-test' or export them from the test)")
-        meas = MeasuredFRFs.from_test(td.frfs)
-        got, notes = problem.frf_configurations(name, meas, method, freqs=freqs, damping=damping)
-        for note in notes:
-            click.echo(f"note ({path.name}): {note}", err=True)
-        click.echo(f"{path.name}: updating frequencies " + ", ".join(f"{f:.1f}" for f in got[0].frf_hz) + " Hz",
-                   err=True)
-        cfgs += got
-        if td.modes is not None and td.modes.n_modes:
-            check.append(problem.configuration(name, MeasuredModes.from_test(td.modes), "freq"))
-        else:
-            peaks = resonance_lines(meas[0].frequencies, meas[0].H)
-            click.echo(f"{path.name}: no modes in the file; the before/after tables use its FRF peaks paired by order",
-                       err=True)
-            check.append(problem.configuration(name, MeasuredModes(peaks), "freq"))
-    return check, cfgs
 
 
 @click.command("update")
@@ -133,39 +74,43 @@ def frf_data(problem, board, test_uff, configs, method, frf_freqs, damping):
 def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping, solver, params, max_iter, tol_pct,
             mesh_size, out, json_path):
     """Update a board model's parameters against modal tests (UFF) or measured frequencies (CSV)."""
-    from ..board import BoardError, load_board
+    from ..domain import StructureError
+    from ..problems import UpdateProblem, load_structure, run
+    from ..problems.frf_tests import frf_configurations
     from ..report import update_report as rep
     from ..report.files import write_json, write_text
     from ..testdata import TestDataError
+    from ..testdata.measured import read_frequency_table
     from ..units import to_si
-    from ..updating.board_problem import BoardProblem, MeasuredModes, run
 
     if (test_uff is None) == (freq_csv is None):
         fail("give either TEST_UFF (and NAME=FILE for other configurations) or --frequencies FILE.csv")
     if freq_csv is not None and method != "freq":
         fail("--frequencies holds no shapes: use --method freq")
     try:
-        board = load_board(board_toml)
+        board = load_structure(board_toml)
         ms = to_si(mesh_size, "mm", "--mesh-size") if mesh_size else None
         t0 = step("building the models")
-        problem = BoardProblem(board, params.split(",") if params else None, mesh_size=ms)
+        problem = UpdateProblem(board, params.split(",") if params else None, mesh_size=ms)
         if method.startswith("frf"):
-            check, cfgs = frf_data(problem, board, test_uff, configs, method, frf_freqs, damping)
-        elif freq_csv is not None:
-            data = read_frequency_table(freq_csv, board)
-            click.echo("frequencies only: test mode n is paired with elastic model mode n (by order)", err=True)
+            freqs = None if frf_freqs is None else parse_frf_freqs(frf_freqs)
+            check, cfgs, notes = frf_configurations(problem, [(None, test_uff)] + parse_extra(configs), method,
+                                                    freqs, damping)
+            for note in notes:
+                click.echo(f"note: {note}", err=True)
         else:
-            data = measured_configurations(board, test_uff, configs)
-            if method == "freq":
-                data = [(c, MeasuredModes(m.frequencies, m.shapes, m.xyz, m.directions)) for c, m in data]
-        if not method.startswith("frf"):
+            if freq_csv is not None:
+                data = read_frequency_table(freq_csv, board)
+                click.echo("frequencies only: test mode n is paired with elastic model mode n (by order)", err=True)
+            else:
+                data = measured_configurations(board, test_uff, configs)
             check = [problem.configuration(c, m, "freq") for c, m in data]
             cfgs = check if method == "freq" else [q for c, m in data for q in problem.mode_configurations(c, m, method)]
         done(t0)
         t0 = step(f"updating {len(problem.names)} parameter(s) with {method}/{solver} over {len(cfgs)} configuration(s)")
         res, before, after = run(problem, cfgs, solver, check=check, max_iter=max_iter, tol_freq_pct=tol_pct)
         done(t0)
-    except (BoardError, TestDataError, KeyError, ValueError) as exc:
+    except (StructureError, TestDataError, KeyError, ValueError) as exc:
         fail(str(exc))
     rows = rep.parameter_rows(problem, res.p)
     click.echo(f"\n{board.name}: {res.reason} after {res.iterations} iteration(s) "
@@ -173,7 +118,10 @@ def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping,
     click.echo(rep.format_parameters(rows))
     click.echo("")
     click.echo(rep.format_correlation(before, after))
-    dst = rep.write_updated_board(board_toml, board, problem, res.p)
+    try:
+        dst = problem.write_updated(res.p, rep.updated_board_path(board_toml))
+    except StructureError as exc:
+        fail(str(exc))
     click.echo(f"\nupdated board written to {dst}", err=True)
     if out is not None:
         rep.plot_iterations(out / "iterations.png", problem, res)

@@ -118,8 +118,8 @@ def initial_quantities(board) -> dict:
             q[f"{key}.thickness"] = c.thickness
         if c.model == "smeared_local":
             E = board.quantity(f"{key}.E")
-            q[f"{key}.E"] = E[0] if E else (c.E if c.E is not None else board.plate.equivalent_isotropic()[0])
-            q[f"{key}.rho"] = board.quantity(f"{key}.rho")[0]
+            q[f"{key}.E"] = E if E is not None else (c.E if c.E is not None else board.plate.equivalent_isotropic()[0])
+            q[f"{key}.rho"] = board.quantity(f"{key}.rho")
     return q
 
 

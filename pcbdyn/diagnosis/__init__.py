@@ -4,6 +4,13 @@ candidate effects (one plugin module per kind), :mod:`.layout` says where they c
 the mesh and the plate theory leave between model and test, :mod:`.pipeline` runs the whole
 diagnosis."""
 
+# the kinds of effects, registered in the order candidates are generated and searched
+from . import point_mass  # noqa: F401  (point_mass, point_inertia)
+from . import ground_spring  # noqa: F401
+from . import edge_stiffness  # noqa: F401
+from . import region_stiffness  # noqa: F401
+from . import stiffener  # noqa: F401
+from . import line_mass  # noqa: F401
 from .catalogue import (
     KINDS,
     Candidate,
@@ -16,8 +23,8 @@ from .catalogue import (
     kind,
     place,
 )
-from .layout import Layout, from_board, from_model
+from .layout import Layout, from_model, from_structure
 from .select import Selection, forward_select
 
 __all__ = ["KINDS", "Candidate", "CatalogueError", "Layout", "Selection", "add_effect", "derivatives", "place",
-           "eigenvalue_columns", "forward_select", "frequency_columns", "from_board", "from_model", "generate", "kind"]
+           "eigenvalue_columns", "forward_select", "frequency_columns", "from_model", "from_structure", "generate", "kind"]

@@ -3,7 +3,7 @@ nominal value is zero (issue 7, step 4).
 
 A candidate is a catalogue kind (``point_mass``, ``ground_spring``, ``edge_stiffness``,
 ``region_stiffness``, ``stiffener``, ``line_mass``), a place and a parameter. Every kind is a
-plugin module of this package exposing an object (registered in :data:`KINDS`) with
+plugin module of this package that registers an object (:func:`register`, into :data:`KINDS`) with
 
 - ``name``, ``report_as`` (the catalogue type reported), ``param`` (what the parameter is),
   ``unit`` (SI), ``scale`` (a typical magnitude), ``lower`` (the least physical value),
@@ -18,32 +18,31 @@ plugin module of this package exposing an object (registered in :data:`KINDS`) w
 Every effect enters K and M linearly in its parameter, so dK/dp and dM/dp are exact and the
 same at every value, and the first-order eigenvalue sensitivity (thesis eq. 3.11 with k = i)
 d lambda_i / dp = phi_i^T (dK/dp - lambda_i dM/dp) phi_i is a sum of element quadratic forms
-computed for all candidates of a kind in one pass (:func:`eigenvalue_columns`).
-A new kind of effect is one new module plus one line in :data:`KINDS`.
+computed for all candidates of a kind in one pass (:func:`effect_forms`, :func:`eigenvalue_columns`).
+A new kind of effect is one new module plus its import in :mod:`pcbdyn.diagnosis`.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
-from importlib import import_module
 
 import numpy as np
 import scipy.sparse as sp
 
 from ..fe.assembly import scatter
 from ..fe.mesh import element_dofs
+from ..updating.sensitivity import eigen_derivatives
 
-#: catalogue name -> (module of this package, plugin object in it). ``point_inertia`` is the
+#: catalogue name -> plugin object, filled by :func:`register` as the kind modules are imported (by
+#: :mod:`pcbdyn.diagnosis`, in the order candidates are generated). ``point_inertia`` is the
 #: rotary-inertia parameter of a point mass (reported as a ``point_mass``).
-KINDS = {
-    "point_mass": ("point_mass", "MASS"),
-    "point_inertia": ("point_mass", "INERTIA"),
-    "ground_spring": ("ground_spring", "KIND"),
-    "edge_stiffness": ("edge_stiffness", "KIND"),
-    "region_stiffness": ("region_stiffness", "KIND"),
-    "stiffener": ("stiffener", "KIND"),
-    "line_mass": ("line_mass", "KIND"),
-}
+KINDS: dict = {}
+
+
+def register(*plugins) -> None:
+    """Add catalogue kinds (plugin objects with a ``name``) to :data:`KINDS`."""
+    for plugin in plugins:
+        KINDS[plugin.name] = plugin
 
 
 class CatalogueError(ValueError):
@@ -101,10 +100,9 @@ class Blocks:
 def kind(name: str):
     """The plugin object of catalogue kind ``name``."""
     try:
-        module, attr = KINDS[name]
+        return KINDS[name]
     except KeyError:
         raise CatalogueError(f"unknown effect kind '{name}' (use one of {', '.join(KINDS)})") from None
-    return getattr(import_module(f"{__package__}.{module}"), attr)
 
 
 def copy_model(model):
@@ -142,7 +140,7 @@ def place(layout, candidate) -> Candidate:
     return replace(candidate.spec.place(layout, candidate), name=candidate.name, prime=candidate.prime)
 
 
-def bilinear_forms(model, basis: np.ndarray, shapes: np.ndarray, candidates):
+def effect_forms(model, basis: np.ndarray, shapes: np.ndarray, candidates):
     """(BK, BM), each (n_candidates, n_basis, n_shapes): phi_k^T dK/dp phi_i and phi_k^T dM/dp phi_i
     for full-length ``basis`` columns k and ``shapes`` columns i, summed over each candidate's
     cells (the terms of the eigenvalue and eigenvector derivatives, thesis eqs. 3.6 and 3.11)."""
@@ -164,11 +162,10 @@ def bilinear_forms(model, basis: np.ndarray, shapes: np.ndarray, candidates):
 
 def eigenvalue_columns(model, modes, candidates) -> np.ndarray:
     """d lambda_i / dp for every mode i (rows) and candidate (columns) [rad^2/s^2 per SI unit],
-    from mass-normalised full-length shapes (``fe.modal.Modes``): sum over the candidate's cells
-    of phi_i^T (Ke - lambda_i Me) phi_i."""
-    BK, BM = bilinear_forms(model, modes.shapes, modes.shapes, candidates)
-    i = np.arange(modes.shapes.shape[1])
-    return (BK[:, i, i] - BM[:, i, i] * modes.omega2[None, :]).T
+    from mass-normalised full-length shapes (``fe.modal.Modes``): thesis eq. 3.6 on the candidates'
+    element forms (:func:`pcbdyn.updating.sensitivity.eigen_derivatives`)."""
+    BK, BM = effect_forms(model, modes.shapes, modes.shapes, candidates)
+    return eigen_derivatives(BK, BM, modes.omega2, np.arange(modes.shapes.shape[1]))[0].T
 
 
 def frequency_columns(model, modes, candidates) -> np.ndarray:

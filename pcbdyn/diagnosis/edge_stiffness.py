@@ -13,7 +13,7 @@ import numpy as np
 
 from ..board.effects import edge_spring_property
 from ..fe.elements import kernel
-from .catalogue import AlongSides, Blocks, copy_model
+from .catalogue import register, AlongSides, Blocks, copy_model
 
 
 class _EdgeStiffness(AlongSides):
@@ -36,3 +36,4 @@ class _EdgeStiffness(AlongSides):
 
 
 KIND = _EdgeStiffness()
+register(KIND)

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..fe import SpringProperty
-from .catalogue import Blocks, copy_model, node_candidates, on_nearest_node
+from .catalogue import register, Blocks, copy_model, node_candidates, on_nearest_node
 
 
 class _GroundSpring:
@@ -38,3 +38,4 @@ class _GroundSpring:
 
 
 KIND = _GroundSpring()
+register(KIND)

@@ -1,9 +1,9 @@
 """Where candidate effects can go on a meshed plate: its shell cells and nodes, its straight
 boundary sides and support lines, prime-suspect points and part footprints.
 
-A :class:`Layout` is made from any ``fe.Model`` (:func:`from_model`) or from a board model
-(:func:`from_board`, which adds the measurement points and declared masses as prime suspects and
-the part footprints as regions). Candidate generators (the catalogue's plugins) only ask it
+A :class:`Layout` is made from any ``fe.Model`` (:func:`from_model`) or from a structure's built model
+(:func:`from_structure`, which adds what the structure names as prime suspects and footprints: on a
+board, the measurement points, declared masses and part footprints). Candidate generators (the catalogue's plugins) only ask it
 geometric questions: grid nodes, boundary segments, cells inside a polygon, the cells a line crosses.
 """
 
@@ -254,9 +254,9 @@ def from_model(model, suspects=None, footprints=None, thickness: float | None = 
     return Layout(model, shells, sides, dict(suspects or {}), dict(footprints or {}), t)
 
 
-def from_board(bm) -> Layout:
-    """The layout of a :class:`pcbdyn.board.model.BoardModel`: measurement points (``points.*``) and
-    declared point masses (``masses.*``) are the prime suspects, part footprints the regions."""
-    suspects = {n: v for n, v in bm.point_nodes.items() if n.startswith(("points.", "masses."))}
-    footprints = {f"components.{c.ref}": c.corners() for c in bm.board.components}
-    return from_model(bm.model, suspects, footprints, bm.board.thickness)
+def from_structure(pm) -> Layout:
+    """The layout of a structure's built model ``pm`` (e.g. :class:`pcbdyn.board.BoardModel`), with the
+    prime suspects, footprints and plate thickness of its ``layout_hints()`` (on a board: measurement
+    points and declared masses, part footprints)."""
+    suspects, footprints, thickness = pm.layout_hints()
+    return from_model(pm.model, suspects, footprints, thickness)

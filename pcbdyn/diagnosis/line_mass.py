@@ -8,7 +8,7 @@ import numpy as np
 
 from ..board.effects import tributary_weights
 from ..fe import MassProperty
-from .catalogue import AlongSides, Blocks, copy_model
+from .catalogue import register, AlongSides, Blocks, copy_model
 
 
 class _LineMass(AlongSides):
@@ -34,3 +34,4 @@ class _LineMass(AlongSides):
 
 
 KIND = _LineMass()
+register(KIND)

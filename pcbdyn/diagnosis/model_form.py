@@ -13,6 +13,7 @@ import numpy as np
 from ..correlation.mac import mac
 from ..fe.modal import solve_modes
 from ..fe.probe import model_probe
+from ..updating.solvers import covariance
 from .residual import paired_mac
 from .select import ALPHA, adopt, estimate, penalty, worth
 
@@ -21,7 +22,7 @@ from .select import ALPHA, adopt, estimate, penalty, worth
 RESOLVED_SHAPE_CHANGE = 0.02
 #: how many times the mesh is halved at most to correct the model's frequencies for it
 MESH_LEVELS = 2
-#: the transverse shear factor (:data:`..components.models.SHEAR_KEY`) of the Kirchhoff limit:
+#: the factor on the shells' transverse shear (``with_shear_factor`` of a structure's model) of the Kirchhoff limit:
 #: a shear this much stiffer is a Kirchhoff plate to within 0.1 % of the gap
 KIRCHHOFF_SHEAR = 1000.0
 
@@ -34,7 +35,7 @@ def follow(model, ob, u_prev, k_prev):
     if ob.shapes is None:
         k = np.minimum(k_prev, modes.frequencies.size - 1)
         return modes.frequencies[k], None, k, np.full(k.size, np.inf)
-    U = np.asarray(model_probe(model, ob.xyz, ob.directions, tol=0.02).P @ modes.shapes)
+    U = np.asarray(model_probe(model, ob.modes.xyz, ob.modes.directions, tol=0.02).P @ modes.shapes)
     k = mac(u_prev, U).argmax(axis=1)
     U = U[:, k]
     return modes.frequencies[k], U, k, np.sqrt(np.clip(1.0 - paired_mac(U, u_prev), 0.0, None))
@@ -70,15 +71,12 @@ def discretisation(finer, ob, coarse_state):
 
 def kirchhoff_shift(fine_bm, ob, coarse_state) -> np.ndarray:
     """Relative frequency change per paired mode when the shells' transverse shear of ``fine_bm``
-    (a BoardModel on the finest mesh of :func:`discretisation`) is made rigid: the Kirchhoff
-    limit. The gap grows as the mesh resolves the shear boundary layer at free edges (about 1 %
+    (a structure's model on the finest mesh of :func:`discretisation`, with ``with_shear_factor``) is
+    made rigid: the Kirchhoff limit. The gap grows as the mesh resolves the shear boundary layer at free edges (about 1 %
     on the twisting modes of a 2.8 mm card at a quarter of its model's mesh, half that at the
     model's mesh), so it is measured where the frequencies are corrected to."""
-    from ..components.models import SHEAR_KEY
-
     f, U, k, _ = follow(fine_bm.model, ob, coarse_state.u, coarse_state.pairs)
-    fk, _, _, _ = follow(fine_bm.with_quantities({SHEAR_KEY: KIRCHHOFF_SHEAR}).model, ob,
-                         coarse_state.u if U is None else U, k)
+    fk, _, _, _ = follow(fine_bm.with_shear_factor(KIRCHHOFF_SHEAR).model, ob, coarse_state.u if U is None else U, k)
     return fk / f - 1.0
 
 
@@ -106,7 +104,7 @@ def fit_plate_share(res, candidates, sel, shifts, sigma_f, bounds=None, alpha: f
                               for ob, cs, d in zip(obs, st.configs, shifts)])
         J = np.column_stack([held, col])
         x = np.linalg.lstsq(J, st.r, rcond=None)[0]
-        var_theta = min(1.0, max(1.0, fit.chi2 / max(res.n_rows - J.shape[1], 1)) * np.linalg.pinv(J.T @ J)[-1, -1])
+        var_theta = min(1.0, covariance(J, st.r)[-1, -1])
         x0 = np.linalg.lstsq(held, st.r, rcond=None)[0] if held.shape[1] else np.zeros(0)
         step = float(np.clip(theta + x[-1], 0.0, 1.0)) - theta
         e1, e0 = st.r - J[:, :-1] @ x[:-1] - col * step, st.r - held @ x0

@@ -1,7 +1,7 @@
 """Diagnosis of a board against modal tests (issue 7): update the declared parameters, decide
 whether what remains is noise, and otherwise find, place and size the effects the model lacks.
 
-1. One mesh for every configuration (``build_model(..., shared_mesh=True)``), test modes paired by
+1. One mesh for every configuration (:class:`pcbdyn.problems.StructureModels`, ``shared_mesh``), test modes paired by
    MAC, residual rows in units of noise (:mod:`.residual`).
 2. Noise: the stated levels (uniform bounds as in thesis eqs. 5.72-5.73, so a standard deviation
    of p / sqrt(3)), or, for shapes without a stated level, the part of each measured shape that no
@@ -36,12 +36,12 @@ import numpy as np
 import shapely
 from scipy.stats import chi2 as chi2_dist
 
-from ..board import build_model
 from ..fe.modal import solve_modes
 from ..fe.probe import model_probe, segment_parameter
+from ..problems.models import StructureModels
 from .bodies import as_bodies
-from .catalogue import add_effect, generate, place, weighted_centre
-from .layout import from_board
+from .catalogue import KINDS, add_effect, generate, kind, place, weighted_centre
+from .layout import from_structure
 from .model_form import MESH_LEVELS, discretisation, fit_plate_share, kirchhoff_shift
 from .residual import ModalResidual, Observation
 from .select import ALPHA, adopt, estimate, penalty, refine, search, without_vanished
@@ -55,8 +55,6 @@ CANDIDATE_OPTIONS = {"segments": 16, "path_spacing": 1.0}
 
 
 def _options(kinds) -> set:
-    from .catalogue import KINDS, kind
-
     return {o for name in (kinds or KINDS) for o in kind(name).options}
 
 @dataclass
@@ -96,46 +94,22 @@ def _noise_sigmas(ob: Observation, freq_pct, shape_pct, basis_shapes):
     return sf, np.maximum(np.sqrt(np.mean(var)) / rms, 1e-4)
 
 
-class _BoardModels:
-    """The board's configurations on one mesh, as functions of the declared parameters."""
-
-    def __init__(self, board, configs, h):
-        self.names = [p.name for p in board.parameters]
-        self.bms = [build_model(board, c, h, shared_mesh=True) for c in configs]
-        params = [self.bms[0].parameters[n] for n in self.names]
-        self.p0 = np.array([p.value for p in params], float)
-        self.bounds = (np.array([p.bounds[0] for p in params], float), np.array([p.bounds[1] for p in params], float))
-
-    def at(self, p):
-        return [bm.with_parameters(dict(zip(self.names, np.asarray(p, float).tolist()))) for bm in self.bms]
-
-    def build(self, p):
-        return [b.model for b in self.at(p)]
-
-    def derivatives(self, p, models):
-        return [[b.parameters[n].derivatives(b) for n in self.names] for b in self.at(p)]
-
-    def residual(self, observations) -> ModalResidual:
-        return ModalResidual(observations, self.build, self.derivatives if self.names else None, len(self.names))
-
-
-def _observations(tests, bms) -> list:
+def _observations(tests, models) -> list:
+    """An Observation per test [(configuration, Modes)], read on its configuration's built model."""
     obs = []
-    for (c, mm), bm in zip(tests, bms):
-        ob = Observation(c, np.asarray(mm.frequencies, float), np.ones(len(mm.frequencies)), xyz=mm.xyz,
-                         directions=mm.directions)
+    for (c, mm), pm in zip(tests, models):
+        ob = Observation(c, mm, np.ones(mm.n_modes))
         if mm.shapes is not None:
-            ob.shapes = np.asarray(mm.shapes, float)
-            ob.read = model_probe(bm.model, mm.xyz, mm.directions, tol=0.02).P
-            ob.sigma_s = np.ones(ob.f.size)  # until the noise is known
+            ob.read = model_probe(pm.model, mm.xyz, mm.directions, tol=0.02).P
+            ob.sigma_s = np.ones(mm.n_modes)  # until the noise is known
         obs.append(ob)
     return obs
 
 
-def _finer(board, name, h, p: dict) -> list:
-    """BoardModels of configuration ``name`` at parameters ``p`` on the meshes twice, four
+def _finer(structure, name, h, p: dict) -> list:
+    """Built models of configuration ``name`` at parameters ``p`` on the meshes twice, four
     times, ... as fine as ``h`` (:data:`.model_form.MESH_LEVELS`)."""
-    return [build_model(board, name, h / 2**j, shared_mesh=True).with_parameters(p) for j in range(1, MESH_LEVELS + 1)]
+    return [structure.build(name, h / 2**j, shared_mesh=True).with_parameters(p) for j in range(1, MESH_LEVELS + 1)]
 
 
 @dataclass
@@ -163,7 +137,7 @@ def _correct(ob, cs, models, form: _Form):
     return ds
 
 
-def _set_noise(board, models, h, obs, state, freq_pct, shape_pct) -> list:
+def _set_noise(structure, models, h, obs, state, freq_pct, shape_pct) -> list:
     """Each observation's discretisation correction of the model frequencies, and its sigmas:
     measurement noise, what remains of the discretisation error and the plate theory's gap, in
     quadrature (:mod:`.model_form`). Returns a :class:`_Form` per observation."""
@@ -175,7 +149,7 @@ def _set_noise(board, models, h, obs, state, freq_pct, shape_pct) -> list:
             wide = solve_modes(cs.model, n_modes=ob.shapes.shape[0] // 2)
             basis = np.asarray(ob.read @ np.column_stack([wide.rigid_shapes, wide.shapes]))
         sf, ss = _noise_sigmas(ob, freq_pct, shape_pct, basis)
-        finer = _finer(board, ob.name, h, p0)
+        finer = _finer(structure, ob.name, h, p0)
         forms.append(_Form(finer, kirchhoff_shift(finer[-1], ob, cs), sf))
         ds = _correct(ob, cs, (bm.model for bm in finer), forms[-1])
         ob.sigma_s = None if ss is None else np.sqrt(ss**2 + ds**2)
@@ -195,7 +169,7 @@ def _with_masses(models, res, p, masses, forms) -> None:
     for ob, cs, form in zip(res.observations, ref.configs, forms):
         carried = []
         for bm in (b.with_parameters(at) for b in form.finer):
-            layout, model = from_board(bm), bm.model
+            layout, model = from_structure(bm), bm.model
             for c, v in masses:
                 model = add_effect(model, place(layout, c), v)
             carried.append(model)
@@ -214,26 +188,27 @@ def _range_test(res, base, n_params, alpha) -> dict:
             "rank_Ab": int(np.sum(np.linalg.svd(np.column_stack([A, base.state.r]), compute_uv=False) > level))}
 
 
-def diagnose(board, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_size=None, kinds=None,
+def diagnose(structure, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_size=None, kinds=None,
              max_effects: int = 3, alpha: float = ALPHA, progress=None) -> Diagnosis:
-    """Diagnose ``board`` against ``tests`` = [(configuration name or None, MeasuredModes)]."""
+    """Diagnose ``structure`` (a board, or any structure of :mod:`pcbdyn.domain`) against ``tests`` =
+    [(configuration name or None, :class:`pcbdyn.testdata.Modes`)]."""
     say = progress or (lambda msg: None)
-    h = mesh_size or board.mesh_size
+    h = mesh_size or structure.mesh_size
     say("building the models")
-    models = _BoardModels(board, [c for c, _ in tests], h)
+    models = StructureModels(structure, [c for c, _ in tests], mesh_size=h, shared_mesh=True)
     names, p0 = models.names, models.p0
-    obs = _observations(tests, models.bms)
-    res = models.residual(obs)
+    obs = _observations(tests, models.models)
+    res = ModalResidual.of_models(models, obs)
     say("solving the model as given")
     before = res.evaluate(p0)
     unmatched = {ob.name or "base": (np.flatnonzero(~cs.matched) + 1).tolist() for ob, cs in zip(obs, before.configs)}
     if any(unmatched.values()):  # modes the model has no partner for (MAC < 0.3): local modes of what it lacks
         say(f"test modes without a model partner, left out: {unmatched}")
         obs = [ob.subset(cs.matched) for ob, cs in zip(obs, before.configs)]
-        res = models.residual(obs)
+        res = ModalResidual.of_models(models, obs)
         before = res.evaluate(p0)
     say("estimating the noise and the model's discretisation error")
-    forms = _set_noise(board, models, h, obs, before, freq_noise_pct, shape_noise_pct)
+    forms = _set_noise(structure, models, h, obs, before, freq_noise_pct, shape_noise_pct)
     before = res.evaluate(p0)
     say(f"fitting the {len(names)} declared parameter(s)" if names else "no declared parameters")
     base = estimate(res, p0, [], [], 10, models.bounds)
@@ -255,7 +230,7 @@ def diagnose(board, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_size=
                          after=out["parameters_only"], **out)
     say("generating the candidate effects")
     options = {k: v * h if k == "path_spacing" else v for k, v in CANDIDATE_OPTIONS.items() if k in _options(kinds)}
-    layout = from_board(models.bms[0])
+    layout = from_structure(models.models[0])
     cands = generate(layout, kinds, **options)
     say(f"searching {len(cands)} candidate effects")
     sel = search(res, cands, p0, models.bounds, max_effects=max_effects, shortlist=2, alpha=alpha, base=base)
@@ -350,8 +325,6 @@ class LocalMoves:
         return out
 
     def __call__(self, k) -> list:
-        from .catalogue import kind
-
         c = self.cands[k]
         if m := RUN.match(c.name):
             i, j = int(m["i"]), int(m["j"] or m["i"])
@@ -475,8 +448,8 @@ def _evidence(res, state, cands) -> dict:
     """{kind: (xy, chi^2 removed)} for the node kinds: the linear chi^2 drop of a candidate at each
     node, the declared parameters projected out (the map of where the residual points)."""
     out = {}
-    for kind in ("point_mass", "ground_spring"):
-        idx = [i for i, c in enumerate(cands) if c.kind == kind]
+    for name in ("point_mass", "ground_spring"):
+        idx = [i for i, c in enumerate(cands) if c.kind == name]
         if not idx:
             continue
         A = res.effect_columns(state, [cands[i] for i in idx])
@@ -489,5 +462,5 @@ def _evidence(res, state, cands) -> dict:
         n2 = np.einsum("ij,ij->j", A, A)
         gain = np.where(n2 > 0, (A.T @ r) ** 2 / np.where(n2 > 0, n2, 1.0), 0.0)
         gain[(A.T @ r) < 0] = 0.0  # negative magnitudes are not physical
-        out[kind] = (np.array([cands[i].at for i in idx]), gain)
+        out[name] = (np.array([cands[i].at for i in idx]), gain)
     return out

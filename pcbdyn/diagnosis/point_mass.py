@@ -17,7 +17,7 @@ import numpy as np
 from ..fe import MassProperty
 from ..fe.elements.discrete import mass_matrices
 from ..fixtures.supports import disc_footprint, mass_footprint
-from .catalogue import Blocks, copy_model, node_candidates, on_nearest_node
+from .catalogue import register, Blocks, copy_model, node_candidates, on_nearest_node
 
 
 class _Lumped:
@@ -83,3 +83,4 @@ class _Lumped:
 
 MASS = _Lumped("point_mass", "mass", "kg", 1e-2)
 INERTIA = _Lumped("point_inertia", "inertia", "kg*m^2", 1e-6)
+register(MASS, INERTIA)

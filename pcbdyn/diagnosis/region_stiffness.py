@@ -20,7 +20,7 @@ import numpy as np
 
 from ..board.effects import ScaledShell
 from ..fe.elements import kernel
-from .catalogue import Blocks, Candidate, copy_model
+from .catalogue import register, Blocks, Candidate, copy_model
 
 
 def _centroid(conns, xy) -> np.ndarray:
@@ -162,3 +162,4 @@ def _fresh(model, name: str) -> str:
 
 
 KIND = _RegionStiffness()
+register(KIND)

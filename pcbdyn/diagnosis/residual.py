@@ -13,7 +13,7 @@ Sensitivities: the eigenvalue derivative (thesis eq. 3.6) for the frequency rows
 shape rows the modal expansion of the eigenvector derivative over every computed mode, rigid-body
 modes included (eqs. 3.8-3.14): d phi_i = sum_(k != i) phi_k phi_k^T (dK - lambda_i dM) phi_i /
 (lambda_i - lambda_k); the part along phi_i only rescales the shape and drops out with s_i. Both
-need only the bilinear forms phi_k^T dK phi_i, phi_k^T dM phi_i (:func:`.catalogue.bilinear_forms`
+need only the bilinear forms phi_k^T dK phi_i, phi_k^T dM phi_i (:func:`.catalogue.effect_forms`
 for candidates, sparse products for parameters). The truncated expansion makes the columns
 approximate; every fit is confirmed on full re-solves.
 """
@@ -28,41 +28,49 @@ from ..correlation.mac import mac
 from ..correlation.pairing import pair_modes
 from ..fe.assembly import assemble
 from ..fe.modal import solve_modes
-from .catalogue import bilinear_forms, derivatives
+from ..testdata import Modes
+from ..updating.sensitivity import bilinear_forms, eigen_derivatives
+from .catalogue import derivatives, effect_forms
 
 
 @dataclass
 class Observation:
-    """One test configuration: measured frequencies ``f`` [Hz] (m,), optionally shapes (n_pts, m)
-    that the model gives as ``read @ u`` (``read`` (n_pts, n_dof), full DOFs); relative standard
-    deviations ``sigma_f`` (m,) of the frequencies and ``sigma_s`` (m,) of a shape component (per
-    RMS of the mode's measured shape); ``xyz``, ``directions``: the measured DOFs [m];
-    ``f_scale`` (m,): the factor that takes the paired model frequency to its converged-mesh value
-    (a discretisation correction; 1 by default). Without shapes the modes pair by order."""
+    """One test configuration in the residual: its measured ``modes`` (:class:`pcbdyn.testdata.Modes`:
+    frequencies, and shapes that the model gives as ``read @ u``, ``read`` (n_pts, n_dof) on the full
+    DOFs); relative standard deviations ``sigma_f`` (m,) of the frequencies and ``sigma_s`` (m,) of a
+    shape component (per RMS of the mode's measured shape); ``f_scale`` (m,): the factor that takes the
+    paired model frequency to its converged-mesh value (a discretisation correction; 1 by default).
+    Without shapes the modes pair by order."""
+
+    name: str | None
+    modes: Modes
+    sigma_f: np.ndarray
+    read: object = None
+    sigma_s: np.ndarray | None = None
+    f_scale: np.ndarray | None = None
+
+    def __post_init__(self):
+        self.sigma_f = np.asarray(self.sigma_f, float)
+        if self.f_scale is None:
+            self.f_scale = np.ones(self.f.size)
+
+    @property
+    def f(self) -> np.ndarray:
+        return self.modes.frequencies
+
+    @property
+    def shapes(self) -> np.ndarray | None:
+        return self.modes.shapes
+
+    @property
+    def numbers(self) -> np.ndarray:
+        return self.modes.numbers
 
     def subset(self, keep) -> "Observation":
         """The observation of the measured modes ``keep`` (a boolean mask or indices)."""
         k = np.asarray(keep)
-        return Observation(self.name, self.f[k], self.sigma_f[k], None if self.shapes is None else self.shapes[:, k],
-                           self.read, None if self.sigma_s is None else self.sigma_s[k], self.xyz, self.directions,
-                           self.numbers[k], self.f_scale[k])
-
-    name: str | None
-    f: np.ndarray
-    sigma_f: np.ndarray
-    shapes: np.ndarray | None = None
-    read: object = None
-    sigma_s: np.ndarray | None = None
-    xyz: np.ndarray | None = None
-    directions: np.ndarray | None = None
-    numbers: np.ndarray | None = None  # the test's mode numbers (default 1..m)
-    f_scale: np.ndarray | None = None
-
-    def __post_init__(self):
-        if self.numbers is None:
-            self.numbers = np.arange(1, np.size(self.f) + 1)
-        if self.f_scale is None:
-            self.f_scale = np.ones(np.size(self.f))
+        return Observation(self.name, self.modes.subset(k), self.sigma_f[k], self.read,
+                           None if self.sigma_s is None else self.sigma_s[k], self.f_scale[k])
 
     @property
     def n_rows(self) -> int:
@@ -136,6 +144,12 @@ class ModalResidual:
     observation, all on one mesh, so that a candidate's nodes mean the same in each) carrying
     effects. ``derivatives(p, models)``: per observation, one (dK, dM) pair (full size) per declared
     parameter, or None when there are none."""
+
+    @classmethod
+    def of_models(cls, models, observations) -> "ModalResidual":
+        """The residual of ``observations`` against a structure's configuration models as functions of
+        its declared parameters (:class:`pcbdyn.problems.StructureModels`)."""
+        return cls(observations, models.build, models.derivatives if models.names else None, len(models.names))
 
     def __init__(self, observations, build, derivatives=None, n_params: int = 0):
         self.observations = list(observations)
@@ -215,17 +229,10 @@ class ModalResidual:
         ``dU_static`` (n_pts, m, n_col): the shape derivatives' part from the modes beyond the basis."""
         modes = cs.modes
         nr = modes.n_rigid
-        lam_b = np.r_[np.zeros(nr), modes.omega2]
-        ib = nr + cs.pairs
-        lam = lam_b[ib]
-        B = BK - BM * lam[None, None, :]
-        dlam = B[:, ib, np.arange(ib.size)]  # (n_col, m)
+        dlam, C = eigen_derivatives(BK, BM, np.r_[np.zeros(nr), modes.omega2], nr + cs.pairs)  # (n_col, m)
         df = dlam * ob.f_scale**2 / (8.0 * np.pi**2 * cs.f_a)  # d(c f)/dp, f = f_a / c
         out = [(df / (ob.sigma_f * ob.f)).T]
         if cs.u is not None:
-            gap = lam[None, :] - lam_b[:, None]  # (n_basis, m)
-            same = np.abs(gap) <= 1e-9 * np.maximum(np.abs(lam)[None, :], 1.0)
-            C = np.where(same[None], 0.0, B / np.where(same, 1.0, gap)[None])
             Ub = np.asarray(ob.read @ np.column_stack([modes.rigid_shapes, modes.shapes]))
             dU = np.einsum("pk,cki->pic", Ub, C, optimize=True)  # (n_pts, m, n_col)
             if dU_static is not None:
@@ -248,7 +255,7 @@ class ModalResidual:
         out = []
         for ob, cs in zip(self.observations, st.configs):
             basis, paired = self._basis(cs)
-            BK, BM = bilinear_forms(cs.model, basis, paired, candidates)
+            BK, BM = effect_forms(cs.model, basis, paired, candidates)
             out.append(self._columns(ob, cs, BK, BM))
         return np.vstack(out)
 
@@ -259,8 +266,7 @@ class ModalResidual:
         out = []
         for ob, cs, pairs in zip(self.observations, st.configs, self.derivatives(st.p, [c.model for c in st.configs])):
             basis, paired = self._basis(cs)
-            BK = np.stack([basis.T @ (dK @ paired) for dK, _ in pairs])
-            BM = np.stack([basis.T @ (dM @ paired) for _, dM in pairs])
+            BK, BM = bilinear_forms(basis, paired, [dK for dK, _ in pairs], [dM for _, dM in pairs])
             static = None
             if cs.u is not None:
                 lam = cs.modes.omega2[cs.pairs]

@@ -27,8 +27,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import lsq_linear
 from scipy.stats import chi2 as chi2_dist
+
+from ..updating.gauss_newton import gauss_newton
 
 #: magnitudes are bounded by this many times their kind's typical ``scale`` (a 1 kg mass or a
 #: 1e7 N/m spring is no longer an effect a test setup hides; unbounded, a huge mass pins a node)
@@ -79,51 +80,34 @@ class Fit:
 
 
 def estimate(res, p0, cands, v0, steps: int, bounds=None, tol: float = 1e-5, param_columns=None) -> Fit:
-    """Gauss-Newton on (ln p, magnitudes) with bounded steps (``bounds`` = (lower, upper) of p),
-    halving a step that raises chi^2; ``cov`` is the covariance of (ln p, magnitudes) from the
-    last Jacobian, scaled by the residual's own variance when larger than stated.
-    ``param_columns``: the parameters' columns held from an earlier state (a quick fit that
-    ranks candidates need not re-derive the board's matrices at every step)."""
+    """The declared parameters (on a log scale, within ``bounds`` = (lower, upper) of p) and the
+    magnitudes of ``cands`` fitted to the residual ``res`` by the updating engine's bounded Gauss-Newton
+    (:func:`pcbdyn.updating.gauss_newton.gauss_newton`); ``cov`` is the covariance of (ln p,
+    magnitudes). ``param_columns``: the parameters' columns held from an earlier state (a quick fit
+    that ranks candidates need not re-derive the board's matrices at every step)."""
     p = np.asarray(p0, float)
     npar = p.size
     lo_v = np.array([c.spec.lower for c in cands], float)
     hi_v = UPPER * np.array([c.spec.scale for c in cands], float)
     scale = np.r_[np.ones(npar), [c.spec.scale for c in cands]]
-    v = np.clip(np.asarray(v0, float), lo_v, hi_v)
-    try:
-        st = res.evaluate(p, cands, v)
-    except (ValueError, ArithmeticError, np.linalg.LinAlgError):  # e.g. overlapping regions softened below zero
-        return Fit(p, v, None, np.zeros((0, 0)))
-    lo_p, hi_p = (np.full(p.size, 0.0), np.full(p.size, np.inf)) if bounds is None else bounds
+    lo_p, hi_p = (np.full(npar, 0.0), np.full(npar, np.inf)) if bounds is None else bounds
     lo_p = np.maximum(lo_p, 1e-6 * np.abs(p))  # ln p: a parameter may shrink a millionfold, not vanish
-    for _ in range(steps):
-        J = _jacobian(res, st, cands, npar, param_columns) * scale
-        if J.shape[1] == 0:
-            break
-        lo = np.r_[np.log(lo_p / p)[:npar], (lo_v - v)] / scale
-        hi = np.r_[np.log(hi_p / p)[:npar], (hi_v - v)] / scale
-        dy = lsq_linear(J, st.r, bounds=(np.minimum(lo, 0.0), np.maximum(hi, 0.0))).x * scale
-        for _half in range(4):
-            p_new = p * np.exp(dy[:npar])
-            v_new = np.clip(v + dy[npar:], lo_v, hi_v)
-            try:
-                trial = res.evaluate(p_new, cands, v_new)
-            except (ValueError, ArithmeticError, np.linalg.LinAlgError):
-                trial = None
-            if trial is not None and trial.chi2 <= st.chi2 * (1 + 1e-9):
-                break
-            dy = 0.5 * dy
-        else:
-            break
-        small = np.all(np.abs(dy) <= tol * np.r_[np.ones(npar), np.maximum(np.abs(v), scale[npar:])])
-        p, v, st = trial.p, v_new, trial
-        if small:
-            break
-    J = _jacobian(res, st, cands, npar, param_columns)
-    k = J.shape[1]
-    var = max(1.0, st.chi2 / max(res.n_rows - k, 1))
-    cov = var * np.linalg.pinv(J.T @ J) if k else np.zeros((0, 0))
-    return Fit(p, v, st, cov)
+    with np.errstate(divide="ignore"):
+        lower, upper = np.r_[np.log(lo_p), lo_v], np.r_[np.log(hi_p), hi_v]
+
+    def evaluate(y):
+        try:
+            return res.evaluate(np.exp(y[:npar]), cands, y[npar:])
+        except (ValueError, ArithmeticError, np.linalg.LinAlgError):  # e.g. overlapping regions softened below zero
+            return None
+
+    def step_tol(y):
+        return tol * np.r_[np.ones(npar), np.maximum(np.abs(y[npar:]), scale[npar:])]
+
+    y0 = np.r_[np.log(p), np.clip(np.asarray(v0, float), lo_v, hi_v)]
+    gn = gauss_newton(evaluate, lambda st: _jacobian(res, st, cands, npar, param_columns), y0, lower, upper,
+                      scale, steps, step_tol)
+    return Fit(np.exp(gn.y[:npar]), gn.y[npar:], gn.state, gn.cov)
 
 
 def _jacobian(res, st, cands, npar, param_columns=None):
@@ -325,11 +309,13 @@ def forward_select(model, candidates, f_test, sigma: float, max_effects: int = 3
     """:func:`search` on frequencies alone: ``f_test`` [Hz] paired in order with the first
     len(f_test) elastic modes of ``model``, relative noise ``sigma`` (e.g. 0.002), no declared
     parameters."""
+    from ..testdata import Modes
     from .residual import ModalResidual, Observation
 
     f_test = np.asarray(f_test, dtype=float)
     if not sigma > 0:
         raise ValueError(f"sigma (relative frequency noise) must be > 0, got {sigma}")
-    res = ModalResidual([Observation(None, f_test, np.full(f_test.size, float(sigma)))], lambda p: [model])
+    res = ModalResidual([Observation(None, Modes.frequencies_only(f_test), np.full(f_test.size, float(sigma)))],
+                        lambda p: [model])
     return search(res, candidates, max_effects=max_effects, newton_steps=newton_steps, shortlist=shortlist,
                   alpha=alpha)

@@ -17,10 +17,10 @@ from __future__ import annotations
 import numpy as np
 
 from ..board.effects import rib_property
-from ..board.spec import RibSection
+from ..board.entries import RibSection
 from ..fe import EmbeddedBeamProperty
 from ..fe.elements import kernel
-from .catalogue import Blocks, Candidate, copy_model
+from .catalogue import register, Blocks, Candidate, copy_model
 
 
 class _Stiffener:
@@ -108,3 +108,4 @@ def _extent(layout):
 
 
 KIND = _Stiffener()
+register(KIND)

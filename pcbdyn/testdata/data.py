@@ -124,36 +124,78 @@ def _code_vector(code):
 
 @dataclass
 class Modes:
-    """Measured (real, normal) modes: frequencies [Hz], viscous damping ratios, shapes (n_dof, n_modes).
+    """Measured (real, normal) modes: frequencies [Hz], viscous damping ratios, shapes (n_dof, n_modes)
+    at the measured DOFs; the one measured-modes type of correlation, updating and diagnosis.
 
     ``mpc`` is the modal phase collinearity of each mode before it was made real (1 for a mode
-    that was real already); shapes are in whatever scaling the test gave.
+    that was real already); shapes are in whatever scaling the test gave. A test of frequencies only
+    (a table of measured frequencies) has no points, DOFs or shapes: its modes pair with the model's by
+    ``numbers``, the test's mode numbers (default 1..n).
     """
 
-    points: Points
-    dofs: Dofs
+    points: Points | None
+    dofs: Dofs | None
     frequencies: np.ndarray
-    shapes: np.ndarray
+    shapes: np.ndarray | None
     damping: np.ndarray | None = None
     mpc: np.ndarray | None = None
+    numbers: np.ndarray | None = None
 
     def __post_init__(self):
         self.frequencies = np.asarray(self.frequencies, dtype=float).ravel()
-        self.shapes = np.asarray(self.shapes, dtype=float).reshape(len(self.dofs), -1)
         n = self.frequencies.size
-        if self.shapes.shape[1] != n:
-            raise TestDataError(f"modes: {n} frequencies but {self.shapes.shape[1]} shape columns")
+        if not np.all(np.isfinite(self.frequencies)) or np.any(self.frequencies <= 0):
+            raise TestDataError(f"modes: frequencies must be positive and finite, got {self.frequencies.tolist()}")
+        if self.shapes is not None:
+            if self.dofs is None or self.points is None:
+                raise TestDataError("modes: measured shapes need the points and DOFs they were measured at")
+            self.shapes = np.asarray(self.shapes, dtype=float).reshape(len(self.dofs), -1)
+            if self.shapes.shape[1] != n:
+                raise TestDataError(f"modes: {n} frequencies but {self.shapes.shape[1]} shape columns")
+            self.points.index(np.unique(self.dofs.point_ids))
         self.damping = np.zeros(n) if self.damping is None else np.asarray(self.damping, float).ravel()
         self.mpc = np.ones(n) if self.mpc is None else np.asarray(self.mpc, float).ravel()
-        self.points.index(np.unique(self.dofs.point_ids))
+        self.numbers = np.arange(1, n + 1) if self.numbers is None else np.asarray(self.numbers, int).ravel()
+        if self.numbers.size != n:
+            raise TestDataError(f"modes: {n} frequencies but {self.numbers.size} mode numbers")
+
+    @classmethod
+    def frequencies_only(cls, frequencies, numbers=None) -> "Modes":
+        """Measured frequencies [Hz] without shapes, of the test's mode ``numbers`` (default 1..n)."""
+        return cls(None, None, frequencies, None, numbers=numbers)
 
     @property
     def n_modes(self) -> int:
         return self.frequencies.size
 
+    @property
+    def xyz(self) -> np.ndarray | None:
+        """Coordinates of the point of each measured DOF (n_dof, 3) [m], or None without shapes."""
+        return None if self.shapes is None else self.dof_xyz()
+
+    @property
+    def directions(self) -> np.ndarray | None:
+        """Unit direction of each measured DOF (n_dof, 3), or None without shapes."""
+        return None if self.shapes is None else self.dofs.directions
+
     def dof_xyz(self) -> np.ndarray:
         """Coordinates of the point of each DOF, (n_dof, 3)."""
         return self.points.xyz[self.points.index(self.dofs.point_ids)]
+
+    def measured_points(self) -> Points:
+        """The points that carry a measured DOF."""
+        used = self.points.index(np.unique(self.dofs.point_ids))
+        return Points(self.points.ids[used], self.points.xyz[used])
+
+    def subset(self, keep) -> "Modes":
+        """The modes ``keep`` (a boolean mask or indices), with their numbers."""
+        k = np.asarray(keep)
+        return Modes(self.points, self.dofs, self.frequencies[k], None if self.shapes is None else self.shapes[:, k],
+                     self.damping[k], self.mpc[k], self.numbers[k])
+
+    def without_shapes(self) -> "Modes":
+        """The frequencies alone (pairing by the test's mode numbers)."""
+        return Modes.frequencies_only(self.frequencies, self.numbers)
 
 
 #: FRF kinds and the power of (i omega) that turns a receptance into each
@@ -194,6 +236,42 @@ class FRFs:
         with np.errstate(divide="ignore", invalid="ignore"):
             H = self.H * (w**p)[:, None, None]
         return FRFs(self.points, self.frequencies, H, kind, self.response, self.reference)
+
+
+@dataclass
+class Excitation:
+    """The receptances of one excitation in SI: ``frequencies`` [Hz] (n_f,), ``H`` (n_f, n_resp) [m/N]
+    at points ``xyz`` (n_resp, 3) along unit ``directions`` (n_resp, 3), for a unit force at
+    ``excite_xyz`` (3,) along ``excite_direction`` (3,)."""
+
+    frequencies: np.ndarray
+    H: np.ndarray
+    xyz: np.ndarray
+    directions: np.ndarray
+    excite_xyz: np.ndarray
+    excite_direction: np.ndarray
+
+
+def excitations(frfs: FRFs) -> list:
+    """One :class:`Excitation` per reference DOF of ``frfs`` (any kind, converted to receptance); the
+    0 Hz line (no receptance from mobility or accelerance there) and responses with missing (NaN)
+    FRFs are dropped."""
+    rec = frfs.as_kind("receptance")
+    pts = rec.points
+    r_xyz = pts.xyz[pts.index(rec.response.point_ids)]
+    e_xyz = pts.xyz[pts.index(rec.reference.point_ids)]
+    f = np.asarray(rec.frequencies, float)
+    lines = f > 0
+    out = []
+    for k in range(rec.H.shape[2]):
+        H = rec.H[lines, :, k]
+        ok = np.all(np.isfinite(H), axis=0)
+        if ok.any():
+            out.append(Excitation(f[lines], H[:, ok], r_xyz[ok], rec.response.directions[ok], e_xyz[k],
+                                  rec.reference.directions[k]))
+    if not out:
+        raise TestDataError("the FRFs hold no complete response column for any reference")
+    return out
 
 
 @dataclass

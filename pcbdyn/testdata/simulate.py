@@ -95,3 +95,9 @@ def simulate_on_model(
     read_ref = model_probe(model, e[None], ref.directions, tol=tol).P
     return simulate_test(modes, points, dofs, read, reference=ref, read_reference=read_ref, f_axis=f_axis,
                          zeta=zeta, kind=kind, noise=noise, seed=seed)
+
+
+def frequency_axis(f_range, df: float, f_top: float) -> np.ndarray:
+    """Lines from f_lo to f_hi every ``df`` Hz; without a range, 0 to 1.2 times ``f_top``."""
+    lo, hi = f_range if f_range is not None else (0.0, df * np.ceil(1.2 * f_top / df))
+    return lo + df * np.arange(int(np.floor((hi - lo) / df + 1e-9)) + 1)

@@ -2,8 +2,9 @@
 
 Inputs are K, M (dense or scipy sparse), the parameter derivatives (dK/dp_j, dM/dp_j) and measured
 frequencies, shapes or FRFs as arrays; outputs are weighted equation blocks A x = b (x = dp/p),
-their solutions, localised parameter subsets and the iteration history. Parameters bound to
-board quantities live in the board layer above.
+their solutions, localised parameter subsets, the iteration history and the bounded Gauss-Newton fit
+of a residual (diagnosis). Parameters bound to structures' quantities live in :mod:`pcbdyn.problems`
+above; nothing here builds a model.
 """
 
 from .equations import (
@@ -15,9 +16,12 @@ from .equations import (
     frf_receptance_equations,
     qms_equations,
 )
+from .gauss_newton import GaussNewton, gauss_newton
 from .iteration import Configuration, UpdateResult, build_equations, mac_pairing, update
 from .pbc import condition_number, condition_numbers, stack, svd_reduce
 from .sensitivity import (
+    bilinear_forms,
+    eigen_derivatives,
     eigenvalue_derivatives,
     eigenvector_derivative_nelson,
     eigenvector_derivatives_modal,
@@ -30,8 +34,10 @@ from .solvers import (
     RankDeficiencyWarning,
     Solution,
     bayes_alpha,
+    bounded_lsq,
     choose_rank,
     condition_curve,
+    covariance,
     frequency_residue,
     line_search,
     solve_bayes,

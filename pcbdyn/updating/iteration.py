@@ -43,6 +43,10 @@ class Configuration:
         None gives unit-length rows (eq. 4.42).
     n_modes: analytical modes computed for pairing (default max(2 m, m + 4) for m measured
         modes; count the rigid-body modes of a free model in).
+    pairing: callable (f_a, phi_a_measured, f_x, phi_x) -> analytical mode index per measured mode,
+        -1 for a mode left unpaired (default: the driver's ``pairing``, else :func:`mac_pairing`).
+    n_rigid: rigid-body modes among the analytical ones (a free model's; they never pair).
+    frf_hz: the updating frequencies [Hz] of the FRF methods (``frf_omegas`` in Hz, for reports).
     """
 
     model: Callable
@@ -59,6 +63,12 @@ class Configuration:
     sigma: np.ndarray | None = None
     n_modes: int | None = None
     name: str = ""
+    pairing: Callable | None = None
+    n_rigid: int = 0
+
+    @property
+    def frf_hz(self) -> np.ndarray | None:
+        return None if self.frf_omegas is None else np.asarray(self.frf_omegas, float) / (2 * np.pi)
 
     def __post_init__(self):
         if self.method not in METHODS:
@@ -122,7 +132,7 @@ def _state(cfg: Configuration, p, pairing):
         lam, Phi = solve_modes(K, M, n_modes)
         f_a = frequencies_hz(lam)
         phi_am = Phi if cfg.P is None else np.asarray(cfg.P @ Phi)
-        pairs = np.asarray((pairing or mac_pairing)(f_a, phi_am, f_x, cfg.phi_x), int)
+        pairs = np.asarray((cfg.pairing or pairing or mac_pairing)(f_a, phi_am, f_x, cfg.phi_x), int)
         used = np.flatnonzero(pairs >= 0)
         if used.size == 0:
             raise ValueError(f"configuration {cfg.name!r}: no measured mode found an analytical partner")
@@ -239,8 +249,8 @@ def update(
     (same first-order equations, since dp/p = d ln p; keeps stiffnesses that span decades
     positive).
     pairing: callable (f_a, phi_a_measured, f_x, phi_x) -> analytical index per measured mode,
-    -1 for a mode left unpaired (dropped from that iteration's equations; default
-    :func:`mac_pairing`). use_line_search: minimise the overall frequency residue along
+    -1 for a mode left unpaired (dropped from that iteration's equations), for configurations that
+    do not carry their own (``Configuration.pairing``; default :func:`mac_pairing`). use_line_search: minimise the overall frequency residue along
     the step (eq. 7.6; default on for "bayes"). Stops when one of: max frequency error <
     ``tol_freq_pct`` (7.2), max parameter change < ``tol_param_pct`` (7.3), mean change of the
     frequency residue over the last three iterations < ``tol_sigma_pct`` (7.4). Divergence: the

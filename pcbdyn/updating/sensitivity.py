@@ -41,19 +41,47 @@ def _check_derivatives(dKs, dMs):
         raise ValueError(f"dKs has {len(dKs)} entries but dMs has {len(dMs)}: give one (dK, dM) pair per parameter")
 
 
+def bilinear_forms(basis, shapes, dKs, dMs):
+    """(BK, BM), each (n_params, n_basis, n_shapes): phi_k^T dK_j phi_i and phi_k^T dM_j phi_i for the
+    columns k of ``basis`` and i of ``shapes`` (the terms of thesis eqs. 3.6 and 3.11)."""
+    _check_derivatives(dKs, dMs)
+    BK = np.stack([basis.T @ (dK @ shapes) for dK in dKs]) if dKs else np.zeros((0, basis.shape[1], shapes.shape[1]))
+    BM = np.stack([basis.T @ (dM @ shapes) for dM in dMs]) if dMs else np.zeros_like(BK)
+    return BK, BM
+
+
+def eigen_derivatives(BK, BM, lam_basis, index):
+    """Eigenvalue derivatives and the modal-expansion coefficients of the eigenvector derivatives from
+    bilinear forms over a basis of modes (:func:`bilinear_forms`; ``lam_basis`` their eigenvalues,
+    ``index`` the basis position of each mode i whose derivatives are wanted):
+
+    - d lambda_i / dp_j = phi_i^T (dK_j - lambda_i dM_j) phi_i (thesis eq. 3.6), (n_params, m);
+    - C_jki = phi_k^T (dK_j - lambda_i dM_j) phi_i / (lambda_i - lambda_k) for the basis modes k of
+      another eigenvalue, 0 for k of the same (eqs. 3.8-3.12), (n_params, n_basis, m): d phi_i / dp_j is
+      sum_k C_jki phi_k plus a multiple of phi_i (the mass normalisation's, eq. 3.13, added by the
+      caller that needs it).
+
+    One formula for updating and for the diagnosis's candidate effects (their forms come from
+    element blocks instead of assembled dK, dM)."""
+    lam_basis = np.asarray(lam_basis, float)
+    index = np.asarray(index, int)
+    lam = lam_basis[index]
+    B = BK - BM * lam[None, None, :]
+    dlam = B[:, index, np.arange(index.size)]
+    gap = lam[None, :] - lam_basis[:, None]
+    same = np.abs(gap) <= 1e-9 * np.maximum(np.abs(lam)[None, :], 1.0)
+    C = np.where(same[None], 0.0, B / np.where(same, 1.0, gap)[None])
+    return dlam, C
+
+
 def eigenvalue_derivatives(lam, Phi, dKs, dMs) -> np.ndarray:
     """d lambda_i / d p_j = phi_i^T (dK_j - lambda_i dM_j) phi_i (thesis eq. 3.6 in lambda form).
 
     Returns shape (n_modes, n_params).
     """
-    _check_derivatives(dKs, dMs)
     lam = np.asarray(lam, float)
-    out = np.empty((lam.size, len(dKs)))
-    for j, (dK, dM) in enumerate(zip(dKs, dMs)):
-        kk = np.einsum("ij,ij->j", Phi, dK @ Phi)
-        mm = np.einsum("ij,ij->j", Phi, dM @ Phi)
-        out[:, j] = kk - lam * mm
-    return out
+    dlam, _ = eigen_derivatives(*bilinear_forms(Phi, Phi, dKs, dMs), lam, np.arange(lam.size))
+    return dlam.T
 
 
 def frequency_derivatives(lam, Phi, dKs, dMs) -> np.ndarray:
@@ -88,24 +116,21 @@ def eigenvector_derivative_nelson(K, M, lam_i, phi_i, dK, dM, dlam=None) -> np.n
 
 
 def eigenvector_derivatives_modal(lam, Phi, i: int, dKs, dMs) -> np.ndarray:
-    """d phi_i / d p_j by modal superposition over the available modes (thesis eqs. 3.8-3.14).
-
-    beta_ik = phi_k^T (dK - lambda_i dM) phi_i / (lambda_i - lambda_k) for k != i and
-    beta_ii = -phi_i^T dM phi_i / 2. Truncated to the modes in Phi, so only approximate unless Phi
-    holds all modes; needs distinct eigenvalues. Returns shape (n_dof, n_params).
+    """d phi_i / d p_j by modal superposition over the available modes (thesis eqs. 3.8-3.14):
+    :func:`eigen_derivatives`' coefficients plus beta_ii = -phi_i^T dM phi_i / 2 along phi_i (mass
+    normalisation). Truncated to the modes in Phi, so only approximate unless Phi holds all modes;
+    needs distinct eigenvalues. Returns shape (n_dof, n_params).
     """
-    _check_derivatives(dKs, dMs)
     lam = np.asarray(lam, float)
     gap = lam[i] - lam
     gap[i] = 1.0
     if np.any(np.abs(gap) < 1e-10 * max(abs(lam[i]), 1.0)):
         raise ValueError(f"mode {i} has a repeated eigenvalue: eq. 3.12 is invalid for repeated modes")
-    out = np.empty((Phi.shape[0], len(dKs)))
-    for j, (dK, dM) in enumerate(zip(dKs, dMs)):
-        beta = Phi.T @ (dK @ Phi[:, i] - lam[i] * (dM @ Phi[:, i])) / gap
-        beta[i] = -0.5 * Phi[:, i] @ (dM @ Phi[:, i])
-        out[:, j] = Phi @ beta
-    return out
+    BK, BM = bilinear_forms(Phi, Phi[:, i:i + 1], dKs, dMs)
+    _, C = eigen_derivatives(BK, BM, lam, [i])
+    beta = C[:, :, 0]
+    beta[:, i] = -0.5 * BM[:, i, 0]
+    return Phi @ beta.T
 
 
 def perturbation_derivatives(build, p, j: int, rel_step: float = 1e-6):

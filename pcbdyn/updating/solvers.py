@@ -197,10 +197,32 @@ def solve_bounded(
     _, s, V = _svd(A)
     r = choose_rank(s, rtol, jump)
     mu = (1e-6 * s[0] if r < n else 0.0) if ridge is None else float(ridge)
-    As, bs = (np.vstack([A, mu * np.eye(n)]), np.concatenate([b, np.zeros(n)])) if mu > 0 else (A, b)
-    res = so.lsq_linear(As, bs, bounds=(lower, upper), method="bvls", tol=1e-12)
-    active = np.flatnonzero((res.x <= lower + 1e-12) | (res.x >= upper - 1e-12))
-    return _finish(res.x, "bounded", A, b, s, V, r, active_bounds=active, ridge=mu)
+    x = bounded_lsq(A, b, lower, upper, mu)
+    active = np.flatnonzero((x <= lower + 1e-12) | (x >= upper - 1e-12))
+    return _finish(x, "bounded", A, b, s, V, r, active_bounds=active, ridge=mu)
+
+
+def bounded_lsq(A, b, lower, upper, ridge: float = 0.0) -> np.ndarray:
+    """x minimising ||A x - b||^2 + ||ridge x||^2 with lower <= x <= upper (eqs. 4.44-4.48): the step of
+    every bounded fit (:func:`solve_bounded`, :func:`.gauss_newton.gauss_newton`)."""
+    A, b = np.asarray(A, float), np.asarray(b, float)
+    n = A.shape[1]
+    if ridge > 0:
+        A, b = np.vstack([A, ridge * np.eye(n)]), np.concatenate([b, np.zeros(n)])
+    return so.lsq_linear(A, b, bounds=(lower, upper), method="bvls", tol=1e-12).x
+
+
+def covariance(J, r, stated: bool = True) -> np.ndarray:
+    """Covariance of least-squares estimates with Jacobian ``J`` (n_rows, k) at residual ``r``:
+    (J^T J)^+ times the residual variance s^2 = |r|^2 / (n - k). Rows in units of a ``stated`` noise
+    (chi-square weights, eq. 4.28) keep at least that noise (s^2 >= 1: a fit better than the noise
+    does not make the estimates surer than it); unweighted rows take s^2 as it is."""
+    J = np.asarray(J, float)
+    n, k = J.shape
+    if k == 0:
+        return np.zeros((0, 0))
+    s2 = float(np.asarray(r, float) @ np.asarray(r, float)) / max(n - k, 1)
+    return (max(1.0, s2) if stated else s2) * np.linalg.pinv(J.T @ J)
 
 
 def line_search(residue, beta_max: float = 2.0, tol: float = 1e-4):

@@ -269,7 +269,7 @@ def make_case(case: Case, folder) -> tuple:
     write_points_csv(folder / "points.csv", points)
     mesh = case.truth_mesh
     base = build_model(tb, None, mesh, shared_mesh=True)
-    layout = dg.from_board(base)
+    layout = dg.from_structure(base)
     cands = [candidate(layout, e) for e in case.effects]
     freqs = {}
     for k, cfg in enumerate(case.configs):
@@ -306,10 +306,10 @@ def params_only(case: Case, board_path, uffs, max_iter: int = 10) -> dict:
     pairing, bounded least squares): {"before": max |df| %, "after": max |df| %, "p": {name: value}}."""
     from pcbdyn.board import load_board
     from pcbdyn.testdata.uff import read_uff
-    from pcbdyn.updating.board_problem import BoardProblem, MeasuredModes, run
+    from pcbdyn.problems import UpdateProblem, run
 
-    prob = BoardProblem(load_board(board_path))
-    cfgs = [prob.configuration(c, MeasuredModes.from_test(read_uff(u).modes), "freq")
+    prob = UpdateProblem(load_board(board_path))
+    cfgs = [prob.configuration(c, read_uff(u).modes, "freq")
             for c, u in zip(case.configs, uffs)]
     res, before, after = run(prob, cfgs, "bounded", max_iter=max_iter)
     return {"before": max(s["max_freq_error_pct"] for s in before),

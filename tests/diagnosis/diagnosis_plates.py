@@ -49,3 +49,17 @@ def rotary_inertia(model, axis: int, about) -> float:
     r[:, 3:] = e
     r = r.ravel()
     return float(r @ (M @ r))
+
+
+def measured(f, shapes=None, xyz=None, directions=(0.0, 0.0, 1.0)):
+    """Measured modes (pcbdyn.testdata.Modes) of frequencies ``f``, with ``shapes`` at points ``xyz``
+    (default: the origin, for residuals that read shapes through a given matrix) along ``directions``."""
+    from pcbdyn.testdata import Dofs, Modes, Points
+
+    if shapes is None:
+        return Modes.frequencies_only(f)
+    shapes = np.asarray(shapes, float)
+    n = shapes.shape[0]
+    ids = np.arange(1, n + 1)
+    xyz = np.zeros((n, 3)) if xyz is None else np.asarray(xyz, float)
+    return Modes(Points(ids, xyz), Dofs(ids, directions), f, shapes)

@@ -64,7 +64,7 @@ BY_NAME = {c.name: c for c in CASES}
 
 
 def effect_entries(case: Case) -> list:
-    """The case's hidden effects as board entries (:func:`pcbdyn.board.enrich.effect_block` dicts)."""
+    """The case's hidden effects as board entries (the effect dicts of :mod:`pcbdyn.board.enrich`)."""
     out = []
     for i, e in enumerate(case.effects):
         d = {"type": e.kind, "name": f"hidden_{i}", "value": e.value, "at": e.at}
@@ -84,12 +84,10 @@ def effect_entries(case: Case) -> list:
 def truth_text(case: Case) -> str:
     """The true board: :func:`bench_cases.truth_text` (declared parameters at true values) with the
     hidden effects declared as board entries."""
-    import tomllib
-
-    from pcbdyn.board.enrich import effect_block
+    from pcbdyn.board.enrich import enriched_text
 
     text = bc.truth_text(replace(case, effects=()))
-    return text + effect_block(effect_entries(case), tomllib.loads(text), date="-", source="the hold-out truth")
+    return enriched_text(text, effect_entries(case), date="-", source="the hold-out truth")
 
 
 def expected(case: Case) -> list:

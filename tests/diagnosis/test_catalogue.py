@@ -184,7 +184,7 @@ def test_stiffener_across_an_unstructured_mesh_converges():
     ratio = []
     for h in (6.75e-3, 1.6875e-3):
         bm = build_model(board, None, h, shared_mesh=True)
-        rib = dg.kind("stiffener").candidate(dg.from_board(bm), "y=112mm", np.array([0.0, 0.112]),
+        rib = dg.kind("stiffener").candidate(dg.from_structure(bm), "y=112mm", np.array([0.0, 0.112]),
                                               np.array([0.162, 0.112]))
         plain = solve_modes(bm.model, n_modes=6).frequencies
         ratio.append(solve_modes(dg.add_effect(bm.model, rib, 1.0), n_modes=6).frequencies / plain)

@@ -8,10 +8,12 @@ import pytest
 
 from pcbdyn.board import build_model, load_board
 from pcbdyn.diagnosis.model_form import discretisation
-from pcbdyn.diagnosis.pipeline import _BoardModels
-from pcbdyn.diagnosis.residual import Observation
+from pcbdyn.diagnosis.residual import ModalResidual, Observation
 from pcbdyn.fe.modal import solve_modes
 from pcbdyn.fe.probe import model_probe
+from pcbdyn.problems import StructureModels
+
+from diagnosis_plates import measured
 
 CARD = Path(__file__).resolve().parents[2] / "examples" / "six_part_card" / "board.toml"
 N_MODES = 7
@@ -30,10 +32,10 @@ def correction(board, config, reference_mesh):
     ref = build_model(board, config, reference_mesh, shared_mesh=True).model
     rm = solve_modes(ref, n_modes=N_MODES)
     shapes = np.asarray(model_probe(ref, xyz, dirs, tol=0.02).P @ rm.shapes)
-    models = _BoardModels(board, [config], board.mesh_size)
-    ob = Observation(config, rm.frequencies, np.full(N_MODES, 1e-3), shapes,
-                     model_probe(models.bms[0].model, xyz, dirs, tol=0.02).P, np.full(N_MODES, 0.01), xyz, dirs)
-    state = models.residual([ob]).evaluate(models.p0).configs[0]
+    models = StructureModels(board, [config], shared_mesh=True)
+    ob = Observation(config, measured(rm.frequencies, shapes, xyz, dirs), np.full(N_MODES, 1e-3),
+                     model_probe(models.models[0].model, xyz, dirs, tol=0.02).P, np.full(N_MODES, 0.01))
+    state = ModalResidual.of_models(models, [ob]).evaluate(models.p0).configs[0]
     p = dict(zip(models.names, models.p0.tolist()))
     fine = build_model(board, config, board.mesh_size / 2.0, shared_mesh=True).with_parameters(p).model
     scale, sigma, _, resolved = discretisation([fine], ob, state)

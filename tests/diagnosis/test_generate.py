@@ -50,7 +50,7 @@ def board(tmp_path_factory):
     path = tmp_path_factory.mktemp("b") / "board.toml"
     path.write_text(BOARD)
     bm = build_model(load_board(path))
-    layout = dg.from_board(bm)
+    layout = dg.from_structure(bm)
     return bm, layout, dg.generate(layout, segments=4, spacing=0.01, patch=0.025, path_spacing=0.02)
 
 

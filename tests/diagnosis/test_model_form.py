@@ -2,6 +2,7 @@
 limit raises every frequency, more so on a mesh that resolves the shear at free edges, and its
 share in a test's frequencies is recovered with the declared parameters."""
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -9,12 +10,13 @@ import pytest
 
 from pcbdyn.board import load_board
 from pcbdyn.diagnosis.model_form import fit_plate_share, kirchhoff_shift
-from pcbdyn.diagnosis.pipeline import _BoardModels
-from pcbdyn.diagnosis.residual import Observation
+from pcbdyn.diagnosis.residual import ModalResidual, Observation
 from pcbdyn.diagnosis.select import Selection
 from pcbdyn.fe.modal import solve_modes
 from pcbdyn.fe.probe import model_probe
+from pcbdyn.problems import StructureModels
 
+from diagnosis_plates import measured
 from test_discretisation import grid
 
 CARD = Path(__file__).resolve().parents[2] / "examples" / "six_part_card" / "board.toml"
@@ -25,23 +27,23 @@ def observed(models, theta, shifts=None):
     """An observation of the card's own modes at the points, frequencies moved by ``theta`` of the
     Kirchhoff ``shifts`` (0.05 % frequency and 1 % shape sigmas), its residual and the Kirchhoff shifts."""
     xyz, dirs = grid()
-    bm = models.bms[0]
+    bm = models.models[0]
     modes = solve_modes(bm.model, n_modes=N_MODES)
     P = model_probe(bm.model, xyz, dirs, tol=0.02).P
-    ob = Observation(None, modes.frequencies, np.full(N_MODES, 5e-4), np.asarray(P @ modes.shapes), P,
-                     np.full(N_MODES, 0.01), xyz, dirs)
-    res = models.residual([ob])
+    ob = Observation(None, measured(modes.frequencies, np.asarray(P @ modes.shapes), xyz, dirs),
+                     np.full(N_MODES, 5e-4), P, np.full(N_MODES, 0.01))
+    res = ModalResidual.of_models(models, [ob])
     st = res.evaluate(models.p0)
     if shifts is None:
         shifts = [kirchhoff_shift(bm, ob, st.configs[0])]
-    ob.f = ob.f * (1.0 + theta * shifts[0])
+    ob.modes = replace(ob.modes, frequencies=ob.f * (1.0 + theta * shifts[0]))
     return res, shifts
 
 
 @pytest.fixture(scope="module")
 def card():
     board = load_board(CARD)
-    return board, _BoardModels(board, [None], board.mesh_size)
+    return board, StructureModels(board, [None], shared_mesh=True)
 
 
 def test_kirchhoff_limit_raises_every_mode_and_more_on_a_finer_mesh(card):
@@ -50,9 +52,9 @@ def test_kirchhoff_limit_raises_every_mode_and_more_on_a_finer_mesh(card):
     resolves: the largest gap grows with refinement (the reason it is measured on the finest mesh)."""
     board, models = card
     res, (coarse,) = observed(models, 0.0)
-    fine_models = _BoardModels(board, [None], board.mesh_size / 2.0)
+    fine_models = StructureModels(board, [None], mesh_size=board.mesh_size / 2.0, shared_mesh=True)
     st = res.evaluate(models.p0).configs[0]
-    fine = kirchhoff_shift(fine_models.bms[0], res.observations[0], st)
+    fine = kirchhoff_shift(fine_models.models[0], res.observations[0], st)
     assert np.all(coarse > 0.0) and np.all(fine > 0.0)
     assert fine.max() > 1.2 * coarse.max()
 

@@ -15,6 +15,8 @@ from pcbdyn.fe.modal import solve_modes
 from pcbdyn.fe.probe import model_probe
 from pcbdyn.testdata.noise import noisy_shapes
 
+from diagnosis_plates import measured
+
 M_MODES = 6
 
 
@@ -39,8 +41,8 @@ def plate():
     base = build([24e9])
     read = model_probe(base, xyz, zdir).P
     modes = solve_modes(base, n_modes=M_MODES)
-    ob = Observation(None, modes.frequencies * 1.01, np.full(M_MODES, 1e-3), np.asarray(read @ modes.shapes),
-                     read, np.full(M_MODES, 1e-2), xyz, zdir)
+    ob = Observation(None, measured(modes.frequencies * 1.01, np.asarray(read @ modes.shapes), xyz, zdir),
+                     np.full(M_MODES, 1e-3), read, np.full(M_MODES, 1e-2))
 
     def derivatives(p, models):  # E enters the plate's stiffness linearly
         n = models[0].n_dof
@@ -102,6 +104,6 @@ def test_shape_noise_estimate(plate, pct):
     wide = solve_modes(model, n_modes=read.shape[0] // 2)
     basis = np.asarray(read @ wide.shapes)
     phi = np.asarray(read @ modes.shapes)
-    noisy = Observation(None, ob.f, ob.sigma_f, noisy_shapes(phi, pct, seed=4), read, None)
+    noisy = Observation(None, measured(ob.f, noisy_shapes(phi, pct, seed=4)), ob.sigma_f, read, None)
     _, ss = _noise_sigmas(noisy, 0.2, None, basis)
     assert np.mean(ss) == pytest.approx(pct / 100 / np.sqrt(3), rel=0.25)

@@ -15,8 +15,9 @@ from pcbdyn.board import build_model, load_board
 from pcbdyn.fe.modal import solve_modes as fe_modes
 from pcbdyn.testdata.csvio import read_points_csv
 from pcbdyn.testdata.noise import Noise
+from pcbdyn.testdata import Modes
 from pcbdyn.testdata.simulate import simulate_on_model
-from pcbdyn.updating.board_problem import BoardProblem, MeasuredModes, run
+from pcbdyn.problems import UpdateProblem, run
 from pcbdyn.updating.sensitivity import eigenvalue_derivatives, solve_modes
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -84,12 +85,12 @@ def test_eigenvalue_derivatives_match_resolves(tmp_path):
     """Thesis eq. 3.6 on the board's parameters equals central differences of full re-solves."""
     path = tmp_path / "board.toml"
     path.write_text(SPRING_BOARD)
-    prob = BoardProblem(load_board(path))
+    prob = UpdateProblem(load_board(path))
     assert [prob.names[i] for i in prob.log_scale] == ["k_guide", "k_s1"]
     sysm = prob.system(None)
     p0 = prob.p0
     n = 6
-    lam0 = fe_modes(sysm.board_model(p0).model, n_modes=n).omega2
+    lam0 = fe_modes(sysm.at(p0).model, n_modes=n).omega2
     K, M, dKs, dMs = sysm.model(p0)
     lam, Phi = solve_modes(K, M, n)
     assert np.allclose(lam, lam0, rtol=1e-8)
@@ -99,8 +100,8 @@ def test_eigenvalue_derivatives_match_resolves(tmp_path):
         up, dn = p0.copy(), p0.copy()
         up[j] += h
         dn[j] -= h
-        fd = (fe_modes(sysm.board_model(up).model, n_modes=n).omega2
-              - fe_modes(sysm.board_model(dn).model, n_modes=n).omega2) / (2 * h)
+        fd = (fe_modes(sysm.at(up).model, n_modes=n).omega2
+              - fe_modes(sysm.at(dn).model, n_modes=n).omega2) / (2 * h)
         scale = np.max(np.abs(lam0)) / p0[j]  # relative to the size of lambda / p
         assert np.max(np.abs(dlam[:, j] - fd)) < 1e-4 * max(np.max(np.abs(fd)), 1e-3 * scale), name
 
@@ -124,14 +125,14 @@ def test_six_part_card_qms_recovers_thicknesses(tmp_path):
     z at the 81 grid points), three configurations, QMS: thicknesses within 5 %, frequencies 0.5 %."""
     true_t = np.array([4.2, 3.0, 4.0, 2.9, 3.9, 4.4])
     truth = load_board(card(tmp_path, "true.toml", true_t))
-    prob = BoardProblem(load_board(card(tmp_path, "board.toml")))
+    prob = UpdateProblem(load_board(card(tmp_path, "board.toml")))
     pts, dofs = read_points_csv(CARD / "points.csv")
     cfgs, full = [], []
     for k, c in enumerate([None, "c2", "c3"]):
         bm = build_model(truth, c)
         td = simulate_on_model(bm.model, fe_modes(bm.model, n_modes=7), pts, dofs,
                                noise=Noise(frequency_pct=0.2, shape_pct=2.0), seed=k)
-        meas = MeasuredModes.from_test(td.modes)
+        meas = td.modes
         cfgs += prob.mode_configurations(c, meas, "qms")
         full.append(prob.configuration(c, meas, "freq"))  # full model, MAC pairing: the after check
     res, before, after = run(prob, cfgs, "ls", check=full, max_iter=10, tol_freq_pct=0.05)
@@ -158,7 +159,7 @@ def measured(select):
     for cfg, modes in select.items():
         g = df[(df.configuration == cfg) & df["mode"].isin(modes)]
         out.append((None if cfg == "c1" else cfg,
-                    MeasuredModes(g.frequency_hz.to_numpy(float), mode_numbers=g["mode"].to_numpy(int))))
+                    Modes.frequencies_only(g.frequency_hz.to_numpy(float), g["mode"].to_numpy(int))))
     return out
 
 
@@ -170,7 +171,7 @@ def test_real_card_frequency_updating(tmp_path, select, solver):
     """Measured frequencies of the real card (Table 7.2), six thicknesses, frequency-based
     updating (configuration 1 alone: Bayesian step with line search, eqs. 4.38-4.40, 7.5-7.6; three
     configurations: bounded least squares, eqs. 4.44-4.48): the error drops, stays physical (within [2, 10] mm) and ends below 5 %."""
-    prob = BoardProblem(load_board(card(tmp_path, "board.toml")))
+    prob = UpdateProblem(load_board(card(tmp_path, "board.toml")))
     cfgs = [prob.configuration(c, m, "freq") for c, m in measured(select)]
     res, before, after = run(prob, cfgs, solver, max_iter=15, tol_freq_pct=0.1)
     b1, a1 = before[0], after[0]

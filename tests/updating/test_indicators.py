@@ -14,7 +14,7 @@ from pcbdyn.updating.indicators import (
     weighted_emm,
     weighted_emm_indicator,
 )
-from pcbdyn.updating.study import SimulatedFreePCB
+from pcbdyn.problems.cases import SimulatedFreePCB
 
 from structures import chain_model
 

@@ -1,0 +1,198 @@
+"""A board: its validated description and the domain-model interface (:mod:`pcbdyn.domain`) that the
+bridge to updating and diagnosis uses: the quantities parameter targets address, the FE model of a
+configuration, measurement points on the board, and the updated board.toml."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from .. import targets
+from ..atomic import write_checked
+from ..inputs import Reader, read_toml
+from .entries import Analysis, BoardError, Component, Configuration, Outline
+from .laminate import Material
+from .model import BoardModel, build_model
+from .spec import read_outline, read_plate
+from .spec_effects import read_line_mass, read_region, read_stiffener
+from .spec_fixtures import check_edge_springs, read_fixture, read_mass
+from .spec_parts import check_overlaps, read_component
+
+#: the collections of board.toml that parameter targets address
+COLLECTIONS = ("board", "components", "fixtures", "masses", "line_masses", "stiffeners", "regions")
+
+
+@dataclass
+class Board:
+    name: str
+    path: Path
+    outline: Outline
+    plate: object  # a ShellProperty-like object for the bare board
+    isotropic: Material | None  # the board material when given as one (None for a stack-up)
+    mesh_size: float
+    smear: str  # "none" or "global" (all part masses spread over the whole board)
+    components: list
+    fixtures: list
+    masses: list
+    configurations: list
+    parameters: list  # pcbdyn.targets.ParameterSpec
+    analysis: Analysis
+    points: list  # measurement points (x, y) [m] to put nodes on
+    line_masses: list = field(default_factory=list)
+    stiffeners: list = field(default_factory=list)
+    regions: list = field(default_factory=list)
+    transverse_shear: float = 1.0  # factor on every shell's transverse shear stiffness
+
+    @property
+    def thickness(self) -> float:
+        return self.plate.t
+
+    def component(self, ref):
+        return next((c for c in self.components if c.ref == ref), None)
+
+    def fixture(self, name):
+        return next((f for f in self.fixtures if f.name == name), None)
+
+    def point_mass(self, name):
+        return next((m for m in self.masses if m.name == name), None)
+
+    def configuration(self, name):
+        return next((c for c in self.configurations if c.name == name), None)
+
+    def configuration_names(self) -> list:
+        return [c.name for c in self.configurations]
+
+    def entry(self, kind, name):
+        """The ``line_masses``, ``stiffeners`` or ``regions`` entry called ``name`` (or None)."""
+        return next((e for e in getattr(self, kind) if e.name == name), None)
+
+    def quantity(self, target: str) -> float | None:
+        """The current value [SI] of a parameter target such as ``components.U1.thickness``; None when
+        this board has no such quantity (e.g. a thickness of a lumped part)."""
+        try:
+            t = targets.parse(target, COLLECTIONS)
+        except targets.TargetError:
+            return None
+        kind, name, attr = t.collection, t.name, t.attribute
+        if kind == "board":
+            if attr == "transverse_shear":
+                return self.transverse_shear
+            if self.isotropic is None:
+                return None
+            return {"E": self.isotropic.E, "rho": self.isotropic.rho, "thickness": self.plate.t}[attr]
+        if kind == "components" and (c := self.component(name)) is not None and self.smear == "none":
+            return {"thickness": c.thickness if c.model == "equivalent_thickness" else None, "mass": c.mass,
+                    "E": (c.E if c.E is not None else self.isotropic.E)
+                    if c.model == "smeared_local" and self.isotropic is not None else None,
+                    "rho": smeared_density(self, c) if c.model == "smeared_local" else None}[attr]
+        if kind == "fixtures" and (f := self.fixture(name)) is not None:
+            if attr == "k_rot" and f.type in ("wedge_lock", "edge_spring") and isinstance(f.k_rot, float):
+                return f.k_rot
+            if attr == "k" and f.type in ("standoff", "point_spring") and isinstance(f.k, float):
+                return f.k
+            return None
+        if kind == "masses" and (m := self.point_mass(name)) is not None:
+            return {"mass": m.mass, "inertia": m.inertia}[attr]
+        if kind in ("line_masses", "stiffeners", "regions") and (e := self.entry(kind, name)) is not None:
+            return getattr(e, attr)
+        return None
+
+    # -------------------------------------------------------------------- domain-model interface
+    def build(self, config: str | None = None, mesh_size: float | None = None, shared_mesh: bool = False) -> BoardModel:
+        """The FE model of configuration ``config`` (None: the base one); see :func:`.model.build_model`."""
+        return build_model(self, config, mesh_size, shared_mesh)
+
+    def check_points(self, points, source) -> None:
+        """A BoardError naming the points (``points.ids``, ``points.xyz`` [m]) of ``source`` that lie
+        off the outline or in a hole, before any meshing."""
+        off = ~self.outline.contains(points.xyz[:, :2], tol=1e-6)
+        if off.any():
+            listed = ", ".join(f"{int(i)} ({x * 1e3:g}, {y * 1e3:g} mm)"
+                               for i, (x, y) in zip(points.ids[off][:10], points.xyz[off, :2][:10]))
+            lo, hi = self.outline.bbox
+            raise BoardError(
+                f"{Path(source).name}: {int(off.sum())} point(s) lie off the board of {self.path.name} (not on the "
+                f"board): {listed}"
+                f"{' ...' if off.sum() > 10 else ''}. The board frame runs from ({lo[0] * 1e3:g}, {lo[1] * 1e3:g}) to "
+                f"({hi[0] * 1e3:g}, {hi[1] * 1e3:g}) mm; give the points in that frame and state their unit in the "
+                "header (e.g. 'x [mm]')")
+
+    def write_updated(self, values: dict, dst, source: str = "pcbdyn update") -> Path:
+        """``dst``: this board.toml with the parameters' ``values`` {name: SI} written into their targets
+        (comments and layout kept), checked by loading it before it replaces ``dst``."""
+        assignments = {t: float(values[p.name]) for p in self.parameters if p.name in values for t in p.targets}
+        header = f"# {self.path.name} with {', '.join(values)} updated by {source}\n"
+        text = header + targets.updated_text(self.path.read_text(encoding="utf-8"), assignments)
+        return write_checked(dst, text, load_board, BoardError)
+
+
+def smeared_density(board: Board, c: Component) -> float:
+    """Region density of a locally smeared part: the board's plus the part mass over its volume of
+    board, so the region carries board + part mass (thesis 7.2.3, local smearing)."""
+    t = board.plate.t
+    rho_b = board.plate.mass_per_area() / t
+    return rho_b + c.mass / (c.area * t)
+
+
+def load_board(path) -> Board:
+    """Read and validate a board.toml."""
+    return parse_board(read_toml(path, BoardError)[1], Path(path))
+
+
+def parse_board(data: dict, path: Path) -> Board:
+    """The Board of parsed board.toml ``data`` read from ``path``; a BoardError names the first bad field."""
+    r = Reader(path, BoardError)
+    r.table(data, "top level", ["board", "components", "fixtures", "masses", "configurations", "parameters",
+                                "analysis", "points", "line_masses", "stiffeners", "regions"], required=["board"])
+    b = r.table(data["board"], "board", ["name", "outline", "thickness", "material", "stackup", "mesh_size",
+                                         "smear", "transverse_shear"], required=["outline"])
+    outline = read_outline(r, b["outline"])
+    plate, iso = read_plate(r, b)
+    mesh_size = r.q(b.get("mesh_size", "5 mm"), "mm", "board.mesh_size", positive=True)
+    smear = b.get("smear", "none")
+    if smear not in ("none", "global"):
+        r.fail("board.smear", f"'{smear}' is not 'none' or 'global' (global: spread every part's mass over the board)")
+    shear = r.number(b.get("transverse_shear", 1.0), "board.transverse_shear", lo=0.0)
+    board = Board(
+        name=str(b.get("name", Path(path).parent.name)), path=Path(path), outline=outline, plate=plate,
+        isotropic=iso, mesh_size=mesh_size, smear=smear, components=[], fixtures=[], masses=[],
+        configurations=[], parameters=[], analysis=Analysis(), points=[], transverse_shear=shear,
+    )
+    for i, c in enumerate(r.list(data, "components")):
+        board.components.append(read_component(r, c, f"components[{i}]", board))
+    check_overlaps(r, board)
+    for i, f in enumerate(r.list(data, "fixtures")):
+        board.fixtures.append(read_fixture(r, f, f"fixtures[{i}]", board, i))
+    check_edge_springs(r, board)
+    for i, m in enumerate(r.list(data, "masses")):
+        board.masses.append(read_mass(r, m, f"masses[{i}]", board, i))
+    r.unique([m.name for m in board.masses], "masses", "name")
+    for key, read in (("line_masses", read_line_mass), ("stiffeners", read_stiffener), ("regions", read_region)):
+        for i, e in enumerate(r.list(data, key)):
+            getattr(board, key).append(read(r, e, f"{key}[{i}]", board))
+        r.unique([e.name for e in getattr(board, key)], key, "name")
+    for i, c in enumerate(r.list(data, "configurations")):
+        where = f"configurations[{i}]"
+        r.table(c, where, ["name", "masses"], required=["name"])
+        ms = [read_mass(r, m, f"{where}.masses[{j}]", board, j) for j, m in enumerate(c.get("masses", []))]
+        board.configurations.append(Configuration(str(c["name"]), ms))
+    r.unique([c.name for c in board.configurations], "configurations", "name")
+    for i, p in enumerate(data.get("points", [])):
+        pt = r.point(p, f"points[{i}]")
+        if not outline.contains(pt)[0]:
+            r.fail(f"points[{i}]", f"{p} is not on the board; move it inside the outline")
+        board.points.append(pt)
+    if "analysis" in data:
+        a = r.table(data["analysis"], "analysis", ["modes", "f_max"])
+        modes = a.get("modes", 12)
+        if isinstance(modes, bool) or not isinstance(modes, int) or modes < 1:
+            r.fail("analysis.modes", f"must be a positive whole number, got {modes!r}")
+        f_max = r.q(a["f_max"], "Hz", "analysis.f_max", positive=True) if "f_max" in a else None
+        board.analysis = Analysis(modes, f_max)
+    for i, p in enumerate(r.list(data, "parameters")):
+        try:
+            board.parameters.append(targets.parameter_spec(p, f"parameters[{i}]", board.quantity, r.file, COLLECTIONS))
+        except targets.TargetError as exc:
+            raise BoardError(str(exc)) from None
+    r.unique([p.name for p in board.parameters], "parameters", "name")
+    return board

@@ -1,0 +1,46 @@
+"""The domain-model interface: what the bridge to updating and diagnosis (:mod:`pcbdyn.problems`) asks
+of a structure described in a TOML file. :class:`pcbdyn.board.Board` implements it, and so does every
+other structure (a ribbed box), so that update, localize, study, diagnose, library calibration and
+wedge-lock fitting work on any of them with no second copy.
+
+A structure has a ``name``, the ``path`` of its file, its ``parameters``
+(:class:`pcbdyn.targets.ParameterSpec`: named, bounded, with units), ``mesh_size`` [m] and
+``analysis`` (``modes``, ``f_max``), and:
+
+- ``configuration_names()``: its perturbed test configurations (PBC), besides the base one (None);
+- ``build(config=None, mesh_size=None, shared_mesh=False)``: the FE model of one configuration as a
+  :class:`pcbdyn.fe.parametric.ParametricModel` whose ``parameters`` give dK/dp and dM/dp, read at
+  measurement points through the shell shape functions (``shared_mesh``: every configuration on one
+  mesh, node for node);
+- ``check_points(xyz, source)``: a :class:`StructureError` naming the measurement points (of
+  ``source``, a file) that lie off the structure;
+- ``write_updated(values, dst, source)``: its file with parameter ``values`` {name: SI} written into
+  their targets, the user's comments and layout kept; returns the path written;
+- ``diagnosis_layout(pm)``: where a diagnosis may place candidate effects on a built model ``pm``.
+"""
+
+from __future__ import annotations
+
+from typing import Protocol
+
+
+class StructureError(ValueError):
+    """A structure description, or data about it, that cannot be used: the message names the file,
+    the field and the fix."""
+
+
+class Structure(Protocol):
+    """See the module docstring."""
+
+    name: str
+    parameters: list
+
+    def configuration_names(self) -> list: ...
+
+    def build(self, config=None, mesh_size=None, shared_mesh: bool = False): ...
+
+    def check_points(self, xyz, source) -> None: ...
+
+    def write_updated(self, values: dict, dst, source: str = "pcbdyn update"): ...
+
+    def diagnosis_layout(self, pm): ...

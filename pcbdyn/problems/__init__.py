@@ -1,0 +1,12 @@
+"""The bridge from structures (boards, boxes) and their measured data to the plain-matrix updating driver:
+update, localisation, studies, library calibration and wedge-lock fitting build their equations here,
+and diagnosis takes its models from here."""
+
+from .load import load_structure
+from .models import StructureModels
+from .problem import UpdateProblem
+from .run import correlation_state, run
+from .system import ConfigSystem, DynamicReduced, shape_pairing
+
+__all__ = ["ConfigSystem", "DynamicReduced", "StructureModels", "UpdateProblem", "correlation_state",
+           "load_structure", "run", "shape_pairing"]

@@ -1,0 +1,116 @@
+"""One test configuration of one structure as the plain-matrix updating driver sees it: the matrices and
+their parameter derivatives on the independent DOFs, the model read at the measurement points, the
+excited DOF of an FRF, and how measured modes pair with the model's."""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..correlation.pairing import pair_modes
+from ..fe.assembly import assemble
+from ..fe.constraints import build_reduction
+from ..fe.probe import model_probe
+from ..updating.matching import transformation
+from .models import parameter_derivatives, parameter_values
+
+
+class ConfigSystem:
+    """``model(p)`` returns (K, M, dKs, dMs) reduced to the independent DOFs (CSC), one derivative pair per
+    parameter of ``names`` (zero for those the built model ``pm`` lacks), from the elements each
+    parameter touches (:meth:`pcbdyn.fe.parametric.Parameter.derivatives`). The last evaluation is
+    cached (the driver and its line search ask for the same p more than once)."""
+
+    def __init__(self, pm, names, label: str = "base"):
+        self.pm, self.names, self.label = pm, list(names), label
+        K, M = assemble(pm.model)
+        self.reduction = build_reduction(pm.model, K, M)
+        self.n_rigid = 6 if pm.model.free else 0
+        self._cache = (None, None)
+
+    def model(self, p):
+        """(K, M, dKs, dMs) at parameter values ``p`` [SI], on the independent DOFs."""
+        p = np.asarray(p, float)
+        if self._cache[0] is not None and np.array_equal(self._cache[0], p):
+            return self._cache[1]
+        pm = self.at(p)
+        red = self.reduction.reduce
+        K, M = assemble(pm.model)
+        pairs = parameter_derivatives(pm, self.names)
+        out = (red(K), red(M), [red(dK) for dK, _ in pairs], [red(dM) for _, dM in pairs])
+        self._cache = (p.copy(), out)
+        return out
+
+    def at(self, p):
+        """The built model (:class:`pcbdyn.fe.parametric.ParametricModel`) at parameter values ``p``."""
+        return self.pm.with_parameters(parameter_values(self.pm, self.names, p))
+
+    def measurement_matrix(self, xyz, directions) -> sp.csr_matrix:
+        """P (n_meas, n_independent): the model read at the points along the directions."""
+        P = model_probe(self.pm.model, xyz, directions).P
+        return sp.csr_matrix(P @ self.reduction.T)
+
+    def excitation_dof(self, xyz, direction):
+        """(independent DOF index, note or None) of a unit force at point ``xyz`` along ``direction``.
+        The FRF equations (3.34, 3.35, 3.40) take one excited DOF: a point on a node along an axis maps
+        to it exactly; otherwise the DOF with the largest interpolation weight is used and the note
+        says so (move the excitation onto a node, e.g. with a mesh size that divides its coordinates)."""
+        row = self.measurement_matrix(np.asarray(xyz, float)[None], np.asarray(direction, float)[None]).toarray()[0]
+        w = np.abs(row)
+        where = np.round(np.asarray(xyz) * 1e3, 2).tolist()
+        if w.max() == 0:
+            raise ValueError(f"excitation at {where} mm moves no free DOF")
+        j = int(np.argmax(w))
+        if np.isclose(row[j], 1.0) and np.sum(w > 1e-9) == 1:
+            return j, None
+        return j, (f"excitation at {where} mm is not on a node along an axis: the nearest-weight DOF is excited "
+                   "instead (biased); put the excitation on a mesh node")
+
+    def pairing(self, measured, min_mac: float = 0.5):
+        """The driver's pairing callable for the measured modes ``measured`` (:class:`pcbdyn.testdata.Modes`):
+        by MAC (:func:`pcbdyn.correlation.pairing.pair_modes`) when shapes are measured, else by the
+        test's mode numbers; rigid-body modes never pair."""
+        return shape_pairing(min_mac, self.n_rigid, None if measured.shapes is not None else measured.numbers)
+
+
+def shape_pairing(min_mac: float, n_rigid: int = 0, numbers=None):
+    """A pairing callable (f_a, phi_a, f_x, phi_x) -> analytical index per measured mode (-1: unpaired):
+    by MAC, each model mode used once (:func:`pcbdyn.correlation.pairing.pair_modes`), past the first
+    ``n_rigid`` (rigid-body) analytical modes; with ``numbers`` (1-based elastic mode numbers, for
+    frequencies without shapes) by those numbers."""
+
+    def pairing(f_a, phi_a, f_x, phi_x):
+        out = -np.ones(np.size(f_x), int)
+        if numbers is not None or phi_x is None:
+            k = n_rigid + (np.arange(np.size(f_x)) + 1 if numbers is None else np.asarray(numbers)) - 1
+            ok = k < np.size(f_a)
+            out[ok] = k[ok]
+            return out
+        res = pair_modes(np.asarray(phi_x), np.asarray(phi_a)[:, n_rigid:], f_x, np.asarray(f_a)[n_rigid:],
+                         min_mac=min_mac)
+        for pr in res.pairs:
+            out[pr.test] = pr.model + n_rigid
+        return out
+
+    return pairing
+
+
+class DynamicReduced:
+    """``model(p)`` of one measured mode: the structure reduced onto the measured DOFs by the dynamic map
+    at that mode's measured angular frequency ``omega`` (thesis ch. 2.2; P T = I, T frozen within an
+    evaluation, so T^T dK T is the exact derivative of the condensed dynamic stiffness). At the test
+    frequency the condensation is exact for the mode there, unlike Guyan's static one, so shape
+    equations on it carry no reduction bias."""
+
+    def __init__(self, system: ConfigSystem, P, omega: float):
+        self.system, self.P, self.omega = system, P, float(omega)
+
+    def __call__(self, p):
+        K, M, dKs, dMs = self.system.model(p)
+        T = transformation(K, M, self.P, self.omega)
+
+        def red(A):
+            return np.asarray(T.T @ (A @ T))
+
+        Kr, Mr = red(K), red(M)
+        return 0.5 * (Kr + Kr.T), 0.5 * (Mr + Mr.T), [red(d) for d in dKs], [red(d) for d in dMs]

@@ -1,0 +1,66 @@
+"""Bounded Gauss-Newton on a residual in units of noise (thesis ch. 4 with the bounds of eqs.
+4.44-4.48): the nonlinear fit of parameters whose residual is re-solved at every trial, with each step
+halved while it does not lower chi^2 = |r|^2. Diagnosis estimates declared parameters (on a log
+scale) and effect magnitudes with it; the bounded step and the covariance are the updating solvers'.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .solvers import bounded_lsq, covariance
+
+#: how many times a step that raises chi^2 is halved before the fit stops
+HALVINGS = 4
+
+
+@dataclass
+class GaussNewton:
+    """``y``: the variables found; ``state``: the residual's state there (None when even the start
+    could not be evaluated); ``cov``: the covariance of ``y`` from the last Jacobian."""
+
+    y: np.ndarray
+    state: object
+    cov: np.ndarray
+
+    @property
+    def chi2(self) -> float:
+        return np.inf if self.state is None else float(self.state.r @ self.state.r)
+
+
+def gauss_newton(evaluate, jacobian, y0, lower, upper, scale, steps: int, step_tol) -> GaussNewton:
+    """Fit ``y`` from ``y0`` within [lower, upper].
+
+    ``evaluate(y)``: the state at ``y`` (with ``r``, the residual rows in noise units), or None where
+    the model cannot be evaluated; ``jacobian(state)``: dr/dy (n_rows, n_y) there (sign: the rows are
+    data - prediction, so the step solves J dy = r); ``scale`` (n_y,): typical sizes of the variables,
+    which condition the step; ``step_tol`` (n_y,): a step smaller than this in every variable ends the
+    fit. At most ``steps`` steps; a step that raises chi^2 is halved up to :data:`HALVINGS` times."""
+    y = np.asarray(y0, float)
+    lower, upper, scale = (np.asarray(v, float) for v in (lower, upper, scale))
+    st = evaluate(y)
+    if st is None:
+        return GaussNewton(y, None, np.zeros((0, 0)))
+    chi2 = float(st.r @ st.r)
+    for _ in range(steps):
+        J = jacobian(st) * scale
+        if J.shape[1] == 0:
+            break
+        lo, hi = (lower - y) / scale, (upper - y) / scale
+        dy = bounded_lsq(J, st.r, np.minimum(lo, 0.0), np.maximum(hi, 0.0)) * scale
+        for _half in range(HALVINGS):
+            y_new = np.clip(y + dy, lower, upper)
+            trial = evaluate(y_new)
+            if trial is not None and float(trial.r @ trial.r) <= chi2 * (1 + 1e-9):
+                break
+            dy = 0.5 * dy
+        else:
+            break
+        small = np.all(np.abs(dy) <= step_tol(y))
+        y, st, chi2 = y_new, trial, float(trial.r @ trial.r)
+        if small:
+            break
+    J = jacobian(st)
+    return GaussNewton(y, st, covariance(J, st.r) if J.shape[1] else np.zeros((0, 0)))
