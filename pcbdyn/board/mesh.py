@@ -136,8 +136,10 @@ def mesh_board(outline, regions, points, size: float, strips=(), lines=()) -> Bo
             gmsh.option.setNumber("Mesh.MeshSizeMax", size)
             gmsh.model.mesh.generate(2)
             if 2 in gmsh.model.mesh.getElementTypes(2):
-                # blossom left triangles: mesh twice as coarse and split every cell into quads
+                # blossom left triangles: mesh twice as coarse and split every cell into quads, with the
+                # frontal-Delaunay for quads (algorithm 6 on this pass gave other meshes run to run)
                 gmsh.model.mesh.clear()
+                gmsh.option.setNumber("Mesh.Algorithm", 8)
                 gmsh.option.setNumber("Mesh.MeshSizeMax", 2.0 * size)
                 gmsh.option.setNumber("Mesh.SubdivisionAlgorithm", 1)
                 gmsh.model.mesh.generate(2)

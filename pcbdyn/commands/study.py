@@ -34,7 +34,6 @@ Any board instead (equations qms, fbm or freq)::
 
 from __future__ import annotations
 
-import tomllib
 from pathlib import Path
 
 import click
@@ -48,13 +47,11 @@ CASE_KEYS = {
 
 def read_spec(path: Path) -> dict:
     """The [study] and [case] tables of ``path``, checked; ValueError names the bad field."""
+    from ..inputs import read_toml
     from ..problems.cases import CASES
     from ..updating.study import METHODS
 
-    try:
-        doc = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as exc:
-        raise ValueError(f"{path.name} is not valid TOML: {exc}") from None
+    doc = read_toml(path, ValueError)[1]
     s = doc.get("study")
     if not isinstance(s, dict):
         raise ValueError(f"{path.name}: a [study] table is required (see `pcbdyn study --help`)")

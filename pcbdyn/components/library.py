@@ -8,10 +8,10 @@ project's top-level ``library/`` (or the folders named in the PCBDYN_LIBRARY pat
 from __future__ import annotations
 
 import os
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..inputs import read_toml
 from ..units import UnitError, to_si
 
 MODELS = ("lumped", "spread", "smeared_local", "equivalent_thickness")
@@ -60,10 +60,7 @@ def available(board_dir: Path | None = None) -> list[str]:
 def read_package(path: Path) -> Package:
     """Read one library file (table ``[package]``)."""
     path = Path(path)
-    try:
-        data = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as exc:
-        raise LibraryError(f"{path}: not valid TOML ({exc})") from None
+    data = read_toml(path, LibraryError)[1]
     p = data.get("package")
     if not isinstance(p, dict):
         raise LibraryError(f"{path}: needs a [package] table with size, height, mass, default_model, equivalent_thickness")

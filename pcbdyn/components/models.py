@@ -79,7 +79,10 @@ def region_keys(board, c) -> tuple:
         "smeared_local": (f"{key}.E", f"{key}.rho"),
         "equivalent_thickness": (f"{key}.thickness", f"{key}.mass"),
     }[c.model]
-    shared = board_keys(board) if c.model != "smeared_local" else (SHEAR_KEY,)
+    if c.model == "smeared_local":  # its own E and density, at the board's thickness
+        shared = (SHEAR_KEY,) + (("board.thickness",) if board.isotropic is not None else ())
+    else:
+        shared = board_keys(board)
     return shared + own
 
 

@@ -7,13 +7,8 @@ EXAMPLES = ROOT / "examples"
 DATA = Path(__file__).resolve().parent / "data"
 
 
+from data_files import write_board  # noqa: E402,F401  (re-exported for the board tests)
 from reference import thesis_case  # noqa: E402,F401  (re-exported for the board tests)
-
-
-def write_board(tmp_path, text, name="board.toml"):
-    p = tmp_path / name
-    p.write_text(text)
-    return p
 
 
 def rel_err(a, b):

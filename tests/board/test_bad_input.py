@@ -5,43 +5,9 @@ import pytest
 from pcbdyn.board import BoardError, load_board
 
 from board_helpers import write_board
+from data_files import board_text
 
-GOOD = '''
-[board]
-name = "t"
-outline = { width = "100 mm", height = "80 mm" }
-thickness = "1.6 mm"
-material = { E = "22 GPa", nu = 0.15, rho = "1850 kg/m^3" }
-mesh_size = "10 mm"
-
-[[components]]
-ref = "U1"
-package = "PGA"
-at = ["30 mm", "40 mm"]
-
-[[components]]
-ref = "U2"
-at = ["75 mm", "40 mm"]
-size = ["20 mm", "20 mm"]
-mass = "5 g"
-model = "spread"
-
-[[fixtures]]
-name = "left"
-type = "wedge_lock"
-edge = "x=0"
-k_rot = "1e4 N*m/rad/m"
-
-[[masses]]
-name = "tx"
-at = ["90 mm", "10 mm"]
-mass = "13 g"
-
-[[parameters]]
-name = "t1"
-target = "components.U1.thickness"
-bounds = ["2 mm", "10 mm"]
-'''
+GOOD = board_text("bad_input_good.toml")
 
 
 def test_the_good_board_reads(tmp_path):

@@ -8,32 +8,9 @@ from board_helpers import write_board
 from click.testing import CliRunner
 
 from pcbdyn.cli import main
+from data_files import board_text
 
-PLATE = '''
-[board]
-name = "simply supported plate"
-outline = { width = "100 mm", height = "80 mm" }
-thickness = "1.6 mm"
-material = { E = "22 GPa", nu = 0.15, rho = "1850 kg/m^3" }
-mesh_size = "4 mm"
-[[fixtures]]
-type = "hinged_edge"
-edge = "x=0"
-[[fixtures]]
-type = "hinged_edge"
-edge = "x=100 mm"
-[[fixtures]]
-type = "hinged_edge"
-edge = "y=0"
-[[fixtures]]
-type = "hinged_edge"
-edge = "y=80 mm"
-[[configurations]]
-name = "loaded"
-masses = [{ at = ["50 mm", "40 mm"], mass = "10 g" }]
-[analysis]
-modes = 4
-'''
+PLATE = board_text("hinged_plate.toml")
 
 
 def navier(m, n, a=0.1, b=0.08, t=1.6e-3, E=22e9, nu=0.15, rho=1850.0):

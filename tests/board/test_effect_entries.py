@@ -29,21 +29,10 @@ from board_helpers import write_board
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "diagnosis"))
 from diagnosis_plates import rotary_inertia, total_mass  # noqa: E402
+from data_files import board_text
 
 N = 8
-BASE = """
-[board]
-outline = { width = "100 mm", height = "80 mm" }
-thickness = "1.6 mm"
-material = { E = "24 GPa", nu = 0.3, rho = "1900 kg/m^3" }
-mesh_size = "10 mm"
-
-[[fixtures]]
-name = "guide"
-type = "wedge_lock"
-edge = "y=0"
-k_rot = "2e3 N*m/rad/m"
-"""
+BASE = board_text("guided_plate.toml")
 
 # kind -> (value [SI], point the candidate is nearest to [m])
 CASES = {
@@ -232,20 +221,7 @@ def test_edge_spring_on_a_slanted_edge_resists_rotation_about_that_edge_only(tmp
     """k index 3 of the edge spring is the rotation about the segment (edge axis 1), whatever its
     direction: a rotation theta about the slanted edge stores kr L theta^2 / 2, one about the
     in-plane normal to it stores nothing."""
-    text = """
-[board]
-outline = { polygon = [["0 mm", "0 mm"], ["100 mm", "0 mm"], ["60 mm", "80 mm"], ["0 mm", "80 mm"]] }
-thickness = "1.6 mm"
-material = { E = "24 GPa", nu = 0.3, rho = "1900 kg/m^3" }
-mesh_size = "10 mm"
-
-[[fixtures]]
-name = "slant"
-type = "edge_spring"
-from = ["90 mm", "20 mm"]
-to = ["70 mm", "60 mm"]
-k_rot = "300 N*m/rad/m"
-"""
+    text = board_text("slanted_edge_spring.toml")
     bm = build_model(load_board(write_board(tmp_path, text)))
     es = bm.model.sets["fixtures.slant"]
     K, _ = kernel("edge_spring")(bm.model.nodes[es.conn], es.prop)

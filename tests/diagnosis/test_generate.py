@@ -5,44 +5,10 @@ import pytest
 
 from pcbdyn import diagnosis as dg
 from pcbdyn.board import build_model, load_board
+from data_files import board_text
 
 W, H = 0.1, 0.08
-BOARD = '''
-points = [["70 mm", "55 mm"], ["20 mm", "20 mm"], ["50 mm", "40 mm"]]
-
-[board]
-name = "diagnosis test card"
-outline = { width = "100 mm", height = "80 mm" }
-thickness = "1.6 mm"
-material = { E = "22 GPa", nu = 0.15, rho = "1850 kg/m^3" }
-mesh_size = "8 mm"
-
-[[components]]
-ref = "U1"
-at = ["35 mm", "40 mm"]
-size = ["24 mm", "16 mm"]
-mass = "6 g"
-model = "equivalent_thickness"
-thickness = "3 mm"
-
-[[fixtures]]
-name = "left"
-type = "wedge_lock"
-edge = "x=0"
-k_rot = "1e3 N*m/rad/m"
-
-[[fixtures]]
-name = "right"
-type = "wedge_lock"
-edge = "x=100 mm"
-width = "5 mm"
-k_rot = "1e3 N*m/rad/m"
-
-[[masses]]
-name = "tx"
-at = ["88 mm", "12 mm"]
-mass = "3 g"
-'''
+BOARD = board_text("diagnosis_card.toml")
 
 
 @pytest.fixture(scope="module")

@@ -23,62 +23,10 @@ from pcbdyn.updating.sensitivity import eigenvalue_derivatives, solve_modes
 ROOT = Path(__file__).resolve().parents[2]
 CARD = ROOT / "examples" / "six_part_card"
 from reference import thesis_case
+from data_files import board_text
 MESH = "13.5 mm"
 
-SPRING_BOARD = """
-[board]
-outline = { width = "100 mm", height = "80 mm" }
-thickness = "1.6 mm"
-material = { E = "24 GPa", nu = 0.3, rho = "1900 kg/m^3" }
-mesh_size = "10 mm"
-
-[[components]]
-ref = "U1"
-package = "PGA"
-at = ["50 mm", "40 mm"]
-
-[[masses]]
-name = "m1"
-at = ["80 mm", "60 mm"]
-mass = "20 g"
-
-[[fixtures]]
-name = "guide"
-type = "wedge_lock"
-edge = "y=0"
-k_rot = "2e3 N*m/rad/m"
-
-[[fixtures]]
-name = "s1"
-type = "standoff"
-at = ["90 mm", "70 mm"]
-k = "3e5 N/m"
-
-[[parameters]]
-name = "t_U1"
-target = "components.U1.thickness"
-bounds = ["1 mm", "10 mm"]
-[[parameters]]
-name = "rho"
-target = "board.rho"
-bounds = ["1000 kg/m^3", "3000 kg/m^3"]
-[[parameters]]
-name = "E"
-target = "board.E"
-bounds = ["10 GPa", "40 GPa"]
-[[parameters]]
-name = "k_guide"
-target = "fixtures.guide.k_rot"
-bounds = ["1 N*m/rad/m", "1e7 N*m/rad/m"]
-[[parameters]]
-name = "k_s1"
-target = "fixtures.s1.k"
-bounds = ["1e3 N/m", "1e8 N/m"]
-[[parameters]]
-name = "m1"
-target = "masses.m1.mass"
-bounds = ["1 g", "100 g"]
-"""
+SPRING_BOARD = board_text("spring_board.toml")
 
 
 def test_eigenvalue_derivatives_match_resolves(tmp_path):

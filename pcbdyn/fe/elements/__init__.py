@@ -3,24 +3,23 @@ to stiffness and mass matrices (n_cells, 6 * nodes_per_cell, 6 * nodes_per_cell)
 vectorised over cells.
 """
 
-from importlib import import_module
+from . import beam, discrete, edge_spring, embedded_beam, shell_quad4, shell_tri3
 
-#: element type -> (module in this package, function name)
+#: element type -> its matrices function
 KERNELS = {
-    "spring": ("discrete", "spring_matrices"),
-    "mass": ("discrete", "mass_matrices"),
-    "quad4": ("shell_quad4", "matrices"),
-    "tri3": ("shell_tri3", "matrices"),
-    "beam2": ("beam", "matrices"),
-    "embedded_beam2": ("embedded_beam", "matrices"),
-    "edge_spring": ("edge_spring", "matrices"),
+    "spring": discrete.spring_matrices,
+    "mass": discrete.mass_matrices,
+    "quad4": shell_quad4.matrices,
+    "tri3": shell_tri3.matrices,
+    "beam2": beam.matrices,
+    "embedded_beam2": embedded_beam.matrices,
+    "edge_spring": edge_spring.matrices,
 }
 
 
 def kernel(etype: str):
     """The matrices function for an element type."""
     try:
-        module, func = KERNELS[etype]
+        return KERNELS[etype]
     except KeyError:
         raise KeyError(f"no element kernel registered for '{etype}'") from None
-    return getattr(import_module(f"{__name__}.{module}"), func)
