@@ -10,8 +10,9 @@ import numpy as np
 from .common import done, fail, solve_board, step
 
 
-def analyse(board, config, out: Path | None, pictures: bool = True) -> dict:
-    """Build and solve one configuration; print its table; write CSV/VTU/PNG under ``out``."""
+def analyse(board, config, out: Path | None, pictures: bool = True, written: list | None = None) -> dict:
+    """Build and solve one configuration; print its table; write CSV/VTU/PNG under ``out`` (and
+    append their paths to ``written``)."""
     from ..report.files import write_text
     from ..report.modes import format_table, mode_table
 
@@ -33,14 +34,20 @@ def analyse(board, config, out: Path | None, pictures: bool = True) -> dict:
 
         vtu = out / f"{stem}.vtu"
         write_modes_vtu(vtu, bm.model, modes.frequencies, modes.shapes)
+        files = [out / f"{stem}.csv", vtu]
         if pictures:
-            from ..report.pictures import mode_pictures
+            from ..report.pictures import mode_pictures, picture_names
+            from .outlines import board_outlines
 
             t0 = step(f"[{label}] rendering {modes.frequencies.size} mode-shape pictures")
-            renderer = mode_pictures(vtu, bm.model, modes.frequencies, modes.shapes, out / "png", prefix=stem)
+            renderer = mode_pictures(vtu, bm.model, modes.frequencies, modes.shapes, out / "png", prefix=stem,
+                                     title=f"{board.name} [{label}]", outlines=board_outlines(board, config))
+            files += [out / "png" / n for n in picture_names(stem, modes.frequencies.size)]
             done(t0)
             if renderer != "pyvista":
-                click.echo("  note: 3-D rendering failed; the pictures are 2-D contour plots (matplotlib)", err=True)
+                click.echo("  note: 3-D rendering (pyvista) failed; the 3-D views are drawn by matplotlib", err=True)
+        if written is not None:
+            written += files
     return {
         "configuration": label,
         "modes": [{"n": int(row.mode), "frequency_hz": float(row.frequency_hz), "eff_mass_z": float(row.eff_mass_z),
