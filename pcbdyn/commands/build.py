@@ -78,7 +78,8 @@ def command(board_toml, config, all_configs, out, json_path, no_pictures):
         if config is not None and all_configs:
             raise click.UsageError("give --config NAME or --all-configs, not both")
         configs = [None] + [c.name for c in board.configurations] if all_configs else [config]
-        results = [analyse(board, c, out, pictures=not no_pictures) for c in configs]
+        written = []
+        results = [analyse(board, c, out, pictures=not no_pictures, written=written) for c in configs]
     except (BoardError, ModelError) as exc:
         fail(str(exc))
     if json_path is not None:
@@ -86,4 +87,9 @@ def command(board_toml, config, all_configs, out, json_path, no_pictures):
         data["board"] = board.name
         write_json(json_path, data)
     if out is not None:
+        from ..report.manifest import settle
+
+        removed = settle(out, written, "pcbdyn build")
+        if removed:
+            click.echo(f"removed {len(removed)} file(s) an earlier run wrote to {out}/ and this one did not", err=True)
         click.echo(f"results written to {out}/", err=True)
