@@ -39,8 +39,9 @@ def board_outlines(board, config: str | None = None) -> list:
     items += [_item("part", c.ref, c.corners(), True) for c in board.components]
     for f in board.fixtures:
         items += _fixture(board, f)
-    masses = list(board.masses) + (list(board.configuration(config).masses) if config else [])
-    items += [_item("mass", m.name, [m.at]) for m in masses]
+    items += [_item("mass", m.name, [m.at]) for m in board.masses]
+    added = board.configuration(config).masses if config else []
+    items += [_item("mass", f"{m.name} ({config})", [m.at]) for m in added]
     items += [_item("line mass", e.name, e.segment) for e in board.line_masses]
     items += [_item("stiffener", e.name, e.path) for e in board.stiffeners]
     items += [_item("region", e.name, e.polygon, True) for e in board.regions]
