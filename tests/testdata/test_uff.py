@@ -1,12 +1,11 @@
-"""UFF in and out: exact round trips, files written directly with pyuff, variants other tools write,
-and clear errors on files that cannot be read."""
+"""UFF in and out: round trips to the precision each dataset holds, files written directly with
+pyuff, variants other tools write, and clear errors on files that cannot be read."""
 
 import os
 
 import numpy as np
 import pytest
 import pyuff
-
 from uff_helpers import E13, E20, fixed
 
 from pcbdyn.correlation import mac

@@ -5,7 +5,6 @@ has junk in a record is an error naming the file and the dataset, never fewer mo
 import numpy as np
 import pytest
 import pyuff
-
 from uff_helpers import E13, E20, fixed
 
 from pcbdyn.testdata import Dofs, FRFs, Modes, Points, TestData, TestDataError, read_uff, write_uff
