@@ -16,7 +16,10 @@ A structure has a ``name``, the ``path`` of its file, its ``parameters``
   ``source``, a file) that lie off the structure;
 - ``write_updated(values, dst, source)``: its file with parameter ``values`` {name: SI} written into
   their targets, the user's comments and layout kept; returns the path written;
-- ``diagnosis_layout(pm)``: where a diagnosis may place candidate effects on a built model ``pm``.
+- ``outlines(config=None)``: what a mode-shape picture outlines (plain data: kind, label, points).
+
+A built model (:class:`pcbdyn.fe.parametric.ParametricModel`) adds what a diagnosis asks of it:
+``layout_hints()`` (prime suspects, footprints, plate thickness) and ``with_shear_factor(f)``.
 """
 
 from __future__ import annotations
@@ -43,4 +46,4 @@ class Structure(Protocol):
 
     def write_updated(self, values: dict, dst, source: str = "pcbdyn update"): ...
 
-    def diagnosis_layout(self, pm): ...
+    def outlines(self, config=None) -> list: ...

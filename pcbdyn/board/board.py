@@ -13,6 +13,7 @@ from ..inputs import Reader, read_toml
 from .entries import Analysis, BoardError, Component, Configuration, Outline
 from .laminate import Material
 from .model import BoardModel, build_model
+from .outlines import board_outlines
 from .spec import read_outline, read_plate
 from .spec_effects import read_line_mass, read_region, read_stiffener
 from .spec_fixtures import check_edge_springs, read_fixture, read_mass
@@ -116,6 +117,10 @@ class Board:
                 f"{' ...' if off.sum() > 10 else ''}. The board frame runs from ({lo[0] * 1e3:g}, {lo[1] * 1e3:g}) to "
                 f"({hi[0] * 1e3:g}, {hi[1] * 1e3:g}) mm; give the points in that frame and state their unit in the "
                 "header (e.g. 'x [mm]')")
+
+    def outlines(self, config: str | None = None) -> list:
+        """What a mode-shape picture outlines, as plain data (:func:`.outlines.board_outlines`)."""
+        return board_outlines(self, config)
 
     def write_updated(self, values: dict, dst, source: str = "pcbdyn update") -> Path:
         """``dst``: this board.toml with the parameters' ``values`` {name: SI} written into their targets

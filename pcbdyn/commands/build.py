@@ -9,8 +9,9 @@ import click
 from .common import done, fail, solve_structure, step
 
 
-def analyse(board, config, out: Path | None, pictures: bool = True) -> dict:
-    """Build and solve one configuration; print its table; write CSV/VTU/PNG under ``out``."""
+def analyse(board, config, out: Path | None, pictures: bool = True, written: list | None = None) -> dict:
+    """Build and solve one configuration; print its table; write CSV/VTU/PNG under ``out`` (and
+    append their paths to ``written``)."""
     from ..correlation import static_mass
     from ..report.files import write_text
     from ..report.modes import format_table, mode_table
@@ -31,14 +32,19 @@ def analyse(board, config, out: Path | None, pictures: bool = True) -> dict:
 
         vtu = out / f"{stem}.vtu"
         write_modes_vtu(vtu, bm.model, modes.frequencies, modes.shapes)
+        files = [out / f"{stem}.csv", vtu]
         if pictures:
-            from ..report.pictures import mode_pictures
+            from ..report.pictures import mode_pictures, picture_names
 
             t0 = step(f"[{label}] rendering {modes.frequencies.size} mode-shape pictures")
-            renderer = mode_pictures(vtu, bm.model, modes.frequencies, modes.shapes, out / "png", prefix=stem)
+            renderer = mode_pictures(vtu, bm.model, modes.frequencies, modes.shapes, out / "png", prefix=stem,
+                                     title=f"{board.name} [{label}]", outlines=board.outlines(config))
+            files += [out / "png" / n for n in picture_names(stem, modes.frequencies.size)]
             done(t0)
             if renderer != "pyvista":
-                click.echo("  note: 3-D rendering failed; the pictures are 2-D contour plots (matplotlib)", err=True)
+                click.echo("  note: 3-D rendering (pyvista) failed; the 3-D views are drawn by matplotlib", err=True)
+        if written is not None:
+            written += files
     return {
         "configuration": label,
         "modes": [{"n": int(row.mode), "frequency_hz": float(row.frequency_hz), "eff_mass_z": float(row.eff_mass_z),
@@ -70,7 +76,8 @@ def command(board_toml, config, all_configs, out, json_path, no_pictures):
         if config is not None and all_configs:
             raise click.UsageError("give --config NAME or --all-configs, not both")
         configs = [None] + board.configuration_names() if all_configs else [config]
-        results = [analyse(board, c, out, pictures=not no_pictures) for c in configs]
+        written = []
+        results = [analyse(board, c, out, pictures=not no_pictures, written=written) for c in configs]
     except (StructureError, ModelError) as exc:
         fail(str(exc))
     if json_path is not None:
@@ -78,4 +85,9 @@ def command(board_toml, config, all_configs, out, json_path, no_pictures):
         data["board"] = board.name
         write_json(json_path, data)
     if out is not None:
+        from ..report.manifest import settle
+
+        removed = settle(out, written, "pcbdyn build")
+        if removed:
+            click.echo(f"removed {len(removed)} file(s) an earlier run wrote to {out}/ and this one did not", err=True)
         click.echo(f"results written to {out}/", err=True)

@@ -1,14 +1,16 @@
-"""The component library: one TOML file per part family in ``library/`` (size, mass, default model,
-equivalent thickness and where those numbers come from).
+"""The component library: one TOML file per part family (size, mass, default model, equivalent
+thickness and where those numbers come from).
 
 A board looks for a family first in a ``library/`` folder next to its board.toml, then in the
-project's top-level ``library/`` (or the folders named in the PCBDYN_LIBRARY path variable).
+folders named in the PCBDYN_LIBRARY path variable (``os.pathsep``-separated), then in the library
+shipped inside the package (``pcbdyn/library/``, package data, so a plain ``pip install`` has it).
 """
 
 from __future__ import annotations
 
 import os
 from dataclasses import dataclass
+from importlib import resources
 from pathlib import Path
 
 from ..inputs import read_toml
@@ -45,8 +47,13 @@ def search_path(board_dir: Path | None = None) -> list[Path]:
     env = os.environ.get("PCBDYN_LIBRARY")
     if env:
         dirs.extend(Path(p) for p in env.split(os.pathsep) if p)
-    dirs.append(Path(__file__).resolve().parents[2] / "library")
+    dirs.append(shipped_library())
     return dirs
+
+
+def shipped_library() -> Path:
+    """The folder of part families installed with pcbdyn (package data)."""
+    return Path(str(resources.files("pcbdyn") / "library"))
 
 
 def available(board_dir: Path | None = None) -> list[str]:

@@ -15,7 +15,7 @@ import re
 import numpy as np
 
 from .data import Dofs, Modes, Points, TestDataError
-from .uff import _atomic
+from .uff_write import _atomic
 
 _LENGTH = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "um": 1e-6, "in": 0.0254}
 _HEAD = re.compile(r"^\s*([A-Za-z][A-Za-z0-9 ]*?)\s*(?:[\[(]\s*([^\])]*)\s*[\])]|_(mm|cm|m|um|in))?\s*$")

@@ -1,21 +1,21 @@
 """Universal File Format (UFF/UNV) in and out: points (15, 2411), modes (55), FRFs (58, 58b), units (164).
 
-pyuff splits the file into datasets and reads 15, 2411, 58b, 164 and the headers of 58. Values
-are taken here by pattern where pyuff cuts fixed columns: dataset 55 (pyuff reads 13-character
-fields only, so other widths or 'D' exponents are misread, and it writes single precision only)
-and ASCII 58 data (pyuff expects 13 or 20 characters per field: pyuff issue 52). The pattern
-accepts fields run together ("missing spaces", pyuff issue 84), any width and 'D' exponents; the
-record headers say how many values to expect. Also tolerated: 58 data padded past num_pts
-(pyuff issue 22), complex 55 written by pyuff with NDV = 6 for three complex values, 58b blocks
-whose trailing line break pyuff ignores. Any other defect raises :class:`TestDataError` naming
+Reading: pyuff finds the datasets (blocks between '    -1' lines) and reads the headers of 58 and
+the data of 58b. pyuff pairs the '-1' lines and drops an unpaired last one, so a file cut short is
+read as one dataset fewer without a word; the structure is checked here first (every block
+closed, nothing outside the blocks, a dataset number after each opening line). Values are taken
+here by pattern where pyuff cuts fixed columns or skips checks: 15, 2411 and 164 (pyuff splits on
+blanks and misaligns a record that is cut short), dataset 55 (pyuff reads 13-character fields only,
+so other widths or 'D' exponents are misread) and ASCII 58 data (pyuff expects 13 or 20 characters
+per field: pyuff issue 52). The pattern accepts fields run together ("missing spaces", pyuff issue
+84), any width and 'D' exponents; every other character on a data line is an error, and the
+record headers say how many values to expect. Also tolerated: 58 data padded with zeros past
+num_pts (pyuff issue 22), complex 55 written by pyuff with NDV = 6 for three complex values, 58b
+blocks whose trailing line break pyuff ignores. Any defect raises :class:`TestDataError` naming
 the file, the dataset (1-based position and type) and, for 58b, the pyuff.fix_58b repair.
 
-Writing: dataset 55 in ``precision="double"`` (default) puts three E25.16 values per line (the
-double-precision layout of datasets 2411 and 164) so a round trip is exact to ~1e-16; pcbdyn and
-any reader that splits on blanks read it, but pyuff's own 55 reader does not: use
-``precision="single"`` (standard 6E13.5, ~6 significant digits) for such tools. Points go to 2411
-(double precision); FRFs to 58 in double precision, as binary 58b when asked, or when the
-frequency axis would not survive the ASCII header's 6 digits.
+Writing (:mod:`.uff_write`): the standard's fixed layouts; the precision each dataset keeps is
+listed there (2411, 164 and 58b exact; 58 ASCII 13 digits; 55 and 15 six digits).
 
 Units: a 164 dataset gives the file's length and force units; coordinates and FRFs are converted
 to SI (mode shapes keep their scaling: it is arbitrary anyway). Files are written in SI.
@@ -28,27 +28,33 @@ import re
 
 import numpy as np
 
-from ..atomic import atomic_path
 from .data import Dofs, FRFs, Modes, Points, TestData, TestDataError
+from .uff_write import write_uff
 
-_NUM = re.compile(rb"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[EeDd][-+]?\d+)?")
+_NUM = re.compile(rb"[-+]?(?:(?:\d+\.\d*|\.\d+|\d+)(?:[ED][-+]?\d+)?|nan|inf(?:inity)?)", re.IGNORECASE)
 _SPEC_KIND = {8: "receptance", 11: "mobility", 12: "accelerance"}
-_KIND_SPEC = {v: k for k, v in _SPEC_KIND.items()}
 _G = 9.80665
+_TAG = b"    -1"
 
 
-def _numbers(line: bytes) -> list:
+def _numbers(line: bytes, where: str) -> list:
+    """The numbers on one data line; any other character on it is an error naming ``where``."""
+    rest = _NUM.sub(b" ", line).strip()
+    if rest:
+        text = line.decode("latin-1").strip()[:60]
+        raise TestDataError(f"{where}: '{rest.decode('latin-1')[:20]}' is not a number (the line reads '{text}')")
     return [float(t.replace(b"D", b"E").replace(b"d", b"e")) for t in _NUM.findall(line)]
 
 
 class _Cursor:
-    """Reads the numbers of a text block record by record, across line breaks.
+    """Reads the numbers of a dataset's lines record by record, across line breaks.
 
     ``take(n, what, end=True)`` returns the next n numbers; with ``end`` the record must finish
-    there (no numbers left on its last line)."""
+    there (no numbers left on its last line). ``first`` is the 0-based line of ``lines[0]`` in the
+    dataset, for the messages."""
 
-    def __init__(self, lines):
-        self.lines = lines
+    def __init__(self, lines, first: int):
+        self.lines, self.first = lines, first
         self.i = 0
         self.buf = []
 
@@ -56,12 +62,55 @@ class _Cursor:
         while len(self.buf) < n:
             if self.i >= len(self.lines):
                 raise TestDataError(f"the dataset ends before {what} ({len(self.buf)} of {n} values found)")
-            self.buf.extend(_numbers(self.lines[self.i]))
+            self.buf.extend(_numbers(self.lines[self.i], f"{what}, line {self.first + self.i + 1} of the dataset"))
             self.i += 1
         out, self.buf = self.buf[:n], self.buf[n:]
         if end and self.buf:
-            raise TestDataError(f"{what}: expected {n} values, found {n + len(self.buf)} (line {self.i} of the data)")
+            raise TestDataError(f"{what}: expected {n} values, found {n + len(self.buf)} "
+                                f"(line {self.first + self.i} of the dataset)")
         return out
+
+
+# ---------------------------------------------------------------------------------------- structure
+
+
+def _blocks(uff, blob: bytes, path) -> list:
+    """[(type, start, end)] of the datasets pyuff found, once the file's structure is checked:
+    nothing outside the datasets, a dataset number after each opening '-1' line, and no dataset
+    left open at the end (pyuff silently drops an unclosed last dataset: a file cut short)."""
+    ind = [(int(a), int(b)) for a, b in uff._block_ind] if uff.get_n_sets() else []
+    types = [int(t) for t in uff.get_set_types()] if ind else []
+    pos = 0
+    for k, ((s, e), t) in enumerate(zip(ind, types)):
+        if k and blob[pos:s].strip():
+            raise TestDataError(f"{path}: text between datasets #{k} and #{k + 1} belongs to neither "
+                                f"({_show(blob[pos:s])}); a '    -1' line is missing or doubled there")
+        if t <= 0:
+            raise TestDataError(f"{path}: dataset #{k + 1} has no dataset number on the line after its opening "
+                                "'    -1' (a '    -1' line is missing or doubled before it)")
+        pos = e + 1 + len(_TAG)
+    rest = blob[pos:] if ind else blob[_first_tag(blob):]
+    head = rest.lstrip()
+    if head:
+        if head.startswith(b"-1") and head[2:3] in (b"", b" ", b"\r", b"\n"):
+            lines = head.splitlines()
+            t = lines[1][:6].strip().decode("latin-1") if len(lines) > 1 else "?"
+            raise TestDataError(f"{path}: dataset #{len(ind) + 1} (type {t}) is cut short: the file ends before its "
+                                "closing '    -1' line (truncated in copying or writing?); write or copy it again")
+        if ind:
+            raise TestDataError(f"{path}: text after the last dataset (#{len(ind)}) belongs to none "
+                                f"({_show(rest)}); remove it or restore its '    -1' lines")
+    return [(t, s, e) for (s, e), t in zip(ind, types)]
+
+
+def _first_tag(blob: bytes) -> int:
+    """Offset of the first line that is a '    -1' tag, or the end of the file."""
+    m = re.search(rb"(?m)^    -1[ \t]*\r?$", blob)
+    return m.start() if m else len(blob)
+
+
+def _show(text: bytes) -> str:
+    return repr(text.strip()[:40].decode("latin-1"))
 
 
 # ---------------------------------------------------------------------------------------- reading
@@ -72,14 +121,14 @@ def _parse55(raw: bytes) -> dict:
     lines = raw.splitlines()
     if len(lines) < 9:
         raise TestDataError("the dataset is shorter than its header (8 records)")
-    cur = _Cursor(lines[7:])
+    cur = _Cursor(lines[7:], 7)
     _, analysis, data_ch, spec, dtype, ndv = (int(v) for v in cur.take(6, "record 6"))
     nint, nrval = (int(v) for v in cur.take(2, "record 7", end=False))
     ints = [int(v) for v in cur.take(nint, "record 7")]
     reals = cur.take(nrval, "record 8")
     if dtype not in (2, 5):
         raise TestDataError(f"data type {dtype} is neither real (2) nor complex (5)")
-    nodes, vals = _node_records(lines[7 + cur.i :])
+    nodes, vals = _node_records(lines[7 + cur.i :], 7 + cur.i)
     per = {len(v) for v in vals}
     if len(per) > 1:
         raise TestDataError(f"nodes carry different numbers of values ({sorted(per)}); expected {ndv} each")
@@ -98,7 +147,7 @@ def _parse55(raw: bytes) -> dict:
 _INT_LINE = re.compile(rb"^\s*[-+]?\d+\s*$")
 
 
-def _node_records(lines):
+def _node_records(lines, first: int):
     """Node numbers and their values: a line holding one integer starts a node record (record 9);
     the numbers on the following lines, up to the next such line, are its values (record 10)."""
     nodes, vals = [], []
@@ -109,10 +158,48 @@ def _node_records(lines):
             nodes.append(int(line))
             vals.append([])
         elif not nodes:
-            raise TestDataError(f"values before the first node number (line {k + 1} of the node records)")
+            raise TestDataError(f"values before the first node number (line {first + k + 1} of the dataset)")
         else:
-            vals[-1].extend(_numbers(line))
+            vals[-1].extend(_numbers(line, f"node {nodes[-1]}, line {first + k + 1} of the dataset"))
     return nodes, vals
+
+
+_NODE_FIELDS = {4: "label, two coordinate systems, colour", 3: "x, y, z",
+                7: "label, two coordinate systems, colour, x, y, z"}
+
+
+def _parse_nodes(raw: bytes, t: int) -> dict:
+    """Dataset 2411 (4 integers on one line, x y z on the next, per node) or 15 (all 7 on one line)."""
+    shape = (4, 3) if t == 2411 else (7,)
+    rows, part = [], []
+    for k, line in enumerate(raw.splitlines()[2:], start=3):
+        if not line.strip():
+            continue
+        v = _numbers(line, f"line {k} of the dataset")
+        want = shape[len(part)]
+        if len(v) != want:
+            raise TestDataError(f"line {k} of the dataset has {len(v)} values; {want} expected ({_NODE_FIELDS[want]})")
+        part.append(v)
+        if len(part) == len(shape):
+            rows.append(sum(part, []))
+            part = []
+    if part:
+        raise TestDataError(f"node {int(part[0][0])} has no coordinates line (the dataset ends after its label line)")
+    v = np.array(rows, dtype=float).reshape(-1, 7)
+    return {"type": t, "node_nums": v[:, 0], "x": v[:, 4], "y": v[:, 5], "z": v[:, 6]}
+
+
+def _parse164(raw: bytes) -> dict:
+    """Dataset 164: units code (record 1) and the four factors to SI (record 2)."""
+    lines = raw.splitlines()
+    if len(lines) < 4:
+        raise TestDataError("the dataset is shorter than its two records")
+    try:
+        code = int(lines[2][:10])
+    except ValueError:
+        raise TestDataError(f"record 1 '{lines[2][:10].decode('latin-1')}' is not a units code") from None
+    f = _Cursor(lines[3:], 3).take(4, "record 2 (length, force, temperature, offset)")
+    return {"type": 164, "units_code": code, "length": f[0], "force": f[1], "temp": f[2], "temp_offset": f[3]}
 
 
 def _mode_from55(d: dict):
@@ -173,18 +260,18 @@ def read_uff(path, points: Points | None = None, frf_kind: str | None = None) ->
         uff = pyuff.UFF(path)
     except Exception as exc:
         raise TestDataError(f"{path}: not a readable UFF file ({exc})") from None
-    types = [int(t) for t in uff.get_set_types()]
-    if not types:
-        raise TestDataError(f"{path}: no UFF datasets found (each dataset is enclosed in '    -1' lines)")
     with open(path, "rb") as fh:
         blob = fh.read()
+    blocks = _blocks(uff, blob, path)
+    if not blocks:
+        raise TestDataError(f"{path}: no UFF datasets found (each dataset is enclosed in '    -1' lines)")
     dsets, skipped, modes55, frf58 = [], [], [], []
-    for k, t in enumerate(types):
+    for k, (t, s, e) in enumerate(blocks):
         where = f"{path}: dataset #{k + 1} (type {t})"
+        raw = blob[s : e + 1]
         try:
             if t == 55:
-                s, e = uff._block_ind[k]  # pyuff's block offsets; 55 is parsed here (see module doc)
-                m = _mode_from55(_parse55(blob[s : e + 1]))
+                m = _mode_from55(_parse55(raw))
                 if m is None:
                     skipped.append((k + 1, t, "not a mode (analysis type other than 2, 3, 7)"))
                 else:
@@ -193,13 +280,11 @@ def read_uff(path, points: Points | None = None, frf_kind: str | None = None) ->
             if t not in (15, 2411, 58, 164):
                 skipped.append((k + 1, t, "dataset type not used by pcbdyn"))
                 continue
-            d = _read_pyuff(uff, k, t, blob)
+            d = _parse_nodes(raw, t) if t in (15, 2411) else _parse164(raw) if t == 164 else _read58(uff, k, raw)
         except TestDataError as exc:
             raise TestDataError(f"{where}: {exc}") from None
         except Exception as exc:
-            hint = ""
-            if t == 58 and _is_binary(blob, uff._block_ind[k][0]):
-                hint = "; a binary 58b written by some tools needs pyuff.fix_58b(path) first"
+            hint = "; a binary 58b written by some tools needs pyuff.fix_58b(path) first" if _is_binary(raw) else ""
             raise TestDataError(f"{where} cannot be read: {exc}{hint}") from None
         dsets.append(d)
         if t == 58:
@@ -208,10 +293,8 @@ def read_uff(path, points: Points | None = None, frf_kind: str | None = None) ->
             else:
                 skipped.append((k + 1, t, f"function type {d.get('func_type')} is not an FRF (4)"))
     L, F = _units(dsets)
-    geo = _points(dsets, L)
-    if points is not None:
-        geo = points
     try:
+        geo = _points(dsets, L) if points is None else points
         modes = _assemble_modes(modes55, geo) if modes55 else None
         frfs = _assemble_frfs(frf58, geo, L, F, frf_kind) if frf58 else None
     except TestDataError as exc:
@@ -219,30 +302,33 @@ def read_uff(path, points: Points | None = None, frf_kind: str | None = None) ->
     return TestData(geo, modes, frfs, skipped)
 
 
-def _is_binary(blob: bytes, start: int) -> bool:
+def _is_binary(raw: bytes) -> bool:
     """A '58b' dataset: the type line (second line of the block) has 'b' after the number."""
-    lines = blob[start : start + 200].splitlines()
+    lines = raw[:200].splitlines()
     return len(lines) > 1 and lines[1][6:7].lower() == b"b"
 
 
-def _read_pyuff(uff, k, t, blob) -> dict:
-    """Dataset k through pyuff, except the values of an ASCII 58: pyuff cuts those into fixed
-    columns (13 or 20 characters), which silently misreads other widths (pyuff issue 52); they are
-    taken here by pattern, and only the num_pts announced are kept (padded files, pyuff issue 22)."""
-    s, e = uff._block_ind[k]
-    if t != 58 or _is_binary(blob, s):
-        return uff.read_sets(k)
+def _read58(uff, k, raw) -> dict:
+    """Dataset k: the header through pyuff, and the values of a 58b; the values of an ASCII 58 are
+    taken here by pattern (pyuff cuts them into 13 or 20 characters, which silently misreads other
+    widths: pyuff issue 52). Values past num_pts must be zeros (padding, pyuff issue 22)."""
+    if _is_binary(raw):
+        d = uff.read_sets(k)
+        n, got = int(d["num_pts"]), len(d["data"])
+        if got < n:
+            raise TestDataError(f"its binary data holds {got} values, record 7 announces {n}")
+        return d
     d = uff.read_sets(k, header_only=True)
     vals = []
-    for line in blob[s : e + 1].splitlines()[13:]:
-        vals.extend(_numbers(line))
+    for i, line in enumerate(raw.splitlines()[13:]):
+        vals.extend(_numbers(line, f"record 12, line {i + 14} of the dataset"))
     v = np.array(vals)
     n = int(d["num_pts"])
     complex_ = d["ord_data_type"] in (5, 6)
     even = d["abscissa_spacing"] == 1
     step = (2 if complex_ else 1) + (0 if even else 1)
-    if v.size < n * step:
-        raise TestDataError(f"{v.size} values found, {n * step} expected for {n} points")
+    if v.size < n * step or np.any(v[n * step :] != 0):
+        raise TestDataError(f"record 12 holds {v.size} values; record 7 announces {n} points, {n * step} values")
     v = v[: n * step].reshape(n, step)
     d["x"] = d["abscissa_min"] + np.arange(n) * d["abscissa_inc"] if even else v[:, 0]
     y = v[:, 0 if even else 1 :]
@@ -327,121 +413,6 @@ def _assemble_frfs(frf58, geo: Points, L, F, frf_kind) -> FRFs:
     rdofs = Dofs.from_codes([n for n, _ in resp], [c for _, c in resp])
     fdofs = Dofs.from_codes([n for n, _ in ref], [c for _, c in ref])
     return FRFs(geo, x0, H, kinds.pop(), rdofs, fdofs)
-
-
-# ---------------------------------------------------------------------------------------- writing
-
-
-def _atomic(path, write):
-    """Run ``write(tmp_path)`` then move the finished file onto ``path`` (nothing half-written)."""
-    with atomic_path(path) as tmp:
-        write(os.fspath(tmp))
-
-
-def _write55_double(fh, mode_n, freq, zeta, nodes, r):
-    fh.write("%6i\n%6i%74s\n" % (-1, 55, " "))
-    for line in ("pcbdyn measured mode", "NONE", "NONE", "NONE", f"mode {mode_n} frequency {freq:.10g} Hz"):
-        fh.write("%-80s\n" % line)
-    fh.write("%10i%10i%10i%10i%10i%10i\n" % (1, 2, 2, 8, 2, 3))
-    fh.write("%10i%10i%10i%10i\n" % (2, 4, 1, mode_n))
-    fh.write("%25.16E%25.16E%25.16E\n%25.16E\n" % (freq, 0.0, zeta, 0.0))
-    for node, v in zip(nodes, r):
-        fh.write("%10i\n%25.16E%25.16E%25.16E\n" % (node, v[0], v[1], v[2]))
-    fh.write("%6i\n" % -1)
-
-
-def _node_table(modes: Modes):
-    """Nodes and their (x, y, z) shape values (n_nodes, 3, n_modes) for dataset 55."""
-    codes = modes.dofs.codes()
-    nodes, row = np.unique(modes.dofs.point_ids, return_inverse=True)
-    key = row * 3 + np.abs(codes) - 1
-    if np.unique(key).size != key.size:
-        raise TestDataError("modes: a point has two DOFs along the same axis; UFF 55 holds one value per axis")
-    r = np.zeros((nodes.size * 3, modes.n_modes))
-    r[key] = modes.shapes * np.sign(codes)[:, None]
-    return nodes, r.reshape(nodes.size, 3, modes.n_modes)
-
-
-def _even_axis(x) -> bool:
-    """True when x is evenly spaced and its start and step survive the 58 header's E13.5 fields."""
-    if x.size < 2:
-        return False
-    x0, dx = x[0], x[1] - x[0]
-    exact = float("%13.5e" % x0) == x0 and float("%13.5e" % dx) == dx
-    return exact and np.allclose(x0 + np.arange(x.size) * dx, x, rtol=0, atol=1e-13 * np.abs(x).max())
-
-
-def write_uff(path, data: TestData, precision: str = "double", binary: bool | None = None) -> None:
-    """Write points (2411), units (164, SI), modes (55) and FRFs (58/58b) atomically to ``path``.
-
-    ``precision``: "double" or "single" for dataset 55 (see the module notes). ``binary``: write
-    FRFs as 58b; None chooses ASCII unless the frequency axis would lose digits in ASCII.
-    """
-    import pyuff
-
-    if precision not in ("double", "single"):
-        raise TestDataError(f"precision '{precision}' is not 'double' or 'single'")
-    dsets_head = [{"type": 164, "units_code": 1, "units_description": "SI", "temp_mode": 2,
-                   "length": 1.0, "force": 1.0, "temp": 1.0, "temp_offset": 273.15}]
-    pts = data.points
-    if len(pts):
-        n = len(pts)
-        dsets_head.append({"type": 2411, "node_nums": pts.ids, "def_cs": np.ones(n, int),
-                           "disp_cs": np.ones(n, int), "color": np.ones(n, int),
-                           "x": pts.xyz[:, 0], "y": pts.xyz[:, 1], "z": pts.xyz[:, 2]})
-    mode_sets = []
-    if data.modes is not None:
-        nodes, r = _node_table(data.modes)
-        for j in range(data.modes.n_modes):
-            mode_sets.append((j + 1, float(data.modes.frequencies[j]), float(data.modes.damping[j]), nodes, r[:, :, j]))
-    frf_sets = _frf_dsets(data.frfs, binary) if data.frfs is not None else []
-
-    def write(tmp):
-        uff = pyuff.UFF(tmp)
-        uff.write_sets(dsets_head, mode="overwrite")
-        if precision == "double":
-            with open(tmp, "a") as fh:
-                for m in mode_sets:
-                    _write55_double(fh, *m)
-        elif mode_sets:
-            uff.write_sets([_dset55(*m) for m in mode_sets], mode="add")
-        if frf_sets:
-            uff.write_sets(frf_sets, mode="add")
-
-    _atomic(path, write)
-
-
-def _dset55(mode_n, freq, zeta, nodes, r) -> dict:
-    return {"type": 55, "analysis_type": 2, "data_ch": 2, "spec_data_type": 8, "model_type": 1,
-            "id1": "pcbdyn measured mode", "id5": f"mode {mode_n}", "load_case": 1, "mode_n": mode_n,
-            "freq": freq, "modal_m": 0.0, "modal_damp_vis": zeta, "modal_damp_his": 0.0,
-            "node_nums": nodes, "r1": r[:, 0], "r2": r[:, 1], "r3": r[:, 2]}
-
-
-def _frf_dsets(frfs: FRFs, binary) -> list:
-    x = frfs.frequencies
-    even = _even_axis(x)
-    if binary is None:
-        binary = not even
-    rc, fc = frfs.response.codes(), frfs.reference.codes()
-    out = []
-    for i in range(len(frfs.response)):
-        for j in range(len(frfs.reference)):
-            y = frfs.H[:, i, j]
-            if np.all(np.isnan(y)):
-                continue
-            out.append({
-                "type": 58, "binary": int(binary), "func_type": 4, "id1": f"pcbdyn FRF ({frfs.kind})",
-                "rsp_node": int(frfs.response.point_ids[i]), "rsp_dir": int(rc[i]), "rsp_ent_name": "pcbdyn",
-                "ref_node": int(frfs.reference.point_ids[j]), "ref_dir": int(fc[j]), "ref_ent_name": "pcbdyn",
-                "x": x, "data": y.astype(complex), "abscissa_spacing": int(even),
-                "abscissa_spec_data_type": 18, "abscissa_axis_lab": "Frequency", "abscissa_axis_units_lab": "Hz",
-                "ordinate_spec_data_type": _KIND_SPEC[frfs.kind], "ordinate_len_unit_exp": 1,
-                "ordinate_axis_lab": frfs.kind, "ordinate_axis_units_lab": frfs.units.split("/N")[0],
-                "orddenom_spec_data_type": 13, "orddenom_force_unit_exp": 1,
-                "orddenom_axis_lab": "Force", "orddenom_axis_units_lab": "N",
-            })
-    return out
 
 
 __all__ = ["read_uff", "write_uff", "real_modes"]

@@ -61,3 +61,37 @@ def test_bad_board_exits_with_the_message(tmp_path):
     res = CliRunner().invoke(main, ["build", str(board)])
     assert res.exit_code == 2
     assert "board.toml: fixtures[2].edge: 'y=5 mm' is not an edge" in res.output
+
+
+def test_a_smaller_rerun_leaves_no_stale_files_and_keeps_the_users(tmp_path, monkeypatch):
+    """--all-configs with 4 modes, then --config loaded with 2: the base model's files and the
+    pictures of modes 3-4 go (the folder's manifest lists what the earlier run wrote); the user's
+    files in the folder stay. The pictures get the configuration's title and outlines."""
+    import pcbdyn.report.pictures as pictures
+
+    calls = []
+    real = pictures.mode_pictures
+    monkeypatch.setattr(pictures, "_render_child", lambda *args: False)  # matplotlib 3-D views: quicker
+    monkeypatch.setattr(pictures, "mode_pictures", lambda *a, **k: calls.append(k) or real(*a, **k))
+    board = write_board(tmp_path, PLATE)
+    out = tmp_path / "out"
+    res = CliRunner().invoke(main, ["build", str(board), "--all-configs", "--out", str(out)])
+    assert res.exit_code == 0, res.output
+
+    def files():
+        return sorted(p.relative_to(out).as_posix() for p in out.rglob("*") if p.is_file())
+
+    assert [f for f in files() if f.startswith("png/")] == [f"png/modes_{c}_{k}.png" for c in ("base", "loaded")
+                                                            for k in ("01", "02", "03", "04")]
+    assert [c["title"] for c in calls] == ["simply supported plate [base]", "simply supported plate [loaded]"]
+    kinds = [[o["kind"] for o in c["outlines"]] for c in calls]
+    assert kinds[0].count("fixture") == 4 and "mass" not in kinds[0]
+    assert [o["label"] for o in calls[1]["outlines"] if o["kind"] == "mass"] == ["m1 (loaded)"]
+    (out / "notes.txt").write_text("mine")
+    (out / "png" / "sketch.png").write_bytes(b"mine")
+    board.write_text(board.read_text().replace("modes = 4", "modes = 2"))
+    res = CliRunner().invoke(main, ["build", str(board), "--config", "loaded", "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    assert files() == ["modes_loaded.csv", "modes_loaded.vtu", "notes.txt", "pcbdyn-manifest.json",
+                       "png/modes_loaded_01.png", "png/modes_loaded_02.png", "png/sketch.png"]
+    assert "removed 8 file(s) an earlier run wrote" in res.output

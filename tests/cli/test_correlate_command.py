@@ -68,7 +68,8 @@ def test_noise_free_simulation_is_the_model_and_its_frf_peaks_at_the_modes(tmp_p
     assert res.exit_code == 0, res.output
     data = read_uff(tmp_path / "t.uff")
     modes = solve_modes(build_model(load_board(tmp_path / "board.toml")).model, n_modes=7)
-    np.testing.assert_allclose(data.modes.frequencies, modes.frequencies, rtol=1e-9)
+    # UFF 55 holds frequencies in E13.5: six significant digits
+    np.testing.assert_allclose(data.modes.frequencies, modes.frequencies, rtol=5e-6)
     H = np.abs(data.frfs.H[:, :, 0])
     drive = int(np.flatnonzero(data.frfs.response.point_ids == data.frfs.reference.point_ids[0])[0])
     f = data.frfs.frequencies
@@ -127,10 +128,10 @@ def test_thicker_part_gives_the_pair_table_physics_predicts(thick):
     pairs = data["pairs"]
     assert [p["test_mode"] for p in pairs] == list(range(1, 8))
     assert [p["model_mode"] for p in pairs] == list(j + 1)
-    np.testing.assert_allclose([p["f_test_hz"] for p in pairs], mt.frequencies, rtol=1e-9)
+    np.testing.assert_allclose([p["f_test_hz"] for p in pairs], mt.frequencies, rtol=5e-6)  # UFF 55: E13.5
     np.testing.assert_allclose([p["f_model_hz"] for p in pairs], ma.frequencies[j], rtol=1e-6)
     df = np.array([p["df_pct"] for p in pairs])
-    np.testing.assert_allclose(df, 100 * (ma.frequencies[j] - mt.frequencies) / mt.frequencies, atol=1e-6)
+    np.testing.assert_allclose(df, 100 * (ma.frequencies[j] - mt.frequencies) / mt.frequencies, atol=1e-3)
     assert all(p["mac"] > 0.8 for p in pairs)  # the stiffer corner changes the shapes a little
     # a thicker part of the same mass is stiffer: every true frequency is above the model's (df < 0)
     assert np.all(df < 0)
@@ -236,7 +237,8 @@ def test_config_adds_mass_and_lowers_every_frequency(card, tmp_path):
     # one (Rayleigh/min-max); the heavy corner mass also mixes shapes, so pairs need not keep the order
     f_loaded = np.sort(base["test_frequencies_hz"])
     assert np.all(f_loaded < np.array(base["model_frequencies_hz"][: f_loaded.size]))
-    assert len(same) == 7 and all(abs(p["df_pct"]) < 1e-6 and p["mac"] > 1 - 1e-9 for p in same)
+    # the same model up to what UFF 55 keeps (six significant digits)
+    assert len(same) == 7 and all(abs(p["df_pct"]) < 1e-3 and p["mac"] > 1 - 1e-9 for p in same)
 
 
 def test_unknown_configuration_is_named(card):
