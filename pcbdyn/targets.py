@@ -21,6 +21,7 @@ from typing import Callable
 import tomlkit
 
 from .domain import StructureError
+from .inputs import Reader
 from .units import UnitError, from_si, registry, to_si
 
 
@@ -104,20 +105,18 @@ def known(collections=None) -> str:
 
 
 def parse(text, collections=None) -> Target:
-    """``text`` as a :class:`Target` of one of ``collections`` (default: any); TargetError otherwise."""
+    """``text`` as a :class:`Target` of one of ``collections`` (default: any); TargetError otherwise,
+    naming the target kinds there are."""
     parts = str(text).split(".")
+    patterns = [k.pattern for k in KINDS.values() if collections is None or k.collection in collections]
     table = len(parts) == 2 and parts[0] in TABLES
-    if not (table or (len(parts) == 3 and parts[0] not in TABLES)) or not all(parts):
-        raise TargetError(f"'{text}' is not a target; write <collection>.<name>.<attribute> or board.<attribute>, "
-                          f"e.g. {known(collections).split(', ')[0]}")
-    coll, attr = parts[0], parts[-1]
-    if (coll, attr) not in KINDS or (collections is not None and coll not in collections):
-        pats = [k.pattern for k in KINDS.values() if collections is None or k.collection in collections]
-        close = difflib.get_close_matches(f"{coll}.{attr}", [p.replace(".<name>", "").replace(".<ref>", "")
-                                                             for p in pats], n=1)
-        hint = f"did you mean {close[0]}?" if close else f"targets are {', '.join(pats)}"
-        raise TargetError(f"'{text}' is not a target kind of this structure; {hint}")
-    return Target(coll, None if table else parts[1], attr)
+    if table or (len(parts) == 3 and parts[0] not in TABLES and all(parts)):
+        if (parts[0], parts[-1]) in KINDS and (collections is None or parts[0] in collections):
+            return Target(parts[0], None if table else parts[1], parts[-1])
+    close = difflib.get_close_matches(f"{parts[0]}.{parts[-1]}", [p.replace(".<name>", "").replace(".<ref>", "")
+                                                                  for p in patterns], n=1)
+    hint = f"did you mean {close[0]}? " if close else ""
+    raise TargetError(f"'{text}' is not a target of this structure; {hint}targets are {', '.join(patterns)}")
 
 
 def entry_name(collection: str, entry: dict, index: int) -> str:
@@ -159,14 +158,7 @@ def parameter_spec(entry: dict, where: str, value: Callable, file: str, collecti
     def fail(field, msg):
         raise TargetError(f"{file}: {where}{'.' + field if field else ''}: {msg}")
 
-    if not isinstance(entry, dict):
-        fail("", "must be a table with name, target and bounds")
-    for key in entry:
-        if key not in ("name", "target", "bounds"):
-            fail(key, "unknown field; a parameter has name, target and bounds")
-    for key in ("name", "target", "bounds"):
-        if key not in entry:
-            fail(key, f"missing; add {key} = ...")
+    Reader(file, TargetError).table(entry, where, ["name", "target", "bounds"], required=["name", "target", "bounds"])
     raw = entry["target"] if isinstance(entry["target"], list) else [entry["target"]]
     if not raw:
         fail("target", "is empty; give one target or a list of targets that share the value")
@@ -178,8 +170,8 @@ def parameter_spec(entry: dict, where: str, value: Callable, file: str, collecti
             fail("target", str(exc))
         v = value(str(tg))
         if v is None:
-            fail("target", f"'{t}' is not a quantity of this structure; use one of {known(collections)} "
-                           f"({'; '.join(k.pattern + ': ' + k.what for k in KINDS.values() if collections is None or k.collection in collections)})")
+            fail("target", f"'{t}' is not a quantity of this structure ({tg.kind.pattern}: {tg.kind.what}); targets are "
+                           f"{known(collections)}")
         values.append(float(v))
         kinds.append(tg.kind)
     units = sorted({k.unit for k in kinds})

@@ -7,7 +7,7 @@ import pytest
 from board_helpers import EXAMPLES
 
 from pcbdyn.board import load_board
-from pcbdyn.commands.common import PROBE_TOL, points_on_board
+from pcbdyn.commands.common import PROBE_TOL
 from pcbdyn.testdata import read_points_csv
 
 BOARDS = sorted(EXAMPLES.glob("*/board.toml"))
@@ -26,6 +26,6 @@ def test_each_example_has_points_on_its_board(board_toml):
     board = load_board(board_toml)
     points, dofs = read_points_csv(csv)
     assert len(points) >= 20 and np.all(np.abs(dofs.directions[:, 2]) == 1.0)
-    points_on_board(board, points, csv.name, board_toml)  # raises naming any point off the board
+    board.check_points(points, csv.name)  # raises naming any point off the board
     assert board.outline.contains(points.xyz[:, :2]).all()
     assert np.all(np.abs(points.xyz[:, 2]) <= PROBE_TOL)
