@@ -80,11 +80,10 @@ def _neighbours(phi) -> np.ndarray:
     return out
 
 
-def identify(frfs, band=None, max_order: int = 40, select=None, progress=None) -> Identification:
+def identify(frfs, band=None, max_order: int = 40, select=None) -> Identification:
     """Modes of ``frfs`` (:class:`pcbdyn.testdata.FRFs`) in ``band`` (lo, hi) [Hz] (default: the
     FRF axis above 0 Hz), from model orders up to 2 ``max_order`` (capped at a quarter of the
-    band's lines); ``select``: frequencies [Hz] to pick poles near instead of the automatic choice.
-    ``progress(k, n)`` is called per model order."""
+    band's lines); ``select``: frequencies [Hz] to pick poles near instead of the automatic choice."""
     f_all = frfs.frequencies
     if band is None:
         band = (float(f_all[f_all > 0].min()), float(f_all.max()))
@@ -95,7 +94,7 @@ def identify(frfs, band=None, max_order: int = 40, select=None, progress=None) -
     f, rows, pairs = lscf.band_rows(frfs, band)
     order = int(max(2, min(max_order, f.size // 4)))
     all_poles = lscf.poles_by_order(f, rows, frfs.kind, order)
-    c = stability.chart(all_poles, f, rows, frfs.kind, band, progress)
+    c = stability.chart(all_poles, f, rows, frfs.kind, band)
     chosen = stability.auto_select(c) if select is None else stability.pick(c, select)
     poles = c.pole[chosen]
     A = lscf.residues(poles, f, rows, frfs.kind)

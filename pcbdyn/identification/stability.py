@@ -61,9 +61,9 @@ def _status(p, A, prev_p, prev_A) -> str:
     return "s" if damp and shape else "d" if damp else "v" if shape else "f"
 
 
-def chart(all_poles, f, rows, kind, band, progress=None) -> Chart:
+def chart(all_poles, f, rows, kind, band) -> Chart:
     """The chart of the LSCF poles of every order (``all_poles[k]`` at order 2 (k + 1)), with the
-    residues of each order's physical poles for the shape test. ``progress(k, n)``: called per order."""
+    residues of each order's physical poles for the shape test."""
     out = ([], [], [])
     prev_p = prev_A = None
     for k, raw in enumerate(all_poles):
@@ -74,8 +74,6 @@ def chart(all_poles, f, rows, kind, band, progress=None) -> Chart:
             out[1].append(pole)
             out[2].append(_status(pole, A[:, i], prev_p, prev_A))
         prev_p, prev_A = p, A
-        if progress is not None:
-            progress(k + 1, len(all_poles))
     poles = np.array(out[1], dtype=complex)
     return Chart(np.array(out[0], dtype=int), poles, np.abs(poles) / (2.0 * np.pi),
                  -poles.real / np.maximum(np.abs(poles), 1e-300), np.array(out[2], dtype="<U1"))

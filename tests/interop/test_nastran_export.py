@@ -33,7 +33,7 @@ def z_mass(model) -> float:
     return float(r @ (M @ r))
 
 
-def expected_counts(model, fixed_free_mpcs=True) -> dict:
+def expected_counts(model) -> dict:
     """Cards the writer's mapping implies, counted from the model's own sets and constraints."""
     n = {"GRID": model.n_nodes, "CQUAD4": 0, "CTRIA3": 0, "CONM2": 0, "CELAS2": 0, "CBAR": 0, "CBUSH": 0, "MPC": 0}
     fixed = set(model.fixed)
