@@ -2,7 +2,8 @@
 
 import click
 
-from .commands import build, correlate, diagnose, localize, simulate_test, study, update
+from .commands import (build, correlate, diagnose, export, identify, import_kicad, localize, simulate_test, study,
+                       update)
 
 
 @click.group()
@@ -12,5 +13,5 @@ def main():
     tests, update them and find what they lack."""
 
 
-for _module in (build, simulate_test, correlate, update, localize, study, diagnose):
+for _module in (build, simulate_test, correlate, update, localize, study, diagnose, identify, import_kicad, export):
     main.add_command(_module.command)

@@ -17,3 +17,9 @@ if [ ! -x "$here/.venv/bin/python" ]; then
 fi
 "$here/.venv/bin/python" -m pip install -q --upgrade pip
 "$here/.venv/bin/python" -m pip install -q -e "$here[test]"
+# pyNastran (reads the exported Nastran decks back in the tests) pins numpy<2, which the main
+# environment cannot share: it gets a virtual environment of its own.
+if [ ! -x "$here/.venv-nastran/bin/python" ]; then
+  python3 -m venv "$here/.venv-nastran"
+fi
+"$here/.venv-nastran/bin/python" -m pip install -q "numpy<2" "pyNastran==1.4.1"

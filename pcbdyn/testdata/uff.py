@@ -399,6 +399,9 @@ def _assemble_frfs(frf58, geo: Points, L, F, frf_kind) -> FRFs:
             raise TestDataError(f"dataset #{k}: its frequency axis differs from the first FRF's; resample to one axis")
         rk = (int(d["rsp_node"]), int(d["rsp_dir"]))
         fk = (int(d["ref_node"]), int(d["ref_dir"]))
+        if fk[1] == 0:
+            raise TestDataError(f"dataset #{k}: the FRF names no reference (excitation) DOF (node {fk[0]}, direction "
+                                "0); write each FRF with the node and direction it was excited at (record 6)")
         resp.setdefault(rk, len(resp))
         ref.setdefault(fk, len(ref))
         entries.append((resp[rk], ref[fk], y))

@@ -5,7 +5,7 @@ import numpy as np
 from ..model import ModelError
 
 
-def _spring_stiffness(k) -> np.ndarray:
+def spring_stiffness(k) -> np.ndarray:
     """The 6x6 spring matrix from six diagonal values or a full symmetric 6x6 (coupled terms)."""
     k = np.asarray(k, dtype=float)
     if k.shape == (6,):
@@ -18,12 +18,32 @@ def _spring_stiffness(k) -> np.ndarray:
 def spring_matrices(xyz: np.ndarray, prop):
     """Springs in global axes; 1-node cells tie to ground, 2-node cells tie the nodes together."""
     n_cells, nn, _ = xyz.shape
-    k = _spring_stiffness(prop.k)
+    k = spring_stiffness(prop.k)
     if nn == 1:
         Ke = np.broadcast_to(k, (n_cells, 6, 6)).copy()
     else:
         Ke = np.broadcast_to(np.block([[k, -k], [-k, k]]), (n_cells, 12, 12)).copy()
     return Ke, np.zeros_like(Ke)
+
+
+def rigid_fit(xyz: np.ndarray, prop):
+    """Where the body of a footprint mass sits and how it moves: the first sample point of each
+    cell (n_cells, 3) and G (n_cells, 6, 3 nn), the least-squares rigid motion (u_b, theta_b) of
+    the sample points' translations per unit translation of the cell's nodes (see
+    :func:`mass_matrices`)."""
+    n_cells, nn, _ = xyz.shape
+    W = np.eye(nn) if prop.footprint is None else np.asarray(prop.footprint, float)
+    if W.ndim != 2 or W.shape[1] != nn:
+        raise ModelError(f"MassProperty.footprint must be (n_samples, {nn}) weights of the cell's nodes, got {W.shape}")
+    ns = W.shape[0]
+    samples = np.einsum("sn,cnk->csk", W, xyz)
+    r = samples - samples[:, :1, :]
+    A = np.zeros((n_cells, ns, 3, 6))
+    A[:, :, :, :3] = np.eye(3)
+    A[:, :, 0, 4], A[:, :, 0, 5] = r[..., 2], -r[..., 1]  # u = u_b + theta_y z - theta_z y
+    A[:, :, 1, 3], A[:, :, 1, 5] = -r[..., 2], r[..., 0]  # v = v_b - theta_x z + theta_z x
+    A[:, :, 2, 3], A[:, :, 2, 4] = r[..., 1], -r[..., 0]  # w = w_b + theta_x y - theta_y x
+    return samples[:, 0, :], np.linalg.pinv(A.reshape(n_cells, 3 * ns, 6)) @ np.kron(W, np.eye(3))
 
 
 def mass_matrices(xyz: np.ndarray, prop):
@@ -44,18 +64,7 @@ def mass_matrices(xyz: np.ndarray, prop):
     if nn == 1:
         Me = np.broadcast_to(Mb, (n_cells, 6, 6)).copy()
         return np.zeros_like(Me), Me
-    W = np.eye(nn) if prop.footprint is None else np.asarray(prop.footprint, float)
-    if W.ndim != 2 or W.shape[1] != nn:
-        raise ModelError(f"MassProperty.footprint must be (n_samples, {nn}) weights of the cell's nodes, got {W.shape}")
-    ns = W.shape[0]
-    samples = np.einsum("sn,cnk->csk", W, xyz)
-    r = samples - samples[:, :1, :]
-    A = np.zeros((n_cells, ns, 3, 6))
-    A[:, :, :, :3] = np.eye(3)
-    A[:, :, 0, 4], A[:, :, 0, 5] = r[..., 2], -r[..., 1]  # u = u_b + theta_y z - theta_z y
-    A[:, :, 1, 3], A[:, :, 1, 5] = -r[..., 2], r[..., 0]  # v = v_b - theta_x z + theta_z x
-    A[:, :, 2, 3], A[:, :, 2, 4] = r[..., 1], -r[..., 0]  # w = w_b + theta_x y - theta_y x
-    G = np.linalg.pinv(A.reshape(n_cells, 3 * ns, 6)) @ np.kron(W, np.eye(3))  # (n_cells, 6, 3 nn)
+    _, G = rigid_fit(xyz, prop)
     Mt = np.einsum("cai,ab,cbj->cij", G, Mb, G)
     Me = np.zeros((n_cells, nn, 6, nn, 6))
     Me[:, :, :3, :, :3] = Mt.reshape(n_cells, nn, 3, nn, 3)
