@@ -2,7 +2,7 @@
 
 import click
 
-from .commands import build, correlate, diagnose, localize, simulate_test, study, update
+from .commands import build, correlate, diagnose, localize, simulate_test, study, update, vibe
 
 
 @click.group()
@@ -12,5 +12,5 @@ def main():
     tests, update them and find what they lack."""
 
 
-for _module in (build, simulate_test, correlate, update, localize, study, diagnose):
+for _module in (build, simulate_test, correlate, update, localize, study, diagnose, vibe):
     main.add_command(_module.command)
