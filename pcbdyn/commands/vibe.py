@@ -8,7 +8,7 @@ from pathlib import Path
 
 import click
 
-from .common import done, fail, solve_board, step
+from .common import PROBE_TOL, done, fail, solve_board, step
 
 #: at most this many modes are computed (all of them up to twice the top input frequency otherwise)
 MAX_MODES = 150
@@ -63,7 +63,7 @@ def command(board_toml, psd_text, sine_csv, sweep_rate, sweeps, damping_text, du
         bm, modes, K, M = solve_board(board, config, n_modes=MAX_MODES, f_max=analysis_band(psd, sine))
         t0 = step(f"random response of {len(parts)} part(s) to {psd.name} along {axis}")
         a = assess(board, bm, modes, K, M, psd, damping, axis=axis, duration=seconds, sine=sine, chassis_hz=chassis,
-                   parts=parts)
+                   parts=parts, probe_tol=PROBE_TOL)
         done(t0)
     except (BoardError, ModelError, TestDataError, UnitError, VibrationError) as exc:
         fail(str(exc))

@@ -149,14 +149,16 @@ def _sine(be: BaseExcitation, sine: SineSweep, B: np.ndarray, parts, results) ->
 
 
 def assess(board, bm, modes, K, M, psd: Psd, damping: Damping, *, axis: str = "z", duration: float | None = None,
-           sine: SineSweep | None = None, chassis_hz: float | None = None, parts=None) -> Assessment:
+           sine: SineSweep | None = None, chassis_hz: float | None = None, parts=None,
+           probe_tol: float | None = None) -> Assessment:
     """Judge the solved board model ``bm`` (``modes``, assembled ``K``, ``M``) under ``psd`` along
     ``axis``: RMS responses, Steinberg's check and life of every part (worst margin first), Miner
     damage over ``duration`` [s] and of ``sine``, and the octave rule against ``chassis_hz``.
-    ``parts``: the :func:`~.parts.judged_parts` to judge (default: all of the board's)."""
+    ``parts``: the :func:`~.parts.judged_parts` to judge (default: all of the board's);
+    ``probe_tol`` [m]: how far off the board a test point of a UFF damping file may lie."""
     parts = judged_parts(board) if parts is None else parts
     model = bm.model
-    zeta, source = modal_damping(damping, model, modes)
+    zeta, source = modal_damping(damping, model, modes, probe_tol)
     be = base_excitation(model, modes, K, M, zeta, axis)
     grid = frequency_grid(psd.f[0], psd.f[-1], be.frequencies, be.zeta)
     C0, C2 = be.covariance(psd, grid), be.covariance(psd, grid, moment=2)

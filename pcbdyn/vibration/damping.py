@@ -4,7 +4,7 @@ printed circuit boards), a ratio or a Q for every mode, or the ratios identified
 
 Viscous modal damping: zeta = 1 / (2 Q). Steinberg's Q = sqrt(f_n) is his rule of thumb for
 plug-in boards at resonance (D. S. Steinberg, Vibration Analysis for Electronic Equipment, 3rd ed.,
-Wiley 2000, chapters 8 and 9); model modes with no test partner keep it.
+Wiley 2000, eqs. 8.10 and 9.52); model modes with no test partner keep it.
 """
 
 from __future__ import annotations
@@ -62,7 +62,8 @@ def steinberg_zeta(freqs) -> np.ndarray:
 
 
 def modal_damping(damping: Damping, model, modes, tol: float | None = None) -> tuple:
-    """(zeta per elastic mode, where each came from) for the model ``modes``.
+    """(zeta per elastic mode, where each came from) for the model ``modes``; ``tol`` [m]: how far
+    off the shells a test point may lie (default: :func:`pcbdyn.fe.probe.locate`'s).
 
     With a UFF file, the test modes are paired with the model modes by MAC (read through the shell
     shape functions at the test points, :func:`pcbdyn.correlation.correlate`); each paired model

@@ -20,7 +20,7 @@ from ..units import UnitError, to_si
 
 #: standard gravity [m/s^2]: the "g" of vibration specifications
 G = 9.80665
-_GEVS = ("NASA GSFC-STD-7000 (GEVS), section 2.4.2.5: generalized random vibration test levels for components "
+_GEVS = ("NASA GSFC-STD-7000 (GEVS), component random vibration: the generalized test levels for components "
          "of 22.7 kg or less")
 #: bundled input PSDs: name -> (breakpoints [(Hz, g^2/Hz)], source, duration per axis [s], overall grms stated)
 NAMED_PSDS = {
@@ -29,8 +29,8 @@ NAMED_PSDS = {
     "gevs-accept": ([(20, 0.013), (50, 0.08), (800, 0.08), (2000, 0.013)],
                     f"{_GEVS}, acceptance (10.0 grms, 1 min per axis)", 60.0, 10.0),
     "gevs-workmanship": ([(20, 0.01), (80, 0.04), (500, 0.04), (2000, 0.01)],
-                         "NASA GSFC-STD-7000 (GEVS), section 2.4.2.5: minimum workmanship random vibration level for "
-                         "components (6.8 grms, 1 min per axis)", 60.0, 6.8),
+                         "NASA GSFC-STD-7000 (GEVS), component random vibration: the minimum workmanship level "
+                         "(6.8 grms, 1 min per axis)", 60.0, 6.8),
 }
 _COLUMN = re.compile(r"^\s*([A-Za-z][A-Za-z0-9_ ]*?)\s*(?:\[\s*([^\]]*?)\s*\])?\s*$")
 
