@@ -46,7 +46,8 @@ def correlate_page(out: Path, board_toml, test_uff, board, label: str, pairing, 
     page.table("Mode pairs", pairs, note="df = (f_model - f_test) / f_test; pairs by MAC (thesis eq. 2.3)")
     lowest = sorted(comac.items(), key=lambda kv: kv[1])[:10]
     page.table("Lowest COMAC", pd.DataFrame([{"DOF": k, "COMAC": v} for k, v in lowest]),
-               note="COMAC per measured DOF over the pairs (thesis eq. 2.4); low values mark where test and model differ")
+               note="COMAC per measured DOF over the pairs (thesis eq. 2.4); low values mark where test and model "
+                    "differ")
     main = [n for n in ("mac_matrix.png", "frequencies.png", "comac.png") if n in written]
     page.pictures("MAC matrix, frequencies and COMAC", [out / n for n in main],
                   ["MAC matrix (pairs framed)", "model against test frequency", "COMAC per point"])

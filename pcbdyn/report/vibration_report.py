@@ -9,10 +9,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from ..vibration.spectra import G
 from .correlation_plots import _outline, _plt, _save, _shell_triangulation
 from .files import write_text
-
-G = 9.80665
 
 
 def parts_table(a) -> pd.DataFrame:
@@ -61,7 +60,8 @@ def summary_lines(a) -> list:
         lines.append(f"sine sweep: {a.sine.name}, {a.sine.rate:g} octave/min, {a.sine.sweeps} sweep(s)")
     if a.octave is not None:
         o = a.octave
-        lines.append(f"octave rule: board {o['board_hz']:.1f} Hz / chassis {o['chassis_hz']:.1f} Hz = {o['ratio']:.2f}: "
+        lines.append(f"octave rule: board {o['board_hz']:.1f} Hz / chassis {o['chassis_hz']:.1f} Hz = "
+                     f"{o['ratio']:.2f}: "
                      f"{'ok' if o['ok'] else 'FAILS'} ({o['rule']})")
     return lines + [f"note: {n}" for n in a.notes]
 
@@ -132,7 +132,8 @@ def html_page(out: Path, board_toml, board, a, inputs: dict) -> Path:
     failing = [p.ref for p in a.parts if not p.ok]
     verdict = f"{len(failing)} of {len(a.parts)} part(s) fail: {', '.join(failing)}" if failing else \
         f"all {len(a.parts)} part(s) pass Steinberg's criterion"
-    page = Page(f"pcbdyn vibe: {board.name}", subtitle=f"{a.psd.name}, {a.input_grms:.2f} grms along {a.axis}: {verdict}")
+    page = Page(f"pcbdyn vibe: {board.name}",
+                subtitle=f"{a.psd.name}, {a.input_grms:.2f} grms along {a.axis}: {verdict}")
     page.items("Inputs", {"board": describe_file(board_toml), **inputs})
     page.text("Summary", summary_lines(a))
     page.table("Parts, worst margin first", parts_table(a), status=["good" if p.ok else "bad" for p in a.parts],

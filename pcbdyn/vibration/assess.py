@@ -26,7 +26,7 @@ from . import steinberg
 from .base_excitation import AXES, BaseExcitation, base_excitation
 from .damping import Damping, modal_damping
 from .parts import judged_parts
-from .spectra import G, Psd, SineSweep, frequency_grid
+from .spectra import G, Psd, SineSweep, VibrationError, frequency_grid
 
 
 @dataclass
@@ -61,7 +61,7 @@ class PartResult:
         return self.ratio <= 1.0 and (self.damage or 0.0) < 1.0 and (self.sine_damage or 0.0) < 1.0
 
     def to_dict(self) -> dict:
-        d = {k: v for k, v in self.__dict__.items()}
+        d = dict(self.__dict__)
         d["margin"] = None if np.isinf(self.margin) else self.margin
         d["ok"] = self.ok
         return d
@@ -159,7 +159,10 @@ def assess(board, bm, modes, K, M, psd: Psd, damping: Damping, *, axis: str = "z
     parts = judged_parts(board) if parts is None else parts
     model = bm.model
     zeta, source = modal_damping(damping, model, modes, probe_tol)
-    be = base_excitation(model, modes, K, M, zeta, axis)
+    try:
+        be = base_excitation(model, modes, K, M, zeta, axis)
+    except VibrationError as exc:
+        raise VibrationError(f"{board.path.name}: {exc}") from None
     grid = frequency_grid(psd.f[0], psd.f[-1], be.frequencies, be.zeta)
     C0, C2 = be.covariance(psd, grid), be.covariance(psd, grid, moment=2)
     nodes = _shell_nodes(model)

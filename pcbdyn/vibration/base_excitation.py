@@ -3,8 +3,9 @@ modal superposition with modal damping and a static residual for the modes left 
 
 With every support moving rigidly by u_b along the unit rigid translation r, the motion relative
 to the supports, u = u_abs - r u_b, obeys M u'' + C u' + K u = -M r u_b'' (the springs to the
-base stretch only by u, since K r = 0): the thesis' eq. 3.27 with the inertial load -M r u_b''. With mass-normalised modes phi_r and participation
-factors Gamma_r = phi_r^T M r, per unit base acceleration at circular frequency w:
+base stretch only by u, since K r = 0): the thesis' eq. 3.27 with the inertial load -M r u_b''.
+With mass-normalised modes phi_r and participation factors Gamma_r = phi_r^T M r, per unit base
+acceleration at circular frequency w:
 
     u(w)     = -sum_r phi_r Gamma_r / (w_r^2 - w^2 + 2 i zeta_r w_r w)  -  R
     a_abs(w) = r - w^2 u(w)

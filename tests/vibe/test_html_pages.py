@@ -33,7 +33,8 @@ def run(*args):
 def browser():
     if not (CHROMIUM.is_file() and DRIVER.is_file()):
         pytest.skip("Debian's chromium and chromium-driver are not installed (scripts/setup.sh installs them)")
-    webdriver = pytest.importorskip("selenium.webdriver", reason="selenium is a test dependency (pip install -e .[test])")
+    webdriver = pytest.importorskip("selenium.webdriver",
+                                    reason="selenium is a test dependency (pip install -e .[test])")
     from selenium.webdriver.chrome.service import Service
 
     profile = tempfile.mkdtemp(prefix="pcbdyn-chromium-")

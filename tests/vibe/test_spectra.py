@@ -48,7 +48,8 @@ def test_csv_in_g_and_in_si_units_read_alike(tmp_path):
     ("frequency [Hz],psd\n20,0.01\n80,0.04\n", r"spec.csv: column 'psd' has no unit; write it as 'psd \[g\^2/Hz\]'"),
     ("frequency [Hz],psd [mm]\n20,0.01\n80,0.04\n", r"spec.csv: column 'psd \[mm\]'.*expected a unit like"),
     ("freq [Hz],psd [g^2/Hz]\n20,0.01\n80,0.04\n", r"no column 'frequency'"),
-    ("frequency [Hz],psd [g^2/Hz]\n20,0.01\n80,abc\n", r"data row 2: column 'psd \[g\^2/Hz\]' holds 'abc', not a number"),
+    ("frequency [Hz],psd [g^2/Hz]\n20,0.01\n80,abc\n",
+     r"data row 2: column 'psd \[g\^2/Hz\]' holds 'abc', not a number"),
     ("frequency [Hz],psd [g^2/Hz]\n20,0.01\n", r"at least two breakpoints"),
 ])
 def test_bad_psd_files_get_clear_errors(tmp_path, text, match):

@@ -133,7 +133,8 @@ def test_bad_input_gets_clear_errors(plate, tmp_path):
         bad(tmp_path, plate, "--psd", no_unit)
     assert "--damping 'zeta=2'" in bad(tmp_path, plate, "--psd", "gevs-qual", "--damping", "zeta=2")
     assert "--exclude U9: no such part" in bad(tmp_path, plate, "--psd", "gevs-qual", "--exclude", "U9")
-    assert "--duration: cannot read 'two minutes' as a quantity" in bad(tmp_path, plate, "--psd", "gevs-qual", "--duration", "two minutes")
+    assert "--duration: cannot read 'two minutes' as a quantity" in \
+        bad(tmp_path, plate, "--psd", "gevs-qual", "--duration", "two minutes")
 
 
 def test_a_part_without_a_package_constant_is_named(tmp_path):
@@ -151,7 +152,7 @@ def test_a_free_board_is_refused(tmp_path):
     free.write_text('[board]\nname = "free"\noutline = { width = "100 mm", height = "80 mm" }\nthickness = "1.6 mm"\n'
                     'material = { E = "22 GPa", nu = 0.15, rho = "1850 kg/m^3" }\nmesh_size = "20 mm"\n')
     msg = bad(tmp_path, free, "--psd", "gevs-qual")
-    assert "error: the model is free (no fixture holds it)" in msg and "[[fixtures]]" in msg
+    assert "error: free.toml: the model is free (no fixture holds it)" in msg and "[[fixtures]]" in msg
 
 
 def test_html_needs_out(plate, tmp_path):
