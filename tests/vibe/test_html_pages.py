@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from click.testing import CliRunner
-from conftest import write_plate
+from vibe_plates import write_plate
 
 from pcbdyn.cli import main
 from pcbdyn.report.html import Page

@@ -5,7 +5,7 @@ position factors and the curvature operator against the plate's sine shape."""
 import numpy as np
 import pytest
 import scipy.sparse as sp
-from conftest import A, B, navier, solve, write_plate
+from vibe_plates import A, B, navier, solve, write_plate
 from scipy.integrate import quad_vec
 
 from pcbdyn.fe.curvature import curvature_matrix

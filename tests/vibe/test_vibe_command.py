@@ -6,7 +6,7 @@ import json
 import numpy as np
 import pytest
 from click.testing import CliRunner
-from conftest import A, B, write_plate
+from vibe_plates import A, B, write_plate
 
 from pcbdyn.cli import main
 from pcbdyn.vibration.spectra import G
