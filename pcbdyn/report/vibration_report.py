@@ -110,8 +110,11 @@ def spectra_plot(path, a) -> None:
 
 
 def spectra_csv(a) -> str:
+    """Input PSD and, per part, the absolute acceleration and relative displacement PSDs."""
     cols = {"frequency [Hz]": a.grid, "input [g^2/Hz]": a.psd.at(a.grid) / G**2}
-    cols.update({f"{p.ref} acceleration [g^2/Hz]": a.part_accel_psd[:, j] / G**2 for j, p in enumerate(a.parts)})
+    for j, p in enumerate(a.parts):
+        cols[f"{p.ref} acceleration [g^2/Hz]"] = a.part_accel_psd[:, j] / G**2
+        cols[f"{p.ref} relative displacement [mm^2/Hz]"] = a.part_z_psd[:, j] * 1e6
     return pd.DataFrame(cols).to_csv(index=False, float_format="%.6g")
 
 

@@ -80,7 +80,8 @@ class Assessment:
     parts: list
     node_z_rms: np.ndarray  # (n_nodes,) RMS relative displacement normal to the board [m], NaN off the shells
     grid: np.ndarray
-    part_accel_psd: np.ndarray  # (n_grid, n_parts) [(m/s^2)^2/Hz]
+    part_accel_psd: np.ndarray  # (n_grid, n_parts) absolute acceleration [(m/s^2)^2/Hz]
+    part_z_psd: np.ndarray  # (n_grid, n_parts) relative displacement [m^2/Hz]
     octave: dict | None = None
     sine: SineSweep | None = None
     notes: list = field(default_factory=list)
@@ -173,7 +174,8 @@ def assess(board, bm, modes, K, M, psd: Psd, damping: Damping, *, axis: str = "z
     if be.frequencies[-1] < psd.f[-1]:
         notes.append(f"the modes found reach {be.frequencies[-1]:.0f} Hz, below the top of the spectrum "
                      f"({psd.f[-1]:.0f} Hz): the modes above respond statically only")
-    results, accel_psd = [], np.zeros((grid.size, len(parts)))
+    results = []
+    accel_psd, z_psd = np.zeros((grid.size, len(parts))), np.zeros((grid.size, len(parts)))
     if parts:
         centres = np.column_stack([np.array([p.at for p in parts]), np.zeros(len(parts))])
         Bz = be.columns(model_probe(model, centres).P)
@@ -183,7 +185,7 @@ def assess(board, bm, modes, K, M, psd: Psd, damping: Damping, *, axis: str = "z
         k_long, k_across = (np.sqrt(be.variance(be.columns(k), C0)) for k in _curvature_rows(model, parts))
         z_rms, m2 = np.sqrt(be.variance(Bz, C0)), be.variance(Bz, C2)
         a_rms = np.sqrt(be.variance(Ba, Ca))
-        accel_psd = be.response_psd(Ba, psd, grid, "acceleration")
+        accel_psd, z_psd = be.response_psd(Ba, psd, grid, "acceleration"), be.response_psd(Bz, psd, grid)
         h = board.thickness
         for j, p in enumerate(parts):
             z_allow = steinberg.allowable_displacement(p.span, p.length, h, p.c)
@@ -201,4 +203,4 @@ def assess(board, bm, modes, K, M, psd: Psd, damping: Damping, *, axis: str = "z
     order = np.argsort([r.margin for r in results], kind="stable")
     octave = None if chassis_hz is None else steinberg.octave_rule(float(be.frequencies[0]), chassis_hz)
     return Assessment(psd, damping, axis, duration, be, source, [results[i] for i in order],
-                      node_z, grid, accel_psd[:, order], octave, sine, notes)
+                      node_z, grid, accel_psd[:, order], z_psd[:, order], octave, sine, notes)

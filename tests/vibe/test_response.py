@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 from vibe_plates import A, B, navier, solve, write_plate
-from scipy.integrate import quad_vec
+from scipy.integrate import quad_vec, trapezoid
 
 from pcbdyn.fe.curvature import curvature_matrix
 from pcbdyn.fe.modal import reduced_system
@@ -35,6 +35,8 @@ def test_centre_of_a_simply_supported_plate_follows_miles(steinberg_plate):
     assert abs(centre.z_rms_m / miles - 1) < 0.005  # measured: -0.1 % (band 20-2000 Hz, other modes)
     assert centre.rate_hz == pytest.approx(modes.frequencies[0], rel=0.02)  # one mode: nu0 = f1
     assert a.z_peak_m == pytest.approx(centre.z_rms_m, rel=0.01)  # the centre moves most
+    j = a.parts.index(centre)  # the response PSDs are the parts' own, in the table's order
+    assert trapezoid(a.part_z_psd[:, j], a.grid) == pytest.approx(centre.z_rms_m**2, rel=1e-9)
 
 
 def test_position_factors_are_steinbergs_on_a_simply_supported_board(steinberg_plate):

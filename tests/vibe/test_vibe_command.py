@@ -62,6 +62,8 @@ def test_files_are_written(full_run):
     assert sorted(data["files"]) == sorted(p.name for p in out.iterdir())
     head = (out / "parts.csv").read_text().splitlines()[0]
     assert "z_rms [mm]" in head and "life [h]" in head and "sine damage" in head
+    spectra = (out / "response_psd.csv").read_text().splitlines()[0]
+    assert "U1 acceleration [g^2/Hz]" in spectra and "U1 relative displacement [mm^2/Hz]" in spectra
     assert not list(out.glob(".*"))  # nothing half-written left behind
 
 
