@@ -26,10 +26,11 @@ def build_page(out: Path, board_toml, board, results: list) -> Path:
         table = pd.DataFrame([{"mode": m["n"], "frequency [Hz]": m["frequency_hz"],
                                "eff. mass z [%]": 100.0 * m["eff_mass_z"], "shape": m["shape"]} for m in r["modes"]])
         page.table(f"Modes [{label}]", table)
-        pngs = sorted((out / "png").glob(f"modes_{label}_*.png"))
-        if pngs:
-            page.pictures(f"Mode shapes [{label}]", pngs,
-                          [f"mode {m['n']}: {m['frequency_hz']:.1f} Hz, {m['shape']}" for m in r["modes"]][:len(pngs)])
+        shown = [(out / "png" / f"modes_{label}_{m['n']:02d}.png", m) for m in r["modes"]]
+        shown = [(png, m) for png, m in shown if png.is_file()]  # none with --no-pictures
+        if shown:
+            page.pictures(f"Mode shapes [{label}]", [png for png, _ in shown],
+                          [f"mode {m['n']}: {m['frequency_hz']:.1f} Hz, {m['shape']}" for _, m in shown])
     return page.write(out / "report.html")
 
 
