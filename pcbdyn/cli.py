@@ -3,7 +3,7 @@
 import click
 
 from .commands import (build, correlate, diagnose, export, identify, import_kicad, localize, simulate_test, study,
-                       update)
+                       update, vibe)
 
 
 @click.group()
@@ -13,5 +13,6 @@ def main():
     tests, update them and find what they lack."""
 
 
-for _module in (build, simulate_test, correlate, update, localize, study, diagnose, identify, import_kicad, export):
+from .commands import (build, correlate, diagnose, export, identify, import_kicad, localize, simulate_test, study,
+                       update, vibe)
     main.add_command(_module.command)

@@ -6,7 +6,11 @@ stiffness is wanted is caught with a message that names the file, the field and 
 
 from __future__ import annotations
 
+import re
 from functools import lru_cache
+
+#: a standalone "g" or "G" in a unit: the acceleration of gravity where an acceleration is expected
+_GRAVITY = re.compile(r"(?<![A-Za-z_])[gG](?![A-Za-z_0-9])")
 
 
 class UnitError(ValueError):
@@ -31,8 +35,10 @@ def to_si(value, unit: str, where: str = "value") -> float:
     ``unit`` is the expected unit written as pint understands it (e.g. "mm", "N*m/rad/m"); any
     unit of the same dimension is accepted. ``where`` names the field in the messages
     (e.g. "board.toml: board.thickness"). A bare number is accepted only for dimensionless fields.
+    Vibration specifications write accelerations in g: where the expected dimension is not met,
+    a standalone "g" or "G" is read as standard gravity (so "0.04 g^2/Hz" is an acceleration PSD,
+    while "13 g" where a mass is expected stays grams).
     """
-    ureg = registry()
     dim = _dimensionality(unit)
     if isinstance(value, bool) or not isinstance(value, (str, int, float)):
         raise UnitError(f"{where}: expected a quantity such as \"1 {unit}\", got {value!r}")
@@ -40,12 +46,10 @@ def to_si(value, unit: str, where: str = "value") -> float:
         if dim:
             raise UnitError(f"{where}: {value!r} has no unit; write it with one, e.g. \"{value} {unit}\"")
         return float(value)
-    try:
-        q = ureg.Quantity(value.strip())
-    except Exception as exc:  # pint raises several unrelated types for bad text
-        raise UnitError(f"{where}: cannot read {value!r} as a quantity ({exc}); write e.g. \"1 {unit}\"") from None
-    if not isinstance(q, ureg.Quantity):
-        q = ureg.Quantity(q)
+    q = _parse(value, unit, where)
+    if q.dimensionality != dim and _GRAVITY.search(value):
+        gravity = _parse(_GRAVITY.sub("g_n", value), unit, where)
+        q = gravity if gravity.dimensionality == dim else q
     if q.dimensionality != dim:
         got = f"{q.units:~}" or "no unit"
         raise UnitError(
@@ -62,3 +66,12 @@ def from_si(value: float, unit: str) -> float:
     ureg = registry()
     q = ureg.Quantity(float(value), ureg.Quantity(1.0, unit).to_base_units().units)
     return float(q.to(unit).magnitude)
+
+
+def _parse(value: str, unit: str, where: str):
+    ureg = registry()
+    try:
+        q = ureg.Quantity(value.strip())
+    except Exception as exc:  # pint raises several unrelated types for bad text
+        raise UnitError(f"{where}: cannot read {value!r} as a quantity ({exc}); write e.g. \"1 {unit}\"") from None
+    return q if isinstance(q, ureg.Quantity) else ureg.Quantity(q)

@@ -64,13 +64,16 @@ def analyse(board, config, out: Path | None, pictures: bool = True, written: lis
 @click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="write frequencies, mass and DOF count as JSON")
 @click.option("--no-pictures", is_flag=True, help="skip the PNG mode-shape pictures")
-def command(board_toml, config, all_configs, out, json_path, no_pictures):
+@click.option("--html", is_flag=True, help="also write the self-contained page report.html in --out")
+def command(board_toml, config, all_configs, out, json_path, no_pictures, html):
     """Predict a board's resonances: frequencies, effective masses in z, mode shapes."""
     from ..domain import StructureError
     from ..fe import ModelError
     from ..problems import load_structure
     from ..report.files import write_json
 
+    if html and out is None:
+        raise click.UsageError("--html writes report.html into --out: give --out DIR")
     try:
         board = load_structure(board_toml)
         if config is not None and all_configs:
@@ -84,6 +87,10 @@ def command(board_toml, config, all_configs, out, json_path, no_pictures):
         data = dict(results[0]) if len(results) == 1 else {**results[0], "configurations": results}
         data["board"] = board.name
         write_json(json_path, data)
+    if html:
+        from ..report.pages import build_page
+
+        click.echo(f"page written to {build_page(out, board_toml, board, results)}", err=True)
     if out is not None:
         from ..report.manifest import settle
 

@@ -80,7 +80,8 @@ def write_outputs(out: Path, board, bm, modes, test_modes, corr) -> list:
               help="folder for pairs.csv, comac.csv and the PNG pictures")
 @click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="write pairs, unpaired test modes and COMAC as JSON")
-def command(board_toml, test_uff, config, min_mac, n_modes, out, json_path):
+@click.option("--html", is_flag=True, help="also write the self-contained page report.html in --out")
+def command(board_toml, test_uff, config, min_mac, n_modes, out, json_path, html):
     """Correlate a board model with a modal test (UFF): pair table, COMAC, pictures."""
     from ..correlation import correlate
     from ..domain import StructureError
@@ -90,6 +91,8 @@ def command(board_toml, test_uff, config, min_mac, n_modes, out, json_path):
     from ..testdata import TestDataError
     from ..testdata.measured import read_modes
 
+    if html and out is None:
+        raise click.UsageError("--html writes report.html into --out: give --out DIR")
     try:
         board = load_structure(board_toml)
         test_modes = read_modes(test_uff)
@@ -124,6 +127,11 @@ def command(board_toml, test_uff, config, min_mac, n_modes, out, json_path):
     if out is not None:
         t0 = step(f"writing tables and pictures to {out}")
         written = write_outputs(out, board, bm, modes, test_modes, corr)
+        if html:
+            from ..report.pages import correlate_page
+
+            written.append(correlate_page(out, board_toml, test_uff, board, label, pairing,
+                                          dict(zip(corr.dof_labels, corr.comac.tolist())), written).name)
         done(t0)
         click.echo(f"results written to {out}/ ({len(written)} files)", err=True)
     if json_path is not None:

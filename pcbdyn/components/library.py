@@ -27,7 +27,9 @@ class LibraryError(ValueError):
 class Package:
     """One part family: footprint ``size`` (x, y) [m], body ``height`` [m], ``mass`` [kg],
     ``default_model`` (one of :data:`MODELS`), ``equivalent_thickness`` [m] of the board region under
-    the part (thesis section 7.2.3), and free-text ``provenance``."""
+    the part (thesis section 7.2.3), and free-text ``provenance``. Optional: ``steinberg_c``, the
+    package constant of Steinberg's allowable board displacement (lead wires and solder joints;
+    used by ``pcbdyn vibe``), None when the entry does not give one."""
 
     name: str
     size: tuple
@@ -37,6 +39,7 @@ class Package:
     equivalent_thickness: float
     provenance: str
     path: Path
+    steinberg_c: float | None = None
 
 
 def search_path(board_dir: Path | None = None) -> list[Path]:
@@ -91,9 +94,20 @@ def read_package(path: Path) -> Package:
             equivalent_thickness=to_si(p["equivalent_thickness"], "mm", f"{where}.equivalent_thickness"),
             provenance=str(p.get("provenance", "")),
             path=path,
+            steinberg_c=_steinberg_c(path, p),
         )
     except UnitError as exc:
         raise LibraryError(str(exc)) from None
+
+
+def _steinberg_c(path: Path, p: dict) -> float | None:
+    c = p.get("steinberg_c")
+    if c is None:
+        return None
+    if isinstance(c, bool) or not isinstance(c, (int, float)) or not c > 0:
+        raise LibraryError(f"{path}: package.steinberg_c must be a positive number (Steinberg's package constant, "
+                           f"e.g. 1.0 for a standard DIP, 1.75 for a BGA), got {c!r}")
+    return float(c)
 
 
 def find_package(name: str, board_dir: Path | None = None) -> Package | None:

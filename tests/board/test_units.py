@@ -34,3 +34,13 @@ def test_bare_number_needs_a_unit_unless_dimensionless():
 def test_unreadable_quantity():
     with pytest.raises(UnitError, match="cannot read 'two mm'"):
         to_si("two mm", "mm", "x")
+
+
+def test_g_in_an_acceleration_unit_is_standard_gravity():
+    """Vibration specifications write accelerations in g; where a mass is expected g stays grams."""
+    assert to_si("0.04 g^2/Hz", "m^2/s^3") == pytest.approx(0.04 * 9.80665**2, rel=1e-12)
+    assert to_si("0.04 G^2/Hz", "m^2/s^3") == pytest.approx(0.04 * 9.80665**2, rel=1e-12)
+    assert to_si("3 g", "m/s^2") == pytest.approx(3 * 9.80665, rel=1e-12)
+    assert to_si("13 g", "kg") == pytest.approx(0.013, rel=1e-12)
+    with pytest.raises(UnitError, match="expected a unit like 'm/s'"):
+        to_si("3 g", "m/s")

@@ -1,0 +1,88 @@
+"""``pcbdyn vibe board.toml --psd spec.csv|NAME``: does the board survive its vibration
+specification? Random (and sine) response through the board's fixtures, Steinberg's check and
+fatigue life of every part, the octave rule; tables, CSV, pictures, JSON and an HTML page."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from .common import PROBE_TOL, done, fail, solve_board, step
+
+#: at most this many modes are computed (all of them up to twice the top input frequency otherwise)
+MAX_MODES = 150
+
+
+@click.command("vibe")
+@click.argument("board_toml", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.option("--psd", "psd_text", required=True,
+              help="input acceleration PSD: a CSV with columns 'frequency [Hz]', 'psd [g^2/Hz]', or a bundled "
+                   "name (gevs-qual, gevs-accept, gevs-workmanship)")
+@click.option("--sine", "sine_csv", type=click.Path(exists=True, dir_okay=False, path_type=Path), default=None,
+              help="sine sweep: a CSV with 'frequency [Hz]' and the peak 'amplitude [g]' (or '[mm]' of displacement)")
+@click.option("--sweep-rate", type=float, default=2.0, show_default=True, help="sine sweep rate [octave/min]")
+@click.option("--sweeps", type=click.IntRange(min=1), default=1, show_default=True, help="sine sweeps through the band")
+@click.option("--damping", "damping_text", default="steinberg", show_default=True,
+              help="'steinberg' (Q = sqrt(f_n)), 'zeta=0.05', 'Q=10', or a UFF file whose identified damping goes to "
+                   "the model modes it pairs with")
+@click.option("--duration", default=None,
+              help="test time per axis, e.g. '120 s' (default: the time the bundled specification states)")
+@click.option("--axis", type=click.Choice(["x", "y", "z"]), default="z", show_default=True, help="excitation axis")
+@click.option("--chassis-freq", default=None, help="the chassis resonance, e.g. '80 Hz': checks the octave rule")
+@click.option("--config", default=None, help="configuration name from [[configurations]]")
+@click.option("--exclude", multiple=True, help="a part reference to leave out of Steinberg's check (repeatable)")
+@click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=None,
+              help="folder for parts.csv, modes.csv, response_psd.csv, board_map.png, response_psd.png")
+@click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="write input_grms, modes[] and parts[] (ref, z_rms_m, z_allow_m, ratio, life_h, ...) as JSON")
+@click.option("--html", is_flag=True, help="also write the self-contained page report.html in --out")
+def command(board_toml, psd_text, sine_csv, sweep_rate, sweeps, damping_text, duration, axis, chassis_freq, config,
+            exclude, out, json_path, html):
+    """Judge a board under a random (and sine) vibration specification: RMS responses at every part,
+    Steinberg's allowable displacement, fatigue life (three-band, Miner) and the octave rule."""
+    from ..board import BoardError, load_board
+    from ..fe import ModelError
+    from ..report import vibration_report as report
+    from ..report.files import write_json
+    from ..testdata import TestDataError
+    from ..units import UnitError, to_si
+    from ..vibration import (VibrationError, analysis_band, assess, judged_parts, load_psd, parse_damping,
+                             read_sine_csv)
+
+    if html and out is None:
+        raise click.UsageError("--html writes report.html into --out: give --out DIR")
+    try:
+        board = load_board(board_toml)
+        psd = load_psd(psd_text)
+        sine = read_sine_csv(sine_csv, sweep_rate, sweeps) if sine_csv is not None else None
+        damping = parse_damping(damping_text)
+        seconds = to_si(duration, "s", "--duration") if duration is not None else psd.duration
+        chassis = to_si(chassis_freq, "Hz", "--chassis-freq") if chassis_freq is not None else None
+        parts = judged_parts(board, exclude)
+        bm, modes, K, M = solve_board(board, config, n_modes=MAX_MODES, f_max=analysis_band(psd, sine))
+        t0 = step(f"random response of {len(parts)} part(s) to {psd.name} along {axis}")
+        a = assess(board, bm, modes, K, M, psd, damping, axis=axis, duration=seconds, sine=sine, chassis_hz=chassis,
+                   parts=parts, probe_tol=PROBE_TOL)
+        done(t0)
+    except (BoardError, ModelError, TestDataError, UnitError, VibrationError) as exc:
+        fail(str(exc))
+    click.echo(f"\n{board.name} [{config or 'base'}] under {psd.name}:")
+    click.echo("\n".join(report.summary_lines(a)))
+    click.echo("\n" + report.format_table(report.parts_table(a)))
+    written = []
+    if out is not None:
+        t0 = step(f"writing tables and pictures to {out}")
+        written = report.write_outputs(out, board, bm.model, a)
+        if html:
+            inputs = {"configuration": config or "base", "PSD": f"{psd_text} ({psd.source})",
+                      "sine sweep": str(sine_csv) if sine_csv else None, "damping": damping.describe(),
+                      "axis": axis, "duration": None if seconds is None else f"{seconds:g} s",
+                      "chassis frequency": None if chassis is None else f"{chassis:g} Hz",
+                      "excluded parts": ", ".join(exclude) or None}
+            written.append(report.html_page(out, board_toml, board, a, inputs).name)
+        done(t0)
+        click.echo(f"results written to {out}/ ({len(written)} files)", err=True)
+    if json_path is not None:
+        write_json(json_path, {"board": board.name, "configuration": config or "base", **a.to_dict(),
+                               "files": written})

@@ -1,0 +1,58 @@
+"""The HTML pages of ``pcbdyn build`` and ``pcbdyn correlate`` (see :mod:`.html` for the builder):
+the same tables and pictures the commands write, on one self-contained page."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pandas as pd
+
+from .html import Page, describe_file
+
+
+def build_page(out: Path, board_toml, board, results: list) -> Path:
+    """report.html in ``out`` from :func:`pcbdyn.commands.build.analyse` results (one per
+    configuration) and the mode pictures it wrote to ``out/png``."""
+    page = Page(f"pcbdyn build: {board.name}",
+                subtitle=", ".join(f"[{r['configuration']}] first mode {r['modes'][0]['frequency_hz']:.1f} Hz"
+                                   for r in results if r["modes"]))
+    page.items("Inputs", {"board": describe_file(board_toml),
+                          "configurations": ", ".join(r["configuration"] for r in results),
+                          "mesh size": f"{board.mesh_size * 1e3:g} mm"})
+    for r in results:
+        label = r["configuration"]
+        page.items(f"Model [{label}]", {"mass": f"{r['mass_kg'] * 1e3:.2f} g", "DOFs": r["dofs"],
+                                        "rigid-body modes": r["rigid_body_modes"]})
+        table = pd.DataFrame([{"mode": m["n"], "frequency [Hz]": m["frequency_hz"],
+                               "eff. mass z [%]": 100.0 * m["eff_mass_z"], "shape": m["shape"]} for m in r["modes"]])
+        page.table(f"Modes [{label}]", table)
+        shown = [(out / "png" / f"modes_{label}_{m['n']:02d}.png", m) for m in r["modes"]]
+        shown = [(png, m) for png, m in shown if png.is_file()]  # none with --no-pictures
+        if shown:
+            page.pictures(f"Mode shapes [{label}]", [png for png, _ in shown],
+                          [f"mode {m['n']}: {m['frequency_hz']:.1f} Hz, {m['shape']}" for _, m in shown])
+    return page.write(out / "report.html")
+
+
+def correlate_page(out: Path, board_toml, test_uff, board, label: str, pairing, comac: dict, written: list) -> Path:
+    """report.html in ``out`` from a correlation and the pictures :func:`write_outputs` made."""
+    page = Page(f"pcbdyn correlate: {board.name} [{label}] against {Path(test_uff).name}",
+                subtitle=f"{len(pairing.pairs)} pair(s); unpaired test modes: "
+                         f"{', '.join(str(i + 1) for i in pairing.unpaired_test) or 'none'}")
+    page.items("Inputs", {"board": describe_file(board_toml), "test": describe_file(test_uff), "configuration": label})
+    pairs = pd.DataFrame([{"test mode": p.test + 1, "model mode": p.model + 1, "f_test [Hz]": p.f_test,
+                           "f_model [Hz]": p.f_model, "df [%]": p.df_pct, "MAC": p.mac_combined,
+                           "combined with": " ".join(str(c + 1) for c in p.cluster if c != p.model) or "-"}
+                          for p in pairing.pairs])
+    page.table("Mode pairs", pairs, note="df = (f_model - f_test) / f_test; pairs by MAC (thesis eq. 2.3)")
+    lowest = sorted(comac.items(), key=lambda kv: kv[1])[:10]
+    page.table("Lowest COMAC", pd.DataFrame([{"DOF": k, "COMAC": v} for k, v in lowest]),
+               note="COMAC per measured DOF over the pairs (thesis eq. 2.4); low values mark where test and model "
+                    "differ")
+    main = [n for n in ("mac_matrix.png", "frequencies.png", "comac.png") if n in written]
+    page.pictures("MAC matrix, frequencies and COMAC", [out / n for n in main],
+                  ["MAC matrix (pairs framed)", "model against test frequency", "COMAC per point"])
+    overlays = [n for n in written if n.endswith(".png") and n not in main]
+    if overlays:
+        page.pictures("Mode shapes, test over model", [out / n for n in overlays], [Path(n).stem for n in overlays])
+    return page.write(out / "report.html")

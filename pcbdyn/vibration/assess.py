@@ -1,0 +1,206 @@
+"""A board's design verdict under a vibration specification: the random response at every part
+and over the board, Steinberg's check and fatigue life per part, a sine sweep's damage, and the
+octave rule. This is what ``pcbdyn vibe`` reports; it works on an already solved model.
+
+Steinberg's criterion compares the 3-sigma displacement at the board's centre, Z_c, with his
+allowable Z(r) for a part at relative position r (see :mod:`.steinberg`). His r is the ratio of the
+board's displacement at the part to that at the centre, so Z_c <= Z(r) is the same as
+z_part <= r Z(r) = Z(1): with the displacement at the part known from the model, the part is
+judged on its own RMS relative displacement z against ``z_allow`` = Z(1), ratio = 3 z / z_allow.
+The position factor is still reported, read from the model as r = z / z_peak (z_peak the largest
+RMS relative displacement over the board; Steinberg's sin(pi x/a) sin(pi y/b) on a simply
+supported board), with Steinberg's allowable for the board's peak, Z(r), beside it.
+Displacements and curvatures are normal to the board (z), accelerations along the shaken axis.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..fe.curvature import curvature_matrix
+from ..fe.probe import model_probe
+from . import steinberg
+from .base_excitation import AXES, BaseExcitation, base_excitation
+from .damping import Damping, modal_damping
+from .parts import judged_parts
+from .spectra import G, Psd, SineSweep, VibrationError, frequency_grid
+
+
+@dataclass
+class PartResult:
+    """Steinberg's check of one part (SI units; lives in hours, None where nothing moves)."""
+
+    ref: str
+    package: str
+    c: float
+    span_m: float
+    length_m: float
+    position_factor: float
+    z_rms_m: float
+    z_allow_m: float
+    z_allow_board_m: float | None
+    ratio: float
+    rate_hz: float
+    life_h: float | None
+    accel_rms_g: float
+    curvature_rms_per_m: float
+    damage: float | None = None
+    sine_z_peak_m: float | None = None
+    sine_damage: float | None = None
+
+    @property
+    def margin(self) -> float:
+        """z_allow / (3 z) - 1: negative when the part fails Steinberg's 2e7-cycle criterion."""
+        return 1.0 / self.ratio - 1.0 if self.ratio > 0 else float("inf")
+
+    @property
+    def ok(self) -> bool:
+        return self.ratio <= 1.0 and (self.damage or 0.0) < 1.0 and (self.sine_damage or 0.0) < 1.0
+
+    def to_dict(self) -> dict:
+        d = dict(self.__dict__)
+        d["margin"] = None if np.isinf(self.margin) else self.margin
+        d["ok"] = self.ok
+        return d
+
+
+@dataclass
+class Assessment:
+    """Everything ``pcbdyn vibe`` reports, SI inside (see :meth:`to_dict` for the JSON)."""
+
+    psd: Psd
+    damping: Damping
+    axis: str
+    duration: float | None
+    excitation: BaseExcitation
+    damping_source: list
+    parts: list
+    node_z_rms: np.ndarray  # (n_nodes,) RMS relative displacement normal to the board [m], NaN off the shells
+    grid: np.ndarray
+    part_accel_psd: np.ndarray  # (n_grid, n_parts) absolute acceleration [(m/s^2)^2/Hz]
+    part_z_psd: np.ndarray  # (n_grid, n_parts) relative displacement [m^2/Hz]
+    octave: dict | None = None
+    sine: SineSweep | None = None
+    notes: list = field(default_factory=list)
+
+    @property
+    def input_grms(self) -> float:
+        return self.psd.grms() / G
+
+    @property
+    def z_peak_m(self) -> float:
+        return float(np.nanmax(self.node_z_rms))
+
+    def to_dict(self) -> dict:
+        """The JSON contract: input_grms, modes[] (frequency_hz, damping_ratio, ...), parts[] (ref,
+        z_rms_m, z_allow_m, ratio, life_h, ...) worst margin first, and the rest."""
+        be = self.excitation
+        return {
+            "psd": {"name": self.psd.name, "source": self.psd.source,
+                    "breakpoints": [{"frequency_hz": float(f), "psd_g2_hz": float(w / G**2)}
+                                    for f, w in zip(self.psd.f, self.psd.w)]},
+            "input_grms": self.input_grms,
+            "axis": self.axis,
+            "duration_s": self.duration,
+            "damping": self.damping.describe(),
+            "modes": [{"n": i + 1, "frequency_hz": float(f), "damping_ratio": float(z), "damping_source": s,
+                       "effective_mass_fraction": float(m)}
+                      for i, (f, z, s, m) in enumerate(zip(be.frequencies, be.zeta, self.damping_source,
+                                                           be.effective_mass_fraction))],
+            "effective_mass_fraction": float(be.effective_mass_fraction.sum()),
+            "z_peak_rms_m": self.z_peak_m,
+            "parts": [p.to_dict() for p in self.parts],
+            "octave_rule": self.octave,
+            "sine": None if self.sine is None else {"name": self.sine.name, "rate_oct_per_min": self.sine.rate,
+                                                    "sweeps": self.sine.sweeps, "amplitude": self.sine.kind},
+            "ok": all(p.ok for p in self.parts) and (self.octave is None or self.octave["ok"]),
+            "notes": self.notes,
+        }
+
+
+def _shell_nodes(model) -> np.ndarray:
+    return np.unique(np.concatenate([es.conn.ravel() for es in model.sets.values() if es.etype in ("quad4", "tri3")]))
+
+
+def _curvature_rows(model, parts) -> tuple:
+    """(along L, across L) curvature operators, each (n_parts, n_dof) sparse, averaged over the
+    sample points of each footprint; across L is along L turned by 90 degrees."""
+    samples = np.vstack([p.samples for p in parts])
+    C = curvature_matrix(model, samples)
+    per = samples.shape[0] // len(parts)
+    mean = sp.kron(sp.eye(len(parts)), np.full((1, per), 1.0 / per), format="csr")
+    kxx, kyy, kxy = (mean @ C[k::3] for k in range(3))
+    out = []
+    for angle in (np.array([p.angle for p in parts]), np.array([p.angle for p in parts]) + 0.5 * np.pi):
+        c, s = np.cos(angle), np.sin(angle)
+        out.append(sp.diags(c * c) @ kxx + sp.diags(s * s) @ kyy + sp.diags(c * s) @ kxy)
+    return tuple(out)
+
+
+def _sine(be: BaseExcitation, sine: SineSweep, B: np.ndarray, parts, results) -> None:
+    """Peak displacement and Miner damage of the sweep(s) at each part."""
+    f = frequency_grid(sine.f[0], sine.f[-1], be.frequencies, be.zeta)
+    z = np.abs(be.transfer(f) @ B.T) * sine.acceleration(f)[:, None]
+    for j, res in enumerate(results):
+        res.sine_z_peak_m = float(z[:, j].max())
+        res.sine_damage = sine.sweeps * steinberg.sweep_damage(f, z[:, j], res.z_allow_m, sine.rate)
+
+
+def assess(board, bm, modes, K, M, psd: Psd, damping: Damping, *, axis: str = "z", duration: float | None = None,
+           sine: SineSweep | None = None, chassis_hz: float | None = None, parts=None,
+           probe_tol: float | None = None) -> Assessment:
+    """Judge the solved board model ``bm`` (``modes``, assembled ``K``, ``M``) under ``psd`` along
+    ``axis``: RMS responses, Steinberg's check and life of every part (worst margin first), Miner
+    damage over ``duration`` [s] and of ``sine``, and the octave rule against ``chassis_hz``.
+    ``parts``: the :func:`~.parts.judged_parts` to judge (default: all of the board's);
+    ``probe_tol`` [m]: how far off the board a test point of a UFF damping file may lie."""
+    parts = judged_parts(board) if parts is None else parts
+    model = bm.model
+    zeta, source = modal_damping(damping, model, modes, probe_tol)
+    try:
+        be = base_excitation(model, modes, K, M, zeta, axis)
+    except VibrationError as exc:
+        raise VibrationError(f"{board.path.name}: {exc}") from None
+    grid = frequency_grid(psd.f[0], psd.f[-1], be.frequencies, be.zeta)
+    C0, C2 = be.covariance(psd, grid), be.covariance(psd, grid, moment=2)
+    nodes = _shell_nodes(model)
+    node_z = np.full(model.nodes.shape[0], np.nan)
+    node_z[nodes] = np.sqrt(be.variance(be.basis[6 * nodes + 2], C0))
+    z_peak = float(np.nanmax(node_z))
+    notes = []
+    if be.frequencies[-1] < psd.f[-1]:
+        notes.append(f"the modes found reach {be.frequencies[-1]:.0f} Hz, below the top of the spectrum "
+                     f"({psd.f[-1]:.0f} Hz): the modes above respond statically only")
+    results = []
+    accel_psd, z_psd = np.zeros((grid.size, len(parts))), np.zeros((grid.size, len(parts)))
+    if parts:
+        centres = np.column_stack([np.array([p.at for p in parts]), np.zeros(len(parts))])
+        Bz = be.columns(model_probe(model, centres).P)
+        direction = np.eye(3)[AXES.index(axis)]
+        Ba = be.columns(model_probe(model, centres, direction).P, "acceleration")
+        Ca = be.covariance(psd, grid, "acceleration")
+        k_long, k_across = (np.sqrt(be.variance(be.columns(k), C0)) for k in _curvature_rows(model, parts))
+        z_rms, m2 = np.sqrt(be.variance(Bz, C0)), be.variance(Bz, C2)
+        a_rms = np.sqrt(be.variance(Ba, Ca))
+        accel_psd, z_psd = be.response_psd(Ba, psd, grid, "acceleration"), be.response_psd(Bz, psd, grid)
+        h = board.thickness
+        for j, p in enumerate(parts):
+            z_allow = steinberg.allowable_displacement(p.span, p.length, h, p.c)
+            r = float(z_rms[j] / z_peak) if z_peak > 0 else 0.0
+            rate = steinberg.zero_crossing_rate(z_rms[j] ** 2, m2[j])
+            life = steinberg.random_life(z_rms[j], z_allow, rate)
+            results.append(PartResult(
+                p.ref, p.package, p.c, p.span, p.length, r, float(z_rms[j]), z_allow,
+                steinberg.allowable_displacement(p.span, p.length, h, p.c, r) if r > 0 else None,
+                3.0 * float(z_rms[j]) / z_allow, rate, None if np.isinf(life) else life / 3600.0,
+                float(a_rms[j]) / G, float(max(k_long[j], k_across[j])),
+                None if duration is None else (duration / life if np.isfinite(life) else 0.0)))
+        if sine is not None:
+            _sine(be, sine, Bz, parts, results)
+    order = np.argsort([r.margin for r in results], kind="stable")
+    octave = None if chassis_hz is None else steinberg.octave_rule(float(be.frequencies[0]), chassis_hz)
+    return Assessment(psd, damping, axis, duration, be, source, [results[i] for i in order],
+                      node_z, grid, accel_psd[:, order], z_psd[:, order], octave, sine, notes)

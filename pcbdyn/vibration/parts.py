@@ -1,0 +1,95 @@
+"""The parts of a board that Steinberg's check judges, with what his formula needs of each: the
+package constant (from the part's library entry), the part's length L and direction, and the
+board span B along that direction.
+
+L is the footprint's longer side; B is the chord of the board outline through the part's centre
+along that side (for a rectangular board, the edge length parallel to the part, as Steinberg
+defines it). Holes in the board do not shorten B: the board edge is what Steinberg measures.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..components.library import LibraryError, find_package
+from .spectra import VibrationError
+
+#: Steinberg's package constants by kind of part, for the message that asks for one
+CONSTANTS_HINT = ("Steinberg's constants: 0.75 axial-leaded and fine-pitch surface-mount parts, 1.0 standard DIP and "
+                  "through-hole PGA, 1.26 side-brazed DIP, J-lead chip carrier and parts with parallel rows of wires, "
+                  "1.75 BGA, 2.25 leadless ceramic chip carrier")
+#: points across the footprint (fractions of the half-sizes) over which curvatures are averaged
+_SAMPLES = np.array([-2.0 / 3.0, 0.0, 2.0 / 3.0])
+
+
+@dataclass
+class Part:
+    """One judged part: reference, package, Steinberg constant ``c``, centre ``at`` (x, y) [m],
+    ``length`` L [m], ``angle`` of its long side [rad], board ``span`` B [m] along it, and
+    ``samples`` (9, 2): points over the footprint where its curvature is read."""
+
+    ref: str
+    package: str
+    c: float
+    at: np.ndarray
+    length: float
+    angle: float
+    span: float
+    samples: np.ndarray
+
+
+def _chord(outline, centre, angle) -> float:
+    """Length of the outline's chord through ``centre`` along ``angle`` (holes ignored)."""
+    from shapely.geometry import LineString, Point, Polygon
+
+    poly = Polygon(outline.vertices)
+    lo, hi = outline.bbox
+    reach = 2.0 * float(np.hypot(*(hi - lo)))
+    d = np.array([math.cos(angle), math.sin(angle)])
+    cut = poly.intersection(LineString([centre - reach * d, centre + reach * d]))
+    pieces = list(getattr(cut, "geoms", [cut]))
+    return float(min(pieces, key=lambda g: g.distance(Point(centre))).length)
+
+
+def _part(board, comp, pkg) -> Part:
+    a, b = comp.size
+    angle = comp.rotation + (0.0 if a >= b else 0.5 * math.pi)
+    c, s = math.cos(comp.rotation), math.sin(comp.rotation)
+    u, v = np.meshgrid(_SAMPLES * a / 2, _SAMPLES * b / 2)
+    local = np.column_stack([u.ravel(), v.ravel()])
+    samples = np.asarray(comp.at) + local @ np.array([[c, s], [-s, c]])
+    at = np.asarray(comp.at, dtype=float)
+    return Part(comp.ref, pkg.name, pkg.steinberg_c, at, max(a, b), angle, _chord(board.outline, at, angle), samples)
+
+
+def judged_parts(board, exclude=()) -> list:
+    """The :class:`Part` of every component not in ``exclude``; a clear error naming every part
+    whose library entry gives no Steinberg constant (or that has no library package)."""
+    exclude = set(exclude)
+    unknown = exclude - {c.ref for c in board.components}
+    if unknown:
+        raise VibrationError(f"--exclude {', '.join(sorted(unknown))}: no such part in {board.path.name} "
+                             f"(parts: {', '.join(c.ref for c in board.components) or 'none'})")
+    parts, missing = [], []
+    for comp in board.components:
+        if comp.ref in exclude:
+            continue
+        try:
+            pkg = find_package(comp.package, board.path.parent) if comp.package else None
+        except LibraryError as exc:
+            raise VibrationError(str(exc)) from None
+        if pkg is None or pkg.steinberg_c is None:
+            where = f"package {comp.package}, {pkg.path}" if pkg is not None else "no library package"
+            missing.append((comp.ref, where))
+            continue
+        parts.append(_part(board, comp, pkg))
+    if missing:
+        listed = "; ".join(f"{ref} ({where})" for ref, where in missing)
+        raise VibrationError(
+            f"{board.path.name}: no Steinberg package constant for {listed}. Add 'steinberg_c = <value>' with its "
+            f"source to the [package] table of the part's library file ({CONSTANTS_HINT}), give the part a library "
+            f"package that has one, or leave it out with --exclude {missing[0][0]}")
+    return parts
