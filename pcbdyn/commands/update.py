@@ -7,7 +7,7 @@ base = the base configuration, other names = [[configurations]]) only frequencie
 (method freq) and test mode n is paired with elastic model mode n (pairing by order).
 With UFF shapes, pairing is by MAC; QMS/FBM equations are built per measured mode on the model
 condensed dynamically onto the measured DOFs at that mode's frequency (see
-:meth:`pcbdyn.updating.board_problem.BoardProblem.mode_configurations`); the before/after tables
+:meth:`pcbdyn.problems.UpdateProblem.mode_configurations`); the before/after tables
 always come from full-model solves.
 
 FRF methods (frf-in: excitation residual, eq. 3.34; frf-out: receptance residual, eq. 3.35;
@@ -16,7 +16,7 @@ the model DOF under the reference point (it must be on a mesh node and, for frf-
 the responses: a driving-point FRF, since the equations are written on the model condensed
 exactly onto the measured DOFs at each line) and use the updating
 frequencies of ``--frf-freqs`` or, by default, lines away from the resonances where test and
-model FRFs correlate (FDAC, see :func:`pcbdyn.updating.board_problem.choose_frf_frequencies`).
+model FRFs correlate (FDAC, see :func:`pcbdyn.updating.frf_lines.choose_frf_frequencies`).
 The before/after tables pair the file's modes (dataset 55) with the model by MAC; a file without
 modes is checked against its FRF peaks, paired by order. Damped data: frf-in with
 ``--damping diagonal|proportional|light`` or frf-direct; frf-out assumes little damping.

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import click
 
-from .common import PROBE_TOL, done, fail, solve_board, step
+from .common import PROBE_TOL, done, fail, solve_structure, step
 
 #: at most this many modes are computed (all of them up to twice the top input frequency otherwise)
 MAX_MODES = 150
@@ -60,7 +60,7 @@ def command(board_toml, psd_text, sine_csv, sweep_rate, sweeps, damping_text, du
         seconds = to_si(duration, "s", "--duration") if duration is not None else psd.duration
         chassis = to_si(chassis_freq, "Hz", "--chassis-freq") if chassis_freq is not None else None
         parts = judged_parts(board, exclude)
-        bm, modes, K, M = solve_board(board, config, n_modes=MAX_MODES, f_max=analysis_band(psd, sine))
+        bm, modes, K, M = solve_structure(board, config, n_modes=MAX_MODES, f_max=analysis_band(psd, sine))
         t0 = step(f"random response of {len(parts)} part(s) to {psd.name} along {axis}")
         a = assess(board, bm, modes, K, M, psd, damping, axis=axis, duration=seconds, sine=sine, chassis_hz=chassis,
                    parts=parts, probe_tol=PROBE_TOL)
