@@ -25,6 +25,10 @@ COLLECTIONS = ("board", "components", "fixtures", "masses", "line_masses", "stif
 
 @dataclass
 class Board:
+    """A printed circuit board as board.toml describes it (SI units, the board frame): outline, plate
+    (isotropic or stack-up), parts, fixtures, masses, effect entries, test configurations, parameters
+    and analysis settings; :func:`load_board` reads and validates it, :meth:`build` makes its FE model."""
+
     name: str
     path: Path
     outline: Outline
