@@ -13,6 +13,6 @@ def main():
     tests, update them and find what they lack."""
 
 
-from .commands import (build, correlate, diagnose, export, identify, import_kicad, localize, simulate_test, study,
-                       update, vibe)
+for _module in (build, simulate_test, correlate, update, localize, study, diagnose, vibe, identify, import_kicad,
+                export):
     main.add_command(_module.command)

@@ -48,6 +48,32 @@ class BoardModel(ParametricModel):
         return suspects, footprints, self.board.thickness
 
 
+#: fewest elements across the board's smaller side a mesh must have
+MIN_ELEMENTS_ACROSS = 4
+#: most DOFs a board's mesh may have (estimated before meshing); the PCBDYN_MAX_DOFS variable raises it
+MAX_DOFS = 1_200_000
+
+
+def check_mesh_size(board, size: float) -> None:
+    """A BoardError, with the estimate, for a mesh size that gives fewer than
+    :data:`MIN_ELEMENTS_ACROSS` elements across the board or more DOFs than the limit (6 per node, about
+    one node per element of size^2 on the board's area): before gmsh spends minutes on it."""
+    import os
+
+    lo, hi = board.outline.bbox
+    across = float(np.min(hi - lo)) / size
+    where = f"{board.path.name}: board.mesh_size"
+    if across < MIN_ELEMENTS_ACROSS:
+        raise BoardError(f"{where}: {size * 1e3:g} mm gives {across:.1f} elements across the board's "
+                         f"{float(np.min(hi - lo)) * 1e3:g} mm; use at most {float(np.min(hi - lo)) / MIN_ELEMENTS_ACROSS * 1e3:g} mm")
+    limit = int(float(os.environ.get("PCBDYN_MAX_DOFS", MAX_DOFS)))
+    dofs = 6.0 * board.outline.area() / size**2
+    if dofs > limit:
+        raise BoardError(f"{where}: {size * 1e3:g} mm gives about {dofs:,.0f} DOFs, more than the limit of "
+                         f"{limit:,}; use a larger mesh size (about {np.sqrt(6.0 * board.outline.area() / limit) * 1e3:.2g} "
+                         "mm or more), or raise the limit with the PCBDYN_MAX_DOFS variable")
+
+
 def mesh_points(board, config, shared: bool = False) -> list:
     """Named points that must be mesh nodes; ``shared``: those of every configuration, so that all
     configurations mesh alike."""
@@ -78,6 +104,7 @@ def build_model(board, config: str | None = None, mesh_size: float | None = None
         if cfg is None:
             names = ", ".join(c.name for c in board.configurations) or "none defined"
             raise BoardError(f"{board.path.name}: configuration '{config}' does not exist (configurations: {names})")
+    check_mesh_size(board, mesh_size or board.mesh_size)
     named = mesh_points(board, cfg, shared_mesh)
     regions = [(f"components.{c.ref}", c.corners()) for c in board.components] if board.smear == "none" else []
     strips = [s for f in board.fixtures if f.edge is not None

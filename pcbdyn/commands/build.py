@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from .common import done, fail, solve_structure, step
+from .common import checked_outputs, done, fail, solve_structure, step
 
 
 def analyse(board, config, out: Path | None, pictures: bool = True, written: list | None = None) -> dict:
@@ -65,6 +65,7 @@ def analyse(board, config, out: Path | None, pictures: bool = True, written: lis
               help="write frequencies, mass and DOF count as JSON")
 @click.option("--no-pictures", is_flag=True, help="skip the PNG mode-shape pictures")
 @click.option("--html", is_flag=True, help="also write the self-contained page report.html in --out")
+@checked_outputs()
 def command(board_toml, config, all_configs, out, json_path, no_pictures, html):
     """Predict a board's resonances: frequencies, effective masses in z, mode shapes."""
     from ..domain import StructureError

@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import functools
 import sys
 import time
+from pathlib import Path
 
 import click
 
@@ -109,3 +111,62 @@ def parse_noise(text):
         raise click.BadParameter(f"{exc}; e.g. --noise f=0.2,shape=2 (percent, uniform bounds)",
                                  param_hint="--noise") from None
     return n.frequency_pct or None, n.shape_pct or None
+
+
+#: command keyword -> the option users write, for messages
+OPTION_NAMES = {"json_path": "--json", "out": "--out", "bdf": "--nastran", "chart": "--chart"}
+
+
+def check_writable(path: Path, option: str, folder: bool, shown=None) -> None:
+    """A UsageError when ``path`` cannot be written as a file (``folder`` False) or a folder: it is one
+    of the other kind, or an ancestor is a file. ``shown``: how the message names the path."""
+    shown = path if shown is None else shown
+    if folder and path.exists() and not path.is_dir():
+        raise click.UsageError(f"{option} {shown}: is a file; give a folder (or a new name)")
+    if not folder and path.is_dir():
+        raise click.UsageError(f"{option} {shown}: is a folder; give a file name")
+    for parent in path.resolve().parents:
+        if parent.exists():
+            if not parent.is_dir():
+                raise click.UsageError(f"{option} {shown}: {parent.name} is a file, not a folder; choose another place")
+            break
+
+
+def checked_outputs(folders=("out",), files=("json_path",)):
+    """A command decorator: its output options (keywords ``folders`` for folders, ``files`` for files)
+    are checked before any work, so that a run never fails after its computation for want of a place
+    to write; ``--json -`` writes the JSON to the standard output and the report to stderr."""
+
+    def decorate(command):
+        @functools.wraps(command)
+        def run(*args, **kwargs):
+            for keys, folder in ((folders, True), (files, False)):
+                for key in keys:
+                    if kwargs.get(key) is not None and str(kwargs[key]) != "-":
+                        check_writable(Path(kwargs[key]), OPTION_NAMES.get(key, f"--{key}"), folder)
+            if str(kwargs.get("json_path")) == "-":
+                from ..report.files import json_to_stdout
+
+                with json_to_stdout():
+                    return command(*args, **kwargs)
+            return command(*args, **kwargs)
+
+        return run
+
+    return decorate
+
+
+def result_path(out, source, suffix: str, force: bool = False) -> Path:
+    """Where a file pcbdyn names itself goes (``<stem>.<suffix><ext>`` of ``source``, e.g.
+    board.updated.toml): into the ``out`` folder when given (the folder holds this run's results), else
+    beside ``source``, where an earlier file of that name is kept unless ``force``: the next free
+    numbered name is used (board.updated.2.toml)."""
+    source = Path(source)
+    if out is not None:
+        return Path(out) / f"{source.stem}.{suffix}{source.suffix}"
+    path = source.with_name(f"{source.stem}.{suffix}{source.suffix}")
+    k = 2
+    while path.exists() and not force:
+        path = source.with_name(f"{source.stem}.{suffix}.{k}{source.suffix}")
+        k += 1
+    return path

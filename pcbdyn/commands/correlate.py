@@ -8,65 +8,8 @@ import math
 from pathlib import Path
 
 import click
-import numpy as np
 
-from .common import PROBE_TOL, done, fail, solve_structure, step
-
-HEADER = ("test mode", "model mode", "f_test [Hz]", "f_model [Hz]", "df [%]", "MAC")
-
-
-def format_pairs(pairs) -> str:
-    """The pair table as fixed-width text (df = (f_model - f_test) / f_test)."""
-    rows = ["  ".join(f"{h:>12}" for h in HEADER)]
-    for p in pairs:
-        rows.append("  ".join([f"{p.test + 1:>12d}", f"{p.model + 1:>12d}", f"{p.f_test:>12.2f}",
-                               f"{p.f_model:>12.2f}", f"{p.df_pct:>+12.2f}", f"{p.mac_combined:>12.3f}"]))
-    return "\n".join(rows)
-
-
-def pairs_csv(pairs) -> str:
-    lines = [",".join(HEADER) + ",combined with"]
-    for p in pairs:
-        combo = " ".join(str(c + 1) for c in p.cluster if c != p.model)
-        lines.append(f"{p.test + 1},{p.model + 1},{p.f_test!r},{p.f_model!r},{p.df_pct!r},{p.mac_combined!r},{combo}")
-    return "\n".join(lines) + "\n"
-
-
-def comac_csv(labels, xyz, values) -> str:
-    lines = ["dof,x [m],y [m],z [m],COMAC"]
-    lines += [f"{lab},{x!r},{y!r},{z!r},{float(c)!r}" for lab, (x, y, z), c in zip(labels, xyz.tolist(), values)]
-    return "\n".join(lines) + "\n"
-
-
-def z_rows(test_modes):
-    """Rows of the DOFs measured along +-z and their sign (the shape pictures show w only)."""
-    d = test_modes.dofs.directions
-    rows = np.flatnonzero(np.abs(np.abs(d[:, 2]) - 1.0) < 1e-9)
-    return rows, np.sign(d[rows, 2])
-
-
-def write_outputs(out: Path, board, bm, modes, test_modes, corr) -> list:
-    """CSV tables and PNG pictures under ``out``; returns the names written."""
-    from ..report import correlation_plots as plots
-    from ..report.files import write_text
-
-    pairing = corr.pairing
-    written = ["pairs.csv", "comac.csv", "mac_matrix.png", "frequencies.png", "comac.png"]
-    write_text(out / "pairs.csv", pairs_csv(pairing.pairs))
-    xyz = test_modes.dof_xyz()
-    write_text(out / "comac.csv", comac_csv(corr.dof_labels, xyz, corr.comac))
-    plots.mac_matrix(out / "mac_matrix.png", pairing.mac, pairing.pairs, test_modes.frequencies, modes.frequencies)
-    plots.frequency_plot(out / "frequencies.png", pairing.pairs)
-    plots.comac_map(out / "comac.png", board.outline, xyz[:, :2], corr.comac, corr.dof_labels)
-    rows, sign = z_rows(test_modes)
-    if rows.size:
-        model_w = pairing.model_shapes(modes.shapes)[2::6]
-        at = pairing.model_shapes(corr.model_at_test)[rows] * sign[:, None]
-        test_w = test_modes.shapes[np.ix_(rows, pairing.test_index)] * sign[:, None]
-        written += plots.shape_overlays(out, bm.model, board.outline, pairing.pairs, xyz[rows, :2], test_w, at,
-                                        model_w)
-    return written
-
+from .common import PROBE_TOL, checked_outputs, done, fail, solve_structure, step
 
 @click.command("correlate")
 @click.argument("board_toml", type=click.Path(exists=True, dir_okay=False, path_type=Path))
@@ -81,12 +24,14 @@ def write_outputs(out: Path, board, bm, modes, test_modes, corr) -> list:
 @click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="write pairs, unpaired test modes and COMAC as JSON")
 @click.option("--html", is_flag=True, help="also write the self-contained page report.html in --out")
+@checked_outputs()
 def command(board_toml, test_uff, config, min_mac, n_modes, out, json_path, html):
     """Correlate a board model with a modal test (UFF): pair table, COMAC, pictures."""
     from ..correlation import correlate
     from ..domain import StructureError
     from ..fe import ModelError
     from ..problems import load_structure
+    from ..report.correlation_report import comac_line, format_pairs, write_outputs
     from ..report.files import write_json
     from ..testdata import TestDataError
     from ..testdata.measured import read_modes
@@ -120,11 +65,11 @@ def command(board_toml, test_uff, config, min_mac, n_modes, out, json_path, html
     click.echo(format_pairs(pairing.pairs))
     if pairing.unpaired_test:
         click.echo(f"unpaired test modes: {', '.join(str(i + 1) for i in pairing.unpaired_test)}")
-    order = np.argsort(corr.comac)
-    click.echo(f"COMAC over the pairs: mean {float(np.mean(corr.comac)):.3f}; lowest: "
-               + ", ".join(f"{corr.dof_labels[i]} {corr.comac[i]:.3f}" for i in order[:5]))
+    click.echo(comac_line(corr))
     written = []
     if out is not None:
+        from ..report.manifest import settle
+
         t0 = step(f"writing tables and pictures to {out}")
         written = write_outputs(out, board, bm, modes, test_modes, corr)
         if html:
@@ -132,6 +77,7 @@ def command(board_toml, test_uff, config, min_mac, n_modes, out, json_path, html
 
             written.append(correlate_page(out, board_toml, test_uff, board, label, pairing,
                                           dict(zip(corr.dof_labels, corr.comac.tolist())), written).name)
+        settle(out, [out / w for w in written], "pcbdyn correlate")
         done(t0)
         click.echo(f"results written to {out}/ ({len(written)} files)", err=True)
     if json_path is not None:
@@ -140,7 +86,7 @@ def command(board_toml, test_uff, config, min_mac, n_modes, out, json_path, html
             "board": board.name, "configuration": label, "test_file": str(test_uff), "min_mac": min_mac,
             "test_frequencies_hz": [float(f) for f in test_modes.frequencies],
             "model_frequencies_hz": [float(f) for f in modes.frequencies],
-            "mac_matrix": np.round(pairing.mac, 6).tolist(),
+            "mac_matrix": pairing.mac.round(6).tolist(),
             "files": written,
         })
         write_json(json_path, data)

@@ -14,7 +14,8 @@ from pathlib import Path
 
 import click
 
-from .common import done, fail, measured_configurations, parse_noise, step
+from ..diagnosis import KINDS
+from .common import checked_outputs, done, fail, measured_configurations, parse_noise, result_path, step
 
 
 @click.command("diagnose")
@@ -24,19 +25,23 @@ from .common import done, fail, measured_configurations, parse_noise, step
 @click.option("--noise", default=None,
               help="measurement noise in percent as uniform bounds (thesis eqs. 5.72-5.73), e.g. 'f=0.2,shape=2'; "
                    "default: frequencies 0.2 %, shapes estimated from the data")
-@click.option("--kinds", default=None, help="comma-separated catalogue kinds to search (default: all)")
+@click.option("--kinds", default=None, help=f"comma-separated catalogue kinds to search (default: all): {', '.join(KINDS)}")
 @click.option("--max-effects", type=click.IntRange(min=1), default=3, show_default=True)
 @click.option("--mesh-size", default=None, help="element size, e.g. '5 mm' (default: the board's)")
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=None,
-              help="folder for the evidence map and tables")
-@click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None)
-def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size, out, json_path):
-    """Find the effects a board model lacks from modal tests (UFF with mode shapes)."""
+              help="folder for the board with the effects declared, the evidence map and tables")
+@click.option("--force", is_flag=True, help="replace an earlier <board>.diagnosed.toml beside the board (default: a "
+                                            "numbered name)")
+@click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="write effects, before/after and statistics as JSON ('-': standard output)")
+@checked_outputs()
+def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size, out, force, json_path):
+    """Find the effects a board model lacks from modal tests: TEST_UFF (with mode shapes) of the base
+    configuration and NAME=FILE for each perturbed configuration of board.toml (e.g. c2=test2.uff)."""
     from ..board.enrich import write_enriched
+    from ..diagnosis.pipeline import diagnose
     from ..domain import StructureError
     from ..problems import load_structure
-    from ..diagnosis import KINDS
-    from ..diagnosis.pipeline import diagnose
     from ..report import diagnosis_report as rep
     from ..report.files import write_json, write_text
     from ..testdata import TestDataError
@@ -63,18 +68,24 @@ def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size,
     click.echo(rep.format_effects(d.effects))
     click.echo("")
     click.echo(rep.format_states(d.before, d.parameters_only, d.after))
-    enriched = None
+    enriched, written = None, []
     if d.effects:
         try:
-            enriched = write_enriched(board_toml, rep.enriched_effects(d))
+            enriched = write_enriched(board_toml, rep.enriched_effects(d), result_path(out, board_toml, "diagnosed", force))
+            written.append(enriched)
             click.echo(f"\nboard with the effects declared written to {enriched}", err=True)
         except StructureError as exc:
             click.echo(f"\nnote: the enriched board.toml was not written: {exc}", err=True)
     if out is not None:
-        write_text(out / "effects.txt", rep.format_effects(d.effects) + "\n")
-        write_text(out / "correlation.txt", rep.format_states(d.before, d.parameters_only, d.after) + "\n")
+        from ..report.manifest import settle
+
+        written += [out / "effects.txt", out / "correlation.txt"]
+        write_text(written[-2], rep.format_effects(d.effects) + "\n")
+        write_text(written[-1], rep.format_states(d.before, d.parameters_only, d.after) + "\n")
         if d.evidence:
-            rep.plot_evidence(out / "evidence.png", board, d.evidence, d.effects)
+            written.append(out / "evidence.png")
+            rep.plot_evidence(written[-1], board, d.evidence, d.effects)
+        settle(out, written, "pcbdyn diagnose")
     if json_path is not None:
         write_json(json_path, {
             "effects": d.effects, "noise_only": d.noise_only, "message": d.message,

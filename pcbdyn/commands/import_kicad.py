@@ -8,7 +8,7 @@ from pathlib import Path
 
 import click
 
-from .common import done, fail, step
+from .common import checked_outputs, done, fail, step
 
 
 @click.command("import-kicad")
@@ -20,6 +20,7 @@ from .common import done, fail, step
 @click.option("--overwrite", is_flag=True, help="replace --out if it exists (it is kept otherwise)")
 @click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="write what was placed, left out and found as JSON")
+@checked_outputs(folders=(), files=("json_path", "out"))
 def command(pcb, map_toml, out, overwrite, json_path):
     """Make a board.toml from a KiCad board (.kicad_pcb, KiCad 6-8)."""
     from ..atomic import atomic_path

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import click
 
-from .common import done, fail, measured_configurations, parse_extra, parse_noise, step
+from .common import checked_outputs, done, fail, measured_configurations, parse_extra, parse_noise, step
 
 METHOD_CHOICES = ["tls-qrf", "svd-qr", "qr", "min-norm"]
 
@@ -39,11 +39,13 @@ METHOD_CHOICES = ["tls-qrf", "svd-qr", "qr", "min-norm"]
               help="Guyan-reduce the model to the measured DOFs, or expand the measured shapes")
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=None,
               help="folder for the evidence figure and the FBM map (PNG)")
-@click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None)
+@click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="write the selection and its evidence as JSON ('-': standard output)")
+@checked_outputs()
 def command(board_toml, test_uff, config_tests, method, eq_type, params, rank, alpha, noise, matching, out,
             json_path):
-    """Localise model errors among the board's parameters from one or more modal tests
-    (extra tests as CONFIG=test.uff for configurations of board.toml)."""
+    """Localise model errors among a structure's [[parameters]] from modal tests: TEST_UFF of the base
+    configuration and NAME=FILE for each perturbed configuration of board.toml (e.g. c2=test2.uff)."""
     from ..domain import StructureError
     from ..problems import UpdateProblem, load_structure
     from ..problems.localize import evidence, noise_redraws
@@ -84,16 +86,18 @@ def command(board_toml, test_uff, config_tests, method, eq_type, params, rank, a
     if out is not None:
         from ..problems.localize import fbm_map
         from ..report.localisation_plots import localisation_figure, save_map
+        from ..report.manifest import settle
 
-        out.mkdir(parents=True, exist_ok=True)
-        localisation_figure(out / "localisation.png", tls, problem.names)
+        written = [out / "localisation.png"]
+        localisation_figure(written[0], tls, problem.names)
         measured = tests[0][1]
         if eq_type in ("qms", "fbm") and measured.shapes is not None:
             xy = measured.xyz[:, :2]
             fbm, peak = fbm_map(configs[0], states[0])
-            save_map(out / "fbm_map.png", xy, None, fbm, "FBM residual forces at the test points (eq. 5.2)")
+            written.append(out / "fbm_map.png")
+            save_map(written[-1], xy, None, fbm, "FBM residual forces at the test points (eq. 5.2)")
             data["fbm_peak_mm"] = [1e3 * float(v) for v in xy[peak]]
-        drawn = ", fbm_map.png" if "fbm_peak_mm" in data else ""
-        click.echo(f"wrote {out}/localisation.png{drawn}", err=True)
+        settle(out, written, "pcbdyn localize")
+        click.echo(f"wrote {', '.join(str(w) for w in written)}", err=True)
     if json_path is not None:
         write_json(json_path, data)

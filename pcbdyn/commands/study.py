@@ -38,6 +38,8 @@ from pathlib import Path
 
 import click
 
+from .common import check_writable, checked_outputs
+
 KEYS = {"case", "levels_pct", "shots", "methods", "equations", "rank", "seed", "workers", "out", "board", "points"}
 CASE_KEYS = {
     "simulated_free_pcb": {"nu", "n_modes", "errors_mm", "excitation_node", "perturbation_node", "perturbation_kg"},
@@ -89,6 +91,11 @@ def read_spec(path: Path) -> dict:
         opts.update(path=path.parent / s["board"], points_csv=path.parent / s["points"],
                     truth=doc.get("truth", {}))
     out = s.get("out")
+    if out is not None:
+        try:
+            check_writable(path.parent / str(out), "[study] out =", folder=True, shown=out)
+        except click.UsageError as exc:
+            raise ValueError(exc.message) from None
     return {
         "case": case, "case_options": opts, "levels": [float(v) for v in levels], "shots": shots,
         "methods": list(methods), "equations": list(s.get("equations", ["qms"])), "rank": rank,
@@ -102,6 +109,7 @@ def read_spec(path: Path) -> dict:
 @click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path),
               help="write the summary and every shot's result as JSON")
 @click.option("--quiet", is_flag=True, help="no progress bar")
+@checked_outputs(folders=())
 def command(study_toml: Path, json_path: Path | None, quiet: bool):
     """Judge localisation methods by their success ratio over noisy random shots (thesis eq. 5.65-5.66)."""
     from ..report.files import write_json, write_text
@@ -128,10 +136,13 @@ def command(study_toml: Path, json_path: Path | None, quiet: bool):
     if spec["out"] is not None:
         from ..report.localisation_plots import success_ratio_figure
 
-        spec["out"].mkdir(parents=True, exist_ok=True)
-        write_text(spec["out"] / "shots.csv", df.to_csv(index=False))
-        write_text(spec["out"] / "summary.csv", summary.to_csv(index=False))
-        success_ratio_figure(spec["out"] / "success_ratios.png", summary)
+        from ..report.manifest import settle
+
+        written = [spec["out"] / name for name in ("shots.csv", "summary.csv", "success_ratios.png")]
+        write_text(written[0], df.to_csv(index=False))
+        write_text(written[1], summary.to_csv(index=False))
+        success_ratio_figure(written[2], summary)
+        settle(spec["out"], written, "pcbdyn study")
         click.echo(f"wrote {spec['out']}/shots.csv, summary.csv, success_ratios.png", err=True)
     if json_path is not None:
         write_json(json_path, {"case": spec["case"], "true_errors": true,

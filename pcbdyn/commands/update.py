@@ -27,22 +27,17 @@ from __future__ import annotations
 from pathlib import Path
 
 import click
-import numpy as np
 
-from .common import done, fail, measured_configurations, parse_extra, step
+from .common import checked_outputs, done, fail, measured_configurations, parse_extra, result_path, step
 
-#: SI unit of the JSON values for the display units board.toml quantities use (others are SI already)
-SI_UNITS = {"mm": "m", "g": "kg"}
-
-
-def parse_frf_freqs(text):
-    """'150,230 Hz' or '150,230' -> array [Hz]."""
+def parse_frf_freqs(text) -> list:
+    """'150,230 Hz' or '150,230' -> frequencies [Hz]."""
     try:
-        vals = np.array([float(v) for v in text.replace("Hz", "").split(",") if v.strip()])
+        vals = [float(v) for v in text.replace("Hz", "").split(",") if v.strip()]
     except ValueError:
         raise click.BadParameter(f"'{text}' is not a comma-separated list of frequencies in Hz (e.g. 150,230,410)",
                                  param_hint="--frf-freqs") from None
-    if vals.size == 0 or np.any(vals <= 0):
+    if not vals or min(vals) <= 0:
         raise click.BadParameter(f"'{text}': give positive frequencies in Hz (e.g. 150,230,410)", param_hint="--frf-freqs")
     return vals
 
@@ -69,14 +64,21 @@ def parse_frf_freqs(text):
               help="stop when the max frequency error is below this percentage (eq. 7.2)")
 @click.option("--mesh-size", default=None, help="override board.mesh_size, e.g. '10 mm'")
 @click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=None,
-              help="folder for the iteration plot and tables")
-@click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None)
+              help="folder for board.updated.toml, the iteration plot and tables (default: board.updated.toml "
+                   "beside the board)")
+@click.option("--force", is_flag=True, help="replace an earlier board.updated.toml (default: a numbered name)")
+@click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="write parameters, status, before/after and history as JSON ('-': standard output)")
+@checked_outputs()
 def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping, solver, params, max_iter, tol_pct,
-            mesh_size, out, json_path):
-    """Update a board model's parameters against modal tests (UFF) or measured frequencies (CSV)."""
+            mesh_size, out, force, json_path):
+    """Update a structure's [[parameters]] against modal tests: TEST_UFF for the base configuration and
+    NAME=FILE for each perturbed configuration of board.toml (e.g. c2=test2.uff), or measured
+    frequencies (--frequencies CSV)."""
     from ..domain import StructureError
     from ..problems import UpdateProblem, load_structure, run
     from ..problems.frf_tests import frf_configurations
+    from ..problems.run import outcome
     from ..report import update_report as rep
     from ..report.files import write_json, write_text
     from ..testdata import TestDataError
@@ -107,40 +109,33 @@ def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping,
             check = [problem.configuration(c, m, "freq") for c, m in data]
             cfgs = check if method == "freq" else [q for c, m in data for q in problem.mode_configurations(c, m, method)]
         done(t0)
-        t0 = step(f"updating {len(problem.names)} parameter(s) with {method}/{solver} over {len(cfgs)} configuration(s)")
-        res, before, after = run(problem, cfgs, solver, check=check, max_iter=max_iter, tol_freq_pct=tol_pct)
+        blocks = f" ({len(cfgs)} equation blocks)" if len(cfgs) != len(check) else ""
+        t0 = step(f"updating {len(problem.names)} parameter(s) with {method}/{solver} on {len(check)} test "
+                  f"configuration(s){blocks}")
+        res, before, after = run(problem, cfgs, solver, check=check, max_iter=max_iter, tol_freq_pct=tol_pct,
+                                 progress=lambda h: click.echo(rep.progress_line(h), err=True))
         done(t0)
+        what = outcome(problem, res, before, after)
+        dst = problem.write_updated(res.p, result_path(out, board_toml, "updated", force), source=(
+            f"pcbdyn update ({what['status']})"))
     except (StructureError, TestDataError, KeyError, ValueError) as exc:
         fail(str(exc))
     rows = rep.parameter_rows(problem, res.p)
-    click.echo(f"\n{board.name}: {res.reason} after {res.iterations} iteration(s) "
-               f"({'converged' if res.converged else 'not converged'}; best iterate {res.best_iteration})")
+    click.echo(f"\n{board.name}: {what['status']} after {res.iterations} iteration(s) ({res.reason}; best iterate "
+               f"{res.best_iteration})")
+    for line in what["details"]:
+        click.echo(f"  note: {line}")
     click.echo(rep.format_parameters(rows))
     click.echo("")
     click.echo(rep.format_correlation(before, after))
-    try:
-        dst = problem.write_updated(res.p, rep.updated_board_path(board_toml))
-    except StructureError as exc:
-        fail(str(exc))
     click.echo(f"\nupdated board written to {dst}", err=True)
     if out is not None:
-        rep.plot_iterations(out / "iterations.png", problem, res)
-        write_text(out / "parameters.txt", rep.format_parameters(rows) + "\n")
-        write_text(out / "correlation.txt", rep.format_correlation(before, after) + "\n")
-    if json_path is not None:
-        def summary(states):
-            return {"max_freq_error_pct": max(s["max_freq_error_pct"] for s in states),
-                    "configurations": states, "pairs": [q for s in states for q in s["pairs"]]}
+        from ..report.manifest import settle
 
-        write_json(json_path, {
-            "parameters": {r["name"]: {"initial": float(v0), "updated": float(v), "unit": SI_UNITS.get(r["unit"], r["unit"]),
-                                       "display_unit": r["unit"], "change_pct": r["change_pct"],
-                                       "bound_hit": r["bound_hit"]}
-                           for r, v0, v in zip(rows, problem.p0, res.p)},
-            "before": summary(before), "after": summary(after), "iterations": res.iterations,
-            "converged": bool(res.converged), "reason": res.reason, "method": method, "solver": solver,
-            "history": [{"iteration": h["iteration"], "p": np.asarray(h["p"]).tolist(),
-                         "max_freq_error_pct": h["max_freq_error_pct"], "condition_stacked": h["condition_stacked"],
-                         "rank": h.get("rank")} for h in res.history],
-            "updated_board": str(dst),
-        })
+        written = [dst, out / "iterations.png", out / "parameters.txt", out / "correlation.txt"]
+        rep.plot_iterations(written[1], problem, res)
+        write_text(written[2], rep.format_parameters(rows) + "\n")
+        write_text(written[3], rep.format_correlation(before, after) + "\n")
+        settle(out, written, "pcbdyn update")
+    if json_path is not None:
+        write_json(json_path, rep.update_json(problem, res, rows, before, after, what, method, solver, dst))

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import click
 
-from .common import PROBE_TOL, done, fail, solve_structure, step
+from .common import PROBE_TOL, checked_outputs, done, fail, solve_structure, step
 
 #: at most this many modes are computed (all of them up to twice the top input frequency otherwise)
 MAX_MODES = 150
@@ -37,6 +37,7 @@ MAX_MODES = 150
 @click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="write input_grms, modes[] and parts[] (ref, z_rms_m, z_allow_m, ratio, life_h, ...) as JSON")
 @click.option("--html", is_flag=True, help="also write the self-contained page report.html in --out")
+@checked_outputs()
 def command(board_toml, psd_text, sine_csv, sweep_rate, sweeps, damping_text, duration, axis, chassis_freq, config,
             exclude, out, json_path, html):
     """Judge a board under a random (and sine) vibration specification: RMS responses at every part,
@@ -81,6 +82,9 @@ def command(board_toml, psd_text, sine_csv, sweep_rate, sweeps, damping_text, du
                       "chassis frequency": None if chassis is None else f"{chassis:g} Hz",
                       "excluded parts": ", ".join(exclude) or None}
             written.append(report.html_page(out, board_toml, board, a, inputs).name)
+        from ..report.manifest import settle
+
+        settle(out, [out / w for w in written], "pcbdyn vibe")
         done(t0)
         click.echo(f"results written to {out}/ ({len(written)} files)", err=True)
     if json_path is not None:

@@ -1,24 +1,32 @@
-"""Running an update of an :class:`~.problem.UpdateProblem` and the correlation before and after it."""
+"""Running an update of an :class:`~.problem.UpdateProblem`, the correlation before and after it, and
+what happened in the user's terms (status, parameters on their bounds, configurations made worse,
+parameter combinations the data do not determine)."""
 
 from __future__ import annotations
 
+import warnings
+
+import numpy as np
+
 from ..updating.iteration import build_equations, update
+from ..updating.solvers import RankDeficiencyWarning
 
 
 def correlation_state(configs, p) -> list:
     """Per configuration at ``p``: the pairs (as in ``pcbdyn correlate``: test_mode, model_mode
-    (1-based, elastic modes), f_test_hz, f_model_hz, df_pct, mac) and the max |df| in percent."""
+    (1-based, elastic modes), f_test_hz, f_model_hz, df_pct, mac) and the max |df| in percent (None for
+    a configuration none of whose modes pairs)."""
     _, _, states = build_equations(configs, p)
     out = []
     for cfg, st in zip(configs, states):
         pairs = []
-        for k, (u, fa) in enumerate(zip(st["used"], st["f_a"])):
+        for k, (u, fa) in enumerate(zip(st["used"], st.get("f_a", []))):
             ft = float(cfg.f_x[u])
             pairs.append({"test_mode": int(u) + 1, "model_mode": int(st["pairs"][u]) + 1 - cfg.n_rigid,
                           "f_test_hz": ft, "f_model_hz": float(fa), "df_pct": 100.0 * (float(fa) - ft) / ft,
                           "mac": None if st.get("mac") is None else float(st["mac"][k])})
         out.append({"configuration": cfg.name, "pairs": pairs,
-                    "max_freq_error_pct": max(abs(q["df_pct"]) for q in pairs)})
+                    "max_freq_error_pct": max(abs(q["df_pct"]) for q in pairs) if pairs else None})
     return out
 
 
@@ -27,9 +35,52 @@ def run(problem, configs, solver: str = "ls", check=None, **kwargs):
     (UpdateResult, before, after), before/after from :func:`correlation_state` on ``check`` (default
     ``configs``; give the full-model configurations of :meth:`~.problem.UpdateProblem.configuration`
     when updating on :meth:`~.problem.UpdateProblem.mode_configurations`). ``kwargs`` go to
-    :func:`pcbdyn.updating.iteration.update`."""
+    :func:`pcbdyn.updating.iteration.update` (``progress``, ``max_iter``, ...). The solvers' warnings
+    are not printed: :func:`outcome` says what they meant with the parameters named."""
     check = configs if check is None else check
     before = correlation_state(check, problem.p0)
-    res = update(configs, problem.p0, solver=solver, bounds=problem.bounds, log_scale=problem.log_scale, **kwargs)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RankDeficiencyWarning)
+        res = update(configs, problem.p0, solver=solver, bounds=problem.bounds, log_scale=problem.log_scale, **kwargs)
     after = correlation_state(check, res.p)
     return res, before, after
+
+
+def _combination(v, names) -> str:
+    big = np.argsort(-np.abs(v))[:4]
+    big = big[np.abs(v[big]) > 0.1 * np.abs(v).max()]
+    return " and ".join(f"{names[i]} ({'+' if v[i] * v[big[0]] > 0 else '-'})" for i in big)
+
+
+def outcome(problem, res, before, after) -> dict:
+    """What an update did, in the user's terms: ``status`` ("converged", "stopped on bounds", "error grew",
+    "rank-deficient", "diverged" or "not converged": the first that applies of error grew, stopped on
+    bounds, rank-deficient, diverged, not converged, converged), and ``details``: parameters at their
+    bounds, configurations whose error grew (before -> after), parameter combinations the equations
+    did not determine at the last solve, configurations set aside because no mode paired."""
+    lo, hi = problem.bounds
+    bounds = {n: "lower" if np.isclose(v, a, rtol=1e-6) else "upper" for n, v, a, b in
+              zip(problem.names, res.p, lo, hi) if np.isclose(v, a, rtol=1e-6) or np.isclose(v, b, rtol=1e-6)}
+    worse = [(b["configuration"], b["max_freq_error_pct"], a["max_freq_error_pct"]) for b, a in zip(before, after)
+             if None not in (b["max_freq_error_pct"], a["max_freq_error_pct"])
+             and a["max_freq_error_pct"] > b["max_freq_error_pct"] * (1 + 1e-9)]
+    sol = res.solution
+    undetermined = [] if sol is None or not sol.rank_deficient else [
+        _combination(v, problem.names) for v in sol.null_space.T[:3]]
+    set_aside = sorted({n for h in res.history for n in h.get("set_aside", [])})
+    details = [f"{n} stopped at its {side} bound" for n, side in bounds.items()]
+    details += [f"configuration {c}: max |df| grew from {b:.2f} % to {a:.2f} %" for c, b, a in worse]
+    details += [f"the data do not determine {c} separately (rank-deficient equations)" for c in undetermined]
+    details += [f"configuration {c}: no mode paired at some iteration; set aside there" for c in set_aside]
+    if worse:
+        status = "error grew"
+    elif bounds:
+        status = "stopped on bounds"
+    elif undetermined:
+        status = "rank-deficient"
+    elif res.diverged:
+        status = "diverged"
+    else:
+        status = "converged" if res.converged else "not converged"
+    return {"status": status, "details": details, "at_bounds": bounds, "worse": [c for c, _, _ in worse],
+            "undetermined": undetermined, "set_aside": set_aside}

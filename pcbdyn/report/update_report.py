@@ -1,5 +1,5 @@
-"""Reports of a model update: parameter table, before/after correlation tables, iteration plots and
-where the updated board.toml goes (next to the original, never over it)."""
+"""Reports of a model update: parameter table, before/after correlation tables, progress lines,
+iteration plots and the JSON."""
 
 from __future__ import annotations
 
@@ -8,6 +8,9 @@ from pathlib import Path
 import numpy as np
 
 from ..units import from_si
+
+#: SI unit of the JSON values for the display units the input files use (others are SI already)
+SI_UNITS = {"mm": "m", "g": "kg"}
 
 
 def parameter_rows(problem, p) -> list:
@@ -29,11 +32,15 @@ def format_parameters(rows) -> str:
     return "\n".join(out)
 
 
+def _pct(v) -> str:
+    return "(none paired)" if v is None else f"{v:.2f} %"
+
+
 def format_correlation(before, after) -> str:
     """Per configuration: test mode, f_test, f_model and df before and after, MAC after."""
     out = []
     for b, a in zip(before, after):
-        out.append(f"[{b['configuration']}] max |df|: {b['max_freq_error_pct']:.2f} % -> {a['max_freq_error_pct']:.2f} %")
+        out.append(f"[{b['configuration']}] max |df|: {_pct(b['max_freq_error_pct'])} -> {_pct(a['max_freq_error_pct'])}")
         out.append(f"{'test':>5} {'f_test':>9} {'model':>6} {'f_before':>9} {'df [%]':>8} {'model':>6} {'f_after':>9} "
                    f"{'df [%]':>8} {'MAC':>6}")
         after_by = {q["test_mode"]: q for q in a["pairs"]}
@@ -63,7 +70,7 @@ def plot_iterations(path, problem, result) -> None:
     err = [h["max_freq_error_pct"] for h in result.history]
     ax[1].plot(it, err, "o-")
     ax[1].set(xlabel="iteration", ylabel="max |df| [%]", title="max frequency error")
-    ax[2].semilogy(it, [h["condition_stacked"] for h in result.history], "o-")
+    ax[2].semilogy(it, [_finite(h["condition_stacked"]) for h in result.history], "o-")
     ax[2].set(xlabel="iteration", ylabel="condition number", title="stacked equations")
     fig.tight_layout()
     Path(path).parent.mkdir(parents=True, exist_ok=True)
@@ -71,6 +78,35 @@ def plot_iterations(path, problem, result) -> None:
     plt.close(fig)
 
 
-def updated_board_path(board_toml) -> Path:
-    p = Path(board_toml)
-    return p.with_name(f"{p.stem}.updated{p.suffix}")
+def _finite(v):
+    """A number for JSON and plots: None for NaN or infinity (an undefined condition number)."""
+    return float(v) if v is not None and np.isfinite(v) else None
+
+
+def progress_line(h: dict) -> str:
+    """One line per iteration of the update (its history entry ``h``)."""
+    err = "" if h["max_freq_error_pct"] is None else f"max |df| {h['max_freq_error_pct']:.3f} %, "
+    aside = f"; set aside: {', '.join(h['set_aside'])}" if h.get("set_aside") else ""
+    return f"    iteration {h['iteration']}: {err}residual {h['residual_norm']:.4g}{aside}"
+
+
+def _summary(states) -> dict:
+    errors = [s["max_freq_error_pct"] for s in states if s["max_freq_error_pct"] is not None]
+    return {"max_freq_error_pct": max(errors) if errors else None, "configurations": states,
+            "pairs": [q for s in states for q in s["pairs"]]}
+
+
+def update_json(problem, res, rows, before, after, what: dict, method: str, solver: str, dst) -> dict:
+    """The JSON of ``pcbdyn update`` (values in SI; ``unit`` is the SI unit of each parameter)."""
+    return {
+        "parameters": {r["name"]: {"initial": float(v0), "updated": float(v), "unit": SI_UNITS.get(r["unit"], r["unit"]),
+                                   "display_unit": r["unit"], "change_pct": r["change_pct"], "bound_hit": r["bound_hit"]}
+                       for r, v0, v in zip(rows, problem.p0, res.p)},
+        "before": _summary(before), "after": _summary(after), "iterations": res.iterations,
+        "converged": bool(res.converged), "reason": res.reason, "status": what["status"],
+        "status_details": what["details"], "method": method, "solver": solver,
+        "history": [{"iteration": h["iteration"], "p": np.asarray(h["p"]).tolist(),
+                     "max_freq_error_pct": h["max_freq_error_pct"], "condition_stacked": _finite(h["condition_stacked"]),
+                     "rank": h.get("rank"), "set_aside": h.get("set_aside", [])} for h in res.history],
+        "updated_board": str(dst),
+    }

@@ -134,8 +134,9 @@ def _state(cfg: Configuration, p, pairing):
         phi_am = Phi if cfg.P is None else np.asarray(cfg.P @ Phi)
         pairs = np.asarray((cfg.pairing or pairing or mac_pairing)(f_a, phi_am, f_x, cfg.phi_x), int)
         used = np.flatnonzero(pairs >= 0)
-        if used.size == 0:
-            raise ValueError(f"configuration {cfg.name!r}: no measured mode found an analytical partner")
+        if used.size == 0:  # set aside at this state: nothing of it pairs
+            out.update(set_aside=True, pairs=pairs, used=used)
+            return out
         ia = pairs[used]
         out.update(lam=lam[ia], Phi=Phi[:, ia], f_a=f_a[ia], pairs=pairs, used=used,
                    sigma=frequency_residue(f_a[ia], f_x[used]),
@@ -223,14 +224,20 @@ def build_equations(configs, p, pairing: Callable | None = None, stack_reduce: b
 
     Returns (Block, blocks, states): the stacked block (eq. 6.4; SVD-reduced per configuration
     with ``stack_reduce``, eq. 6.6) for a solver or for localisation (:func:`~.subset.tls_qrf`),
-    the unweighted block of each configuration, and each configuration's state (paired
-    frequencies "f_a", "pairs", "mac", frequency residue "sigma", "max_err_pct").
+    the unweighted block of each configuration that pairs, and each configuration's state (paired
+    frequencies "f_a", "pairs", "mac", frequency residue "sigma", "max_err_pct"; "set_aside" for a
+    configuration none of whose measured modes found a partner at p: it is left out of the equations
+    there, as a mode without a partner is left out of its configuration's, and not an error).
     """
     configs = [configs] if isinstance(configs, Configuration) else list(configs)
     p = np.asarray(p, float)
     states = [_state(c, p, pairing) for c in configs]
-    blocks = [_block(c, st, p) for c, st in zip(configs, states)]
-    stacked = stack([_weighted(c, blk) for c, blk in zip(configs, blocks)], reduce=stack_reduce)
+    active = [(c, st) for c, st in zip(configs, states) if not st.get("set_aside")]
+    if not active:
+        raise ValueError("no measured mode of any configuration found an analytical partner; check that test and "
+                         "model are the same structure and configuration, and the points' frame and units")
+    blocks = [_block(c, st, p) for c, st in active]
+    stacked = stack([_weighted(c, blk) for (c, _), blk in zip(active, blocks)], reduce=stack_reduce)
     return stacked, blocks, states
 
 
@@ -238,7 +245,7 @@ def update(
     configs, p0, *, solver: str = "ls", bounds=None, fixed=(), log_scale=(), pairing: Callable | None = None,
     max_iter: int = 30, use_line_search: bool | None = None, stack_reduce: bool = False,
     tol_freq_pct: float = 1.0, tol_param_pct: float = 0.5, tol_sigma_pct: float = 0.01,
-    patience: int = 3, solver_options: dict | None = None,
+    patience: int = 3, solver_options: dict | None = None, progress: Callable | None = None,
 ) -> UpdateResult:
     """Iterate sensitivity-based updating until convergence (thesis eqs. 4.49-4.52, 7.2-7.6).
 
@@ -260,7 +267,9 @@ def update(
     solver_options: keyword arguments of the "ls"/"tls" solver (rank, rtol, jump, t_b, ...), or
     alpha0/factor of the Bayesian schedule. Each history entry holds p, the frequency residue,
     max frequency error, ||b||, pairs, MAC of the pairs, condition numbers per configuration and
-    stacked, and the rank, message and step of the solve made from it.
+    stacked, and the rank, message and step of the solve made from it; ``set_aside`` names the
+    configurations none of whose modes paired at that iteration. ``progress(entry)`` is called with
+    each history entry as it is made (long runs report per iteration).
     """
     configs = [configs] if isinstance(configs, Configuration) else list(configs)
     if solver not in SOLVERS:
@@ -297,17 +306,21 @@ def update(
             diverged, reason = True, f"diverged: the model could not be evaluated after step {it} ({exc})"
             break
         raw_norm = float(np.linalg.norm(np.concatenate([blk.b for blk in blocks])))
-        sigma = float(np.sqrt(np.mean([st["sigma"] ** 2 for st in states]))) if have_f else None
+        paired = [st for st in states if not st.get("set_aside")]
+        sigma = float(np.sqrt(np.mean([st["sigma"] ** 2 for st in paired]))) if have_f else None
         obj = sigma if have_f else raw_norm
         A = A[:, free]
         entry = {
             "iteration": it, "p": p.copy(), "sigma": sigma, "residual_norm": raw_norm,
-            "max_freq_error_pct": max(st["max_err_pct"] for st in states) if have_f else None,
+            "max_freq_error_pct": max(st["max_err_pct"] for st in paired) if have_f else None,
             "pairs": [st.get("pairs") for st in states], "mac": [st.get("mac") for st in states],
+            "set_aside": [c.name for c, st in zip(configs, states) if st.get("set_aside")],
             "condition_per_configuration": [condition_number(blk.A[:, free]) for blk in blocks],
             "condition_stacked": condition_number(A),
         }
         history.append(entry)
+        if progress is not None:
+            progress(entry)
         if obj < best_obj:
             best, best_obj, worse = it, obj, 0
         else:
@@ -343,7 +356,8 @@ def update(
             def residue(bt):
                 trial = stepped(p, bt * x)
                 try:
-                    return float(np.sqrt(np.mean([_state(c, trial, pairing)["sigma"] ** 2 for c in configs])))
+                    states = [_state(c, trial, pairing) for c in configs]
+                    return float(np.sqrt(np.mean([st["sigma"] ** 2 for st in states if not st.get("set_aside")])))
                 except (np.linalg.LinAlgError, ValueError, ArithmeticError):
                     return np.inf  # the trial model cannot be solved: not a candidate
             beta, _ = line_search(residue)

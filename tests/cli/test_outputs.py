@@ -1,0 +1,93 @@
+"""What a run writes and where (issue 21): output places checked before any work, ``--json -`` on the
+standard output, results in ``--out`` and never over an earlier file beside the input without saying
+so, and update's status in the user's terms. Each of these failed before the change."""
+
+import json
+import re
+import shutil
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from pcbdyn.cli import main
+
+ROOT = Path(__file__).resolve().parents[2]
+CARD = ROOT / "examples" / "six_part_card"
+TABLE = CARD / "measured_frequencies_table_7_2.csv"
+
+
+def run(args):
+    return CliRunner().invoke(main, [str(a) for a in args])
+
+
+@pytest.fixture
+def card(tmp_path):
+    shutil.copy(CARD / "board.toml", tmp_path / "board.toml")
+    return tmp_path / "board.toml"
+
+
+@pytest.mark.parametrize("option", ["--json", "--out"])
+def test_an_output_under_a_file_is_refused_before_any_work(card, tmp_path, option):
+    (tmp_path / "a_file").write_text("x")
+    target = tmp_path / "a_file" / ("r.json" if option == "--json" else "dir")
+    r = run(["update", card, "--frequencies", TABLE, "--max-iter", "1", option, target])
+    assert r.exit_code == 2
+    assert "a_file is a file, not a folder" in r.output and "building the models" not in r.output
+
+
+def test_json_dash_writes_json_alone_on_stdout(card):
+    r = run(["build", card, "--no-pictures", "--json", "-"])
+    assert r.exit_code == 0, r.output
+    data = json.loads(r.stdout)
+    assert [m["n"] for m in data["modes"]] == list(range(1, 8)) and not (card.parent / "-").exists()
+    assert "frequency [Hz]" in r.stderr  # the table goes to stderr
+
+
+def test_a_study_whose_out_is_a_file_fails_before_the_shots(tmp_path):
+    (tmp_path / "taken").write_text("x")
+    spec = tmp_path / "study.toml"
+    spec.write_text('[study]\ncase = "simulated_free_pcb"\nlevels_pct = [0]\nshots = 1\nout = "taken"\n')
+    r = run(["study", spec, "--quiet"])
+    assert r.exit_code == 2 and "[study] out = taken: is a file" in r.output and "building case" not in r.output
+
+
+def test_update_reports_bounds_and_worse_configurations_on_the_thesis_data(card, tmp_path):
+    """Table 7.2 data, four parameters: two end on their bounds and configuration c3 ends worse than it
+    started: the status says so instead of "converged" (it said converged before)."""
+    js = tmp_path / "u.json"
+    r = run(["update", card, "--frequencies", TABLE, "--out", tmp_path / "out", "--json", js])
+    assert r.exit_code == 0, r.output
+    data = json.loads(js.read_text())
+    assert data["status"] == "error grew"
+    details = " ".join(data["status_details"])
+    assert "t_PGA stopped at its lower bound" in details and "E_board stopped at its upper bound" in details
+    assert "configuration c3: max |df| grew" in details
+    assert "error grew after" in r.output and "note: t_PGA stopped" in r.output
+    assert "iteration 1:" in r.output and "on 3 test configuration(s)" in r.output
+    assert all(h["condition_stacked"] is None or h["condition_stacked"] > 0 for h in data["history"])
+    assert Path(data["updated_board"]) == tmp_path / "out" / "board.updated.toml"
+
+
+def test_an_earlier_updated_board_beside_the_input_is_kept(card):
+    args = ["update", card, "--frequencies", TABLE, "--params", "t_PGA", "--max-iter", "1"]
+    assert run(args).exit_code == 0
+    first = (card.parent / "board.updated.toml").read_text()
+    r = run(args)
+    assert r.exit_code == 0 and "board.updated.2.toml" in r.output
+    assert (card.parent / "board.updated.toml").read_text() == first
+    assert run(args + ["--force"]).exit_code == 0 and not (card.parent / "board.updated.3.toml").exists()
+
+
+def test_help_shows_the_name_file_syntax_and_the_choices():
+    for cmd in ("update", "localize", "diagnose"):
+        assert "NAME=FILE" in run([cmd, "--help"]).output
+    assert "point_mass, point_inertia, ground_spring" in re.sub(r"\s+", " ", run(["diagnose", "--help"]).output)
+
+
+@pytest.mark.parametrize("size,expect", [("60 mm", "elements across"), ("0.3 mm", "DOFs, more than the limit")])
+def test_a_mesh_size_far_off_the_board_gets_the_estimate(card, size, expect):
+    text = card.read_text().replace('mesh_size = "6.75 mm"', f'mesh_size = "{size}"')
+    card.write_text(text)
+    r = run(["build", card, "--no-pictures"])
+    assert r.exit_code == 2 and expect in r.output and "board.mesh_size" in r.output
