@@ -91,3 +91,18 @@ def test_a_mesh_size_far_off_the_board_gets_the_estimate(card, size, expect):
     card.write_text(text)
     r = run(["build", card, "--no-pictures"])
     assert r.exit_code == 2 and expect in r.output and "board.mesh_size" in r.output
+
+
+def test_a_bug_is_one_line_with_a_log_not_a_traceback(card, monkeypatch):
+    import pcbdyn.problems
+
+    def broken(path):
+        raise RuntimeError("something inside broke")
+
+    monkeypatch.setattr(pcbdyn.problems, "load_structure", broken)
+    r = run(["build", card, "--no-pictures"])
+    assert r.exit_code == 3 and "Traceback" not in r.output
+    line = r.output.strip()
+    assert "internal error (a bug in pcbdyn" in line and "\n" not in line
+    log = Path(line.rsplit("the traceback is in ", 1)[1])
+    assert "something inside broke" in log.read_text() and "Traceback" in log.read_text()
