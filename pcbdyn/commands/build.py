@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from .common import checked_outputs, done, fail, solve_structure, step
+from .common import done, fail, folder_outputs, solve_structure, step
 
 
 def analyse(board, config, out: Path | None, pictures: bool = True, written: list | None = None) -> dict:
@@ -59,13 +59,9 @@ def analyse(board, config, out: Path | None, pictures: bool = True, written: lis
 @click.argument("board_toml", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.option("--config", "config", default=None, help="configuration name from [[configurations]]")
 @click.option("--all-configs", is_flag=True, help="the base model and every configuration")
-@click.option("--out", "out", type=click.Path(file_okay=False, path_type=Path), default=None,
-              help="folder for modes CSV, VTU (ParaView) and PNG mode shapes")
-@click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
-              help="write frequencies, mass and DOF count as JSON")
 @click.option("--no-pictures", is_flag=True, help="skip the PNG mode-shape pictures")
-@click.option("--html", is_flag=True, help="also write the self-contained page report.html in --out")
-@checked_outputs()
+@folder_outputs("folder for modes CSV, VTU (ParaView) and PNG mode shapes",
+                "write frequencies, mass and DOF count as JSON", html=True)
 def command(board_toml, config, all_configs, out, json_path, no_pictures, html):
     """Predict a board's resonances: frequencies, effective masses in z, mode shapes."""
     from ..domain import StructureError

@@ -170,3 +170,23 @@ def result_path(out, source, suffix: str, force: bool = False) -> Path:
         path = source.with_name(f"{source.stem}.{suffix}.{k}{source.suffix}")
         k += 1
     return path
+
+
+def folder_outputs(out_help: str, json_help: str, html: bool = False, force: str | None = None):
+    """The output options of a command that writes into a folder: ``--out`` (``out_help``), ``--force``
+    (when ``force`` says what it replaces), ``--json`` (``json_help``; ``-`` for the standard output) and,
+    with ``html``, ``--html``; all checked before any work (:func:`checked_outputs`)."""
+
+    def decorate(command):
+        command = checked_outputs()(command)
+        if html:
+            command = click.option("--html", is_flag=True, help="also write the self-contained page report.html in "
+                                                                "--out")(command)
+        command = click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
+                               help=f"{json_help} ('-': standard output)")(command)
+        if force:
+            command = click.option("--force", is_flag=True, help=force)(command)
+        return click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=None,
+                            help=out_help)(command)
+
+    return decorate

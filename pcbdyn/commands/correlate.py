@@ -9,7 +9,7 @@ from pathlib import Path
 
 import click
 
-from .common import PROBE_TOL, checked_outputs, done, fail, solve_structure, step
+from .common import PROBE_TOL, done, fail, folder_outputs, solve_structure, step
 
 @click.command("correlate")
 @click.argument("board_toml", type=click.Path(exists=True, dir_okay=False, path_type=Path))
@@ -19,12 +19,8 @@ from .common import PROBE_TOL, checked_outputs, done, fail, solve_structure, ste
               help="pairs with a lower MAC are dropped (their test modes are reported unpaired)")
 @click.option("--modes", "n_modes", type=click.IntRange(min=1), default=None,
               help="model modes to pair with (default: the board's [analysis] modes, at least 1.5 x the test's)")
-@click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=None,
-              help="folder for pairs.csv, comac.csv and the PNG pictures")
-@click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
-              help="write pairs, unpaired test modes and COMAC as JSON")
-@click.option("--html", is_flag=True, help="also write the self-contained page report.html in --out")
-@checked_outputs()
+@folder_outputs("folder for pairs.csv, comac.csv and the PNG pictures",
+                "write pairs, unpaired test modes and COMAC as JSON", html=True)
 def command(board_toml, test_uff, config, min_mac, n_modes, out, json_path, html):
     """Correlate a board model with a modal test (UFF): pair table, COMAC, pictures."""
     from ..correlation import correlate

@@ -15,7 +15,7 @@ from pathlib import Path
 import click
 
 from ..diagnosis import KINDS
-from .common import checked_outputs, done, fail, measured_configurations, parse_noise, result_path, step
+from .common import done, fail, folder_outputs, measured_configurations, parse_noise, result_path, step
 
 
 @click.command("diagnose")
@@ -28,13 +28,9 @@ from .common import checked_outputs, done, fail, measured_configurations, parse_
 @click.option("--kinds", default=None, help=f"comma-separated catalogue kinds to search (default: all): {', '.join(KINDS)}")
 @click.option("--max-effects", type=click.IntRange(min=1), default=3, show_default=True)
 @click.option("--mesh-size", default=None, help="element size, e.g. '5 mm' (default: the board's)")
-@click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=None,
-              help="folder for the board with the effects declared, the evidence map and tables")
-@click.option("--force", is_flag=True, help="replace an earlier <board>.diagnosed.toml beside the board (default: a "
-                                            "numbered name)")
-@click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
-              help="write effects, before/after and statistics as JSON ('-': standard output)")
-@checked_outputs()
+@folder_outputs("folder for the board with the effects declared, the evidence map and tables",
+                "write effects, before/after and statistics as JSON",
+                force="replace an earlier <board>.diagnosed.toml beside the board (default: a numbered name)")
 def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size, out, force, json_path):
     """Find the effects a board model lacks from modal tests: TEST_UFF (with mode shapes) of the base
     configuration and NAME=FILE for each perturbed configuration of board.toml (e.g. c2=test2.uff)."""

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import click
 
-from .common import checked_outputs, done, fail, measured_configurations, parse_extra, parse_noise, step
+from .common import done, fail, folder_outputs, measured_configurations, parse_extra, parse_noise, step
 
 METHOD_CHOICES = ["tls-qrf", "svd-qr", "qr", "min-norm"]
 
@@ -37,11 +37,8 @@ METHOD_CHOICES = ["tls-qrf", "svd-qr", "qr", "min-norm"]
                    "b is weighted for TLS by the errors it makes in the equations (default: eq. 4.43, k_A = k_b)")
 @click.option("--matching", type=click.Choice(["reduce", "expand"]), default="reduce", show_default=True,
               help="Guyan-reduce the model to the measured DOFs, or expand the measured shapes")
-@click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=None,
-              help="folder for the evidence figure and the FBM map (PNG)")
-@click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
-              help="write the selection and its evidence as JSON ('-': standard output)")
-@checked_outputs()
+@folder_outputs("folder for the evidence figure and the FBM map (PNG)",
+                "write the selection and its evidence as JSON")
 def command(board_toml, test_uff, config_tests, method, eq_type, params, rank, alpha, noise, matching, out,
             json_path):
     """Localise model errors among a structure's [[parameters]] from modal tests: TEST_UFF of the base

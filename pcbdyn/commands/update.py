@@ -28,7 +28,7 @@ from pathlib import Path
 
 import click
 
-from .common import checked_outputs, done, fail, measured_configurations, parse_extra, result_path, step
+from .common import done, fail, folder_outputs, measured_configurations, parse_extra, result_path, step
 
 def parse_frf_freqs(text) -> list:
     """'150,230 Hz' or '150,230' -> frequencies [Hz]."""
@@ -63,13 +63,9 @@ def parse_frf_freqs(text) -> list:
 @click.option("--tol", "tol_pct", type=float, default=0.1, show_default=True,
               help="stop when the max frequency error is below this percentage (eq. 7.2)")
 @click.option("--mesh-size", default=None, help="override board.mesh_size, e.g. '10 mm'")
-@click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=None,
-              help="folder for board.updated.toml, the iteration plot and tables (default: board.updated.toml "
-                   "beside the board)")
-@click.option("--force", is_flag=True, help="replace an earlier board.updated.toml (default: a numbered name)")
-@click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
-              help="write parameters, status, before/after and history as JSON ('-': standard output)")
-@checked_outputs()
+@folder_outputs("folder for board.updated.toml, the iteration plot and tables (default: board.updated.toml beside "
+                "the board)", "write parameters, status, before/after and history as JSON",
+                force="replace an earlier board.updated.toml beside the board (default: a numbered name)")
 def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping, solver, params, max_iter, tol_pct,
             mesh_size, out, force, json_path):
     """Update a structure's [[parameters]] against modal tests: TEST_UFF for the base configuration and

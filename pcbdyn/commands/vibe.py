@@ -8,7 +8,7 @@ from pathlib import Path
 
 import click
 
-from .common import PROBE_TOL, checked_outputs, done, fail, solve_structure, step
+from .common import PROBE_TOL, done, fail, folder_outputs, solve_structure, step
 
 #: at most this many modes are computed (all of them up to twice the top input frequency otherwise)
 MAX_MODES = 150
@@ -32,12 +32,8 @@ MAX_MODES = 150
 @click.option("--chassis-freq", default=None, help="the chassis resonance, e.g. '80 Hz': checks the octave rule")
 @click.option("--config", default=None, help="configuration name from [[configurations]]")
 @click.option("--exclude", multiple=True, help="a part reference to leave out of Steinberg's check (repeatable)")
-@click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=None,
-              help="folder for parts.csv, modes.csv, response_psd.csv, board_map.png, response_psd.png")
-@click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
-              help="write input_grms, modes[] and parts[] (ref, z_rms_m, z_allow_m, ratio, life_h, ...) as JSON")
-@click.option("--html", is_flag=True, help="also write the self-contained page report.html in --out")
-@checked_outputs()
+@folder_outputs("folder for parts.csv, modes.csv, response_psd.csv, board_map.png, response_psd.png",
+                "write input_grms, modes[] and parts[] (ref, z_rms_m, z_allow_m, ratio, life_h, ...) as JSON", html=True)
 def command(board_toml, psd_text, sine_csv, sweep_rate, sweeps, damping_text, duration, axis, chassis_freq, config,
             exclude, out, json_path, html):
     """Judge a board under a random (and sine) vibration specification: RMS responses at every part,
