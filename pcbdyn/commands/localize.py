@@ -85,6 +85,7 @@ def command(board_toml, test_uff, config_tests, method, eq_type, params, rank, a
         from ..report.localisation_plots import localisation_figure, save_map
         from ..report.manifest import settle
 
+        out.mkdir(parents=True, exist_ok=True)
         written = [out / "localisation.png"]
         localisation_figure(written[0], tls, problem.names)
         measured = tests[0][1]

@@ -12,6 +12,7 @@ study.toml::
     rank = -1                          # optional: k, or -k = n_params - k; default automatic
     seed = 0
     workers = 2                        # default: all cores
+    scheduler = "tcp://host:8786"      # optional: run the shots on a Dask cluster (or --scheduler)
     out = "study_out"                  # optional: CSV + PNG (relative to the toml)
 
     [case]                             # optional case options
@@ -40,7 +41,8 @@ import click
 
 from .common import check_writable, checked_outputs
 
-KEYS = {"case", "levels_pct", "shots", "methods", "equations", "rank", "seed", "workers", "out", "board", "points"}
+KEYS = {"case", "levels_pct", "shots", "methods", "equations", "rank", "seed", "workers", "scheduler", "out", "board",
+        "points"}
 CASE_KEYS = {
     "simulated_free_pcb": {"nu", "n_modes", "errors_mm", "excitation_node", "perturbation_node", "perturbation_kg"},
     "board": {"n_modes", "params"},
@@ -99,7 +101,7 @@ def read_spec(path: Path) -> dict:
     return {
         "case": case, "case_options": opts, "levels": [float(v) for v in levels], "shots": shots,
         "methods": list(methods), "equations": list(s.get("equations", ["qms"])), "rank": rank,
-        "seed": int(s.get("seed", 0)), "workers": s.get("workers"),
+        "seed": int(s.get("seed", 0)), "workers": s.get("workers"), "scheduler": s.get("scheduler"),
         "out": None if out is None else (path.parent / out),
     }
 
@@ -107,10 +109,12 @@ def read_spec(path: Path) -> dict:
 @click.command("study")
 @click.argument("study_toml", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path),
-              help="write the summary and every shot's result as JSON")
+              help="write the summary and every shot's result as JSON ('-': standard output)")
+@click.option("--scheduler", default=None, help="a Dask scheduler address (tcp://host:8786): the shots run on that "
+                                                "cluster instead of local processes (same results)")
 @click.option("--quiet", is_flag=True, help="no progress bar")
 @checked_outputs(folders=())
-def command(study_toml: Path, json_path: Path | None, quiet: bool):
+def command(study_toml: Path, json_path: Path | None, scheduler: str | None, quiet: bool):
     """Judge localisation methods by their success ratio over noisy random shots (thesis eq. 5.65-5.66)."""
     from ..report.files import write_json, write_text
     from ..testdata import TestDataError
@@ -125,7 +129,8 @@ def command(study_toml: Path, json_path: Path | None, quiet: bool):
         case = CASES[spec["case"]](**spec["case_options"])
         done(t0)
         df = run_study(case, spec["levels"], spec["shots"], spec["methods"], spec["equations"], seed=spec["seed"],
-                       rank=spec["rank"], workers=spec["workers"], progress=not quiet)
+                       rank=spec["rank"], workers=spec["workers"], progress=not quiet,
+                       scheduler=scheduler or spec["scheduler"])
     except (ValueError, TypeError, KeyError, TestDataError, StructureError) as exc:
         fail(f"{study_toml.name}: {str(exc).strip(chr(34) + chr(39))}")
     summary = summarise(df)

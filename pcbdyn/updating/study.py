@@ -24,13 +24,12 @@ Methods (all see the same noisy equations of a shot):
 
 from __future__ import annotations
 
-import os
 import warnings
-from concurrent.futures import ProcessPoolExecutor, as_completed
 
 import numpy as np
 import pandas as pd
 
+from ..parallel import run_jobs
 from .solvers import RankDeficiencyWarning, solve_ls
 from .subset import qr_basic_solution, svd_qr, threshold_selection, tls_qrf
 from .success import add_noise, success_ratio, success_statistics
@@ -94,16 +93,8 @@ class StudyCase:
         return self.build(kind, self.measure(kind, level_pct, rng))
 
 
-_CASE = None
-
-
-def _init(case):
-    global _CASE
-    _CASE = case
-
-
-def _run_batch(kind, level, shots, methods, seed, rank, case=None):
-    case = _CASE if case is None else case
+def _run_batch(kind, level, shots, methods, seed, rank, case):
+    """The rows of ``shots`` of one equation type and noise level (see :func:`run_study`)."""
     rows = []
     for shot in shots:
         key = [seed, case.kinds.index(kind), int(round(level * 1e6)), shot]
@@ -128,12 +119,13 @@ def _run_batch(kind, level, shots, methods, seed, rank, case=None):
 
 def run_study(case, levels, shots: int = 20, methods=("tls-qrf", "svd-qr", "min-norm"), kinds=("qms",),
               seed: int = 0, rank: int | None = None, workers: int | None = None, progress: bool = True,
-              batch: int = 5) -> pd.DataFrame:
+              batch: int = 5, scheduler=None) -> pd.DataFrame:
     """Localise on ``shots`` noisy data sets per noise level (%) and equation type with every
     method; one DataFrame row per (equations, level_pct, shot, method). Shot noise is seeded
-    from (seed, equation type, level, shot), so results do not depend on ``workers``.
-    ``workers``: processes (default all cores; 1 runs in this process). ``rank``: None
-    (automatic), k >= 0 or k < 0 meaning n_params + k, for the rank-based methods."""
+    from (seed, equation type, level, shot), so results do not depend on where the shots ran.
+    ``workers``: local processes (default all cores; 1 runs in this process); ``scheduler``: a Dask
+    scheduler address to run the batches on a cluster instead (:func:`pcbdyn.parallel.run_jobs`).
+    ``rank``: None (automatic), k >= 0 or k < 0 meaning n_params + k, for the rank-based methods."""
     for m in methods:
         if m not in METHODS:
             raise ValueError(f"methods: {m!r} is unknown; choose from {', '.join(METHODS)}")
@@ -145,21 +137,12 @@ def run_study(case, levels, shots: int = 20, methods=("tls-qrf", "svd-qr", "min-
     jobs = [(k, float(lv), list(range(s, min(s + batch, shots))), tuple(methods), seed, rank)
             for k in kinds for lv in levels for s in range(0, shots, batch)]
     total = len(kinds) * len(levels) * shots
-    workers = (os.cpu_count() or 1) if workers is None else int(workers)
     from tqdm import tqdm
 
     rows = []
     with tqdm(total=total, unit="shot", disable=not progress, desc="localisation study") as bar:
-        if workers <= 1:
-            for job in jobs:
-                rows += _run_batch(*job, case=case)
-                bar.update(len(job[2]))
-        else:
-            with ProcessPoolExecutor(max_workers=workers, initializer=_init, initargs=(case,)) as pool:
-                futures = {pool.submit(_run_batch, *job): job for job in jobs}
-                for fut in as_completed(futures):
-                    rows += fut.result()
-                    bar.update(len(futures[fut][2]))
+        for _, got in run_jobs(_run_batch, jobs, case, workers, scheduler, done=lambda job: bar.update(len(job[2]))):
+            rows += got
     df = pd.DataFrame(rows)
     return df.sort_values(["equations", "method", "level_pct", "shot"], ignore_index=True)
 

@@ -1,0 +1,66 @@
+"""Running independent jobs (the shots of a study, the candidates of a diagnosis scan) in this process,
+in local worker processes, or on a Dask cluster when a scheduler address is given.
+
+Each job is ``fn(*args, shared)``: ``shared`` (a case, a residual) is sent to every worker once (the
+process pool's initializer, Dask's scatter), the arguments per job. Results come back as they finish;
+callers that need an order sort them, and jobs are seeded by their own arguments, so the results do not
+depend on where they ran.
+"""
+
+from __future__ import annotations
+
+import os
+from concurrent.futures import ProcessPoolExecutor, as_completed
+
+_SHARED = None
+
+
+def _init(shared) -> None:
+    global _SHARED
+    _SHARED = shared
+
+
+def _call(fn, args):
+    return fn(*args, _SHARED)
+
+
+def run_jobs(fn, jobs, shared, workers: int | None = None, scheduler: str | None = None, done=None):
+    """Yield ``(args, fn(*args, shared))`` for every ``args`` of ``jobs``, as they finish. ``scheduler``: a
+    Dask scheduler address ("tcp://host:8786"), or a ``distributed.Client``; otherwise ``workers`` local
+    processes (default: the cores; 1: in this process). ``done(args)`` is called after each job."""
+    jobs = list(jobs)
+    if scheduler is not None:
+        yield from _on_dask(fn, jobs, shared, scheduler, done)
+        return
+    workers = (os.cpu_count() or 1) if workers is None else int(workers)
+    if workers <= 1 or len(jobs) <= 1:
+        for args in jobs:
+            out = fn(*args, shared)
+            if done:
+                done(args)
+            yield args, out
+        return
+    with ProcessPoolExecutor(max_workers=min(workers, len(jobs)), initializer=_init, initargs=(shared,)) as pool:
+        futures = {pool.submit(_call, fn, args): args for args in jobs}
+        for fut in as_completed(futures):
+            if done:
+                done(futures[fut])
+            yield futures[fut], fut.result()
+
+
+def _on_dask(fn, jobs, shared, scheduler, done):
+    try:
+        from distributed import Client, as_completed as dask_completed
+    except ImportError:  # pragma: no cover - a dependency of pcbdyn
+        raise RuntimeError("--scheduler needs the dask[distributed] package") from None
+    client = scheduler if isinstance(scheduler, Client) else Client(scheduler)
+    try:
+        remote = client.scatter(shared, broadcast=True)
+        futures = {client.submit(fn, *args, remote, pure=False): args for args in jobs}
+        for fut in dask_completed(futures):
+            if done:
+                done(futures[fut])
+            yield futures[fut], fut.result()
+    finally:
+        if client is not scheduler:
+            client.close()
