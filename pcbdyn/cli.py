@@ -14,7 +14,7 @@ from pathlib import Path
 import click
 
 from .commands import (build, correlate, diagnose, export, identify, import_kicad, localize, simulate_test, study,
-                       update, vibe)
+                       update, vibe, wedgelock)
 
 
 def _warning(message, category, filename, lineno, file=None, line=None):
@@ -43,6 +43,6 @@ def main():
     modal tests, update them and find what they lack."""
 
 
-for _module in (build, simulate_test, correlate, update, localize, study, diagnose, vibe, identify, import_kicad,
-                export):
+for _module in (build, simulate_test, correlate, update, wedgelock, localize, study, diagnose, vibe, identify,
+                import_kicad, export):
     main.add_command(_module.command)

@@ -76,6 +76,22 @@ def number_pair(text: str, option: str, unit: str | None = None) -> tuple:
     return tuple(out)
 
 
+def test_arguments(command):
+    """The inputs of a command that fits a structure to its tests: BOARD_TOML, TEST_UFF, NAME=FILE
+    configurations, or ``--frequencies FILE.csv``."""
+    from pathlib import Path
+
+    file = click.Path(exists=True, dir_okay=False, path_type=Path)
+    for decorate in reversed((
+            click.argument("board_toml", type=file), click.argument("test_uff", required=False, type=file),
+            click.argument("configs", nargs=-1),
+            click.option("--frequencies", "freq_csv", type=file, default=None,
+                         help="CSV of measured frequencies (configuration, mode, frequency_hz) instead of UFF files; "
+                              "test mode n pairs with model mode n"))):
+        command = decorate(command)
+    return command
+
+
 def parse_extra(items) -> list:
     """NAME=FILE arguments -> [(configuration name, Path)]."""
     from pathlib import Path

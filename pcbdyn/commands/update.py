@@ -24,11 +24,10 @@ modes is checked against its FRF peaks, paired by order. Damped data: frf-in wit
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import click
 
-from .common import done, fail, folder_outputs, measured_configurations, parse_extra, result_path, step
+from .common import (done, fail, folder_outputs, measured_configurations, parse_extra, result_path, step,
+                     test_arguments)
 
 def parse_frf_freqs(text) -> list:
     """'150,230 Hz' or '150,230' -> frequencies [Hz]."""
@@ -43,12 +42,7 @@ def parse_frf_freqs(text) -> list:
 
 
 @click.command("update")
-@click.argument("board_toml", type=click.Path(exists=True, dir_okay=False, path_type=Path))
-@click.argument("test_uff", required=False, type=click.Path(exists=True, dir_okay=False, path_type=Path))
-@click.argument("configs", nargs=-1)
-@click.option("--frequencies", "freq_csv", type=click.Path(exists=True, dir_okay=False, path_type=Path), default=None,
-              help="CSV of measured frequencies (configuration, mode, frequency_hz) instead of UFF files; "
-                   "pairs by mode order")
+@test_arguments
 @click.option("--method", type=click.Choice(["freq", "fbm", "qms", "frf-in", "frf-out", "frf-direct"]),
               default="freq", show_default=True)
 @click.option("--frf-freqs", default=None,

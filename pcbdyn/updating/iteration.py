@@ -212,10 +212,15 @@ def _condensed_frf_equations(cfg, K, M, dKs, dMs, p) -> eq.Block:
     return eq.Block(np.vstack(A_all), np.concatenate(b_all))
 
 
-def _weighted(cfg, blk):
+def _weighted(cfg, blk, st):
+    """``blk`` with unit-length rows (eq. 4.42) or rows in units of ``cfg.sigma`` (eq. 4.28); a sigma per
+    measured frequency keeps the rows of the modes paired in this state ``st``."""
     if cfg.sigma is None and cfg.method == "frf-in" and _condensed(cfg):
         return blk  # weighted by its noise already
-    d = unit_row_weights(blk.A) if cfg.sigma is None else std_row_weights(cfg.sigma)
+    sigma = cfg.sigma
+    if sigma is not None and cfg.method.startswith("freq") and np.size(sigma) == np.size(cfg.f_x):
+        sigma = np.asarray(sigma, float)[st["used"]]
+    d = unit_row_weights(blk.A) if sigma is None else std_row_weights(sigma)
     return eq.Block(*weight_rows(blk.A, blk.b, d))
 
 
@@ -237,7 +242,7 @@ def build_equations(configs, p, pairing: Callable | None = None, stack_reduce: b
         raise ValueError("no measured mode of any configuration found an analytical partner; check that test and "
                          "model are the same structure and configuration, and the points' frame and units")
     blocks = [_block(c, st, p) for c, st in active]
-    stacked = stack([_weighted(c, blk) for (c, _), blk in zip(active, blocks)], reduce=stack_reduce)
+    stacked = stack([_weighted(c, blk, st) for (c, st), blk in zip(active, blocks)], reduce=stack_reduce)
     return stacked, blocks, states
 
 
