@@ -31,7 +31,7 @@ DEFAULT_NOISE_PCT = 0.2
 SCAN_PER_DECADE = 2
 
 
-@dataclass
+@dataclass(kw_only=True)
 class WedgeLockResult:
     """What the two steps found: the extremes, each test mode's tolerance and sigma [%] (per
     configuration {test mode: %}), the ``decision`` ("clamped" or "springs") and its ``reason``, and, when
@@ -42,14 +42,14 @@ class WedgeLockResult:
     guides: list
     hinged: Extreme
     clamped: Extreme
+    notes: list = field(default_factory=list)
     noise_pct: float
     mesh_pct: list
     tolerance_pct: list
     sigma_pct: list
-    clamped_ok: bool
-    decision: str
-    reason: str
-    notes: list = field(default_factory=list)
+    clamped_ok: bool = False
+    decision: str = ""
+    reason: str = ""
     scan: dict | None = None
     shared: SpringFit | None = None
     per_guide: SpringFit | None = None
@@ -181,7 +181,8 @@ def fit_wedge_locks(board, tests, per_guide: bool | None = None, tol_pct: float 
     fine = correlate_extreme(guides.extreme(board, "clamped"), "clamped", tests, h / 2.0, min_mac, probe_tol)
     mesh = mesh_errors(clamped, fine)
     sigma, tol = _noise_and_tolerance(tests, mesh, noise, tol_pct)
-    result = WedgeLockResult(board, names, hinged, clamped, noise, mesh, tol, sigma, False, "", "", notes)
+    result = WedgeLockResult(board=board, guides=names, hinged=hinged, clamped=clamped, notes=notes, noise_pct=noise,
+                             mesh_pct=mesh, tolerance_pct=tol, sigma_pct=sigma)
     df = clamped.df()
     result.clamped_ok = all(t in d and abs(d[t]) <= tl[t] for d, tl, p in zip(df, tol, paired) for t in p)
     if result.clamped_ok:
