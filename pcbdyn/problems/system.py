@@ -11,7 +11,7 @@ from ..correlation.pairing import pair_modes
 from ..fe.assembly import assemble
 from ..fe.constraints import build_reduction
 from ..fe.probe import model_probe
-from ..updating.matching import transformation
+from ..updating.matching import dynamic_basis
 from .models import parameter_derivatives, parameter_values
 
 
@@ -27,6 +27,7 @@ class ConfigSystem:
         self.reduction = build_reduction(pm.model, K, M)
         self.n_rigid = 6 if pm.model.free else 0
         self._cache = (None, None)
+        self._restricted = (None, None)
 
     def model(self, p):
         """(K, M, dKs, dMs) at parameter values ``p`` [SI], on the independent DOFs."""
@@ -40,6 +41,21 @@ class ConfigSystem:
         out = (red(K), red(M), [red(dK) for dK, _ in pairs], [red(dM) for _, dM in pairs])
         self._cache = (p.copy(), out)
         return out
+
+    def restricted(self, p, dofs) -> list:
+        """[(rows, A[rows][:, dofs])] of K, M, the dKs and the dMs at ``p`` on ``dofs``, ``rows`` their
+        non-zero rows within ``dofs``: what every measured mode's dynamic reduction of this configuration
+        at ``p`` multiplies (made once per p, not once per mode)."""
+        key = (np.asarray(p, float).tobytes(), dofs.tobytes())
+        if self._restricted[0] != key:
+            K, M, dKs, dMs = self.model(p)
+            pieces = []
+            for A in (K, M, *dKs, *dMs):
+                A = sp.csr_matrix(A)[dofs][:, dofs]
+                rows = np.unique(A.nonzero()[0])
+                pieces.append((rows, A[rows]))
+            self._restricted = (key, pieces)
+        return self._restricted[1]
 
     def at(self, p):
         """The built model (:class:`pcbdyn.fe.parametric.ParametricModel`) at parameter values ``p``."""
@@ -107,10 +123,14 @@ class DynamicReduced:
 
     def __call__(self, p):
         K, M, dKs, dMs = self.system.model(p)
-        T = transformation(K, M, self.P, self.omega)
+        dofs, T = dynamic_basis(K, M, self.P, self.omega)
+        pieces = self.system.restricted(p, dofs)
 
-        def red(A):
-            return np.asarray(T.T @ (A @ T))
+        def red(piece):
+            rows, A = piece  # the rows of the DOFs a matrix touches: a parameter's derivative, a few elements
+            return np.asarray(T[rows].T @ (A @ T))
 
-        Kr, Mr = red(K), red(M)
-        return 0.5 * (Kr + Kr.T), 0.5 * (Mr + Mr.T), [red(d) for d in dKs], [red(d) for d in dMs]
+        Kr, Mr = red(pieces[0]), red(pieces[1])
+        n = len(dKs)
+        return (0.5 * (Kr + Kr.T), 0.5 * (Mr + Mr.T), [red(x) for x in pieces[2:2 + n]],
+                [red(x) for x in pieces[2 + n:]])

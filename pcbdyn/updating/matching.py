@@ -19,6 +19,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from scipy.sparse.csgraph import connected_components
 
 from pcbdyn.fe import reduction as fe_reduction
 
@@ -35,22 +36,46 @@ def selected_dofs(P) -> np.ndarray | None:
     return cols if np.unique(cols).size == cols.size else None
 
 
-def transformation(K, M, P, omega: float | None = None) -> np.ndarray:
-    """T (n_dof, n_meas) with u = T u_meas and P T = I: Guyan when ``omega`` is None, else the
-    dynamic map at ``omega`` [rad/s]."""
+def coupled_dofs(Z, P) -> np.ndarray:
+    """The DOFs that ``Z``'s pattern couples, directly or through others, with the DOFs ``P`` reads: the
+    only rows of a map u = T u_meas that are not zero (a flat plate measured along its normal leaves out
+    its whole membrane block)."""
+    pattern = abs(sp.csr_matrix(Z))
+    pattern.eliminate_zeros()
+    _, label = connected_components(pattern, directed=False)
+    read = np.unique(sp.csr_matrix(P).nonzero()[1])
+    return np.flatnonzero(np.isin(label, np.unique(label[read])))
+
+
+def dynamic_basis(K, M, P, omega: float | None = None) -> tuple:
+    """(dofs, T_d): T (:func:`transformation`) on the DOFs it does not leave at zero
+    (:func:`coupled_dofs`); the rest of T is zero. Exact, and a smaller system to factorise."""
     P = sp.csr_matrix(P)
     if P.shape[1] != K.shape[0]:
         raise ValueError(f"P has shape {P.shape}; it must map the {K.shape[0]} model DOFs to measured DOFs")
     masters = selected_dofs(P)
     if masters is not None:
-        if omega is None:
-            return fe_reduction.guyan(K, M, masters)[0]
-        return fe_reduction.dynamic_reduction(K, M, masters, omega)[0]
+        T = (fe_reduction.guyan(K, M, masters) if omega is None else
+             fe_reduction.dynamic_reduction(K, M, masters, omega))[0]
+        return np.arange(K.shape[0]), T
     Z = sp.csr_matrix(K) if omega is None else sp.csr_matrix(K) - omega**2 * sp.csr_matrix(M)
-    n, n_m = K.shape[0], P.shape[0]
-    kkt = sp.bmat([[Z, P.T], [P, None]], format="csc")
+    dofs = coupled_dofs(Z, P)
+    Zd, Pd = Z[dofs][:, dofs], P[:, dofs]
+    n, n_m = dofs.size, P.shape[0]
+    kkt = sp.bmat([[Zd, Pd.T], [Pd, None]], format="csc")
     rhs = np.vstack([np.zeros((n, n_m)), np.eye(n_m)])
-    return spla.splu(kkt).solve(rhs)[:n]
+    return dofs, spla.splu(kkt).solve(rhs)[:n]
+
+
+def transformation(K, M, P, omega: float | None = None) -> np.ndarray:
+    """T (n_dof, n_meas) with u = T u_meas and P T = I: Guyan when ``omega`` is None, else the
+    dynamic map at ``omega`` [rad/s]."""
+    dofs, Td = dynamic_basis(K, M, P, omega)
+    if dofs.size == K.shape[0]:
+        return Td
+    T = np.zeros((K.shape[0], Td.shape[1]))
+    T[dofs] = Td
+    return T
 
 
 def reduce_system(K, M, dKs, dMs, P, omega: float | None = None):
