@@ -13,8 +13,8 @@ from pathlib import Path
 
 import click
 
-from .commands import (build, correlate, diagnose, export, identify, import_kicad, localize, simulate_test, study,
-                       update, vibe, wedgelock)
+from .commands import (build, calibrate, correlate, diagnose, export, identify, import_kicad, library, localize,
+                       simulate_test, study, update, vibe, wedgelock)
 
 
 def _warning(message, category, filename, lineno, file=None, line=None):
@@ -44,5 +44,5 @@ def main():
 
 
 for _module in (build, simulate_test, correlate, update, wedgelock, localize, study, diagnose, vibe, identify,
-                import_kicad, export):
+                import_kicad, export, calibrate, library):
     main.add_command(_module.command)

@@ -1,4 +1,6 @@
-"""``pcbdyn build board.toml``: a board's resonances, mode shapes and effective masses."""
+"""``pcbdyn build board.toml``: a board's resonances, mode shapes and effective masses; with
+``--uncertainty``, each frequency +- the standard deviation the component library's calibrated
+family values give it (:mod:`pcbdyn.problems.uncertainty`)."""
 
 from __future__ import annotations
 
@@ -6,12 +8,14 @@ from pathlib import Path
 
 import click
 
-from .common import done, fail, folder_outputs, solve_structure, step
+from .common import done, fail, folder_outputs, library_option, solve_structure, step
 
 
-def analyse(board, config, out: Path | None, pictures: bool = True, written: list | None = None) -> dict:
+def analyse(board, config, out: Path | None, pictures: bool = True, written: list | None = None,
+            stds: dict | None = None) -> dict:
     """Build and solve one configuration; print its table; write CSV/VTU/PNG under ``out`` (and
-    append their paths to ``written``)."""
+    append their paths to ``written``). ``stds``: the library's family standard deviations
+    (:func:`pcbdyn.problems.uncertainty.library_uncertainty`), propagated to each frequency."""
     from ..correlation import static_mass
     from ..report.files import write_text
     from ..report.modes import format_table, mode_table
@@ -20,6 +24,10 @@ def analyse(board, config, out: Path | None, pictures: bool = True, written: lis
     bm, modes, K, M = solve_structure(board, config)
     mass = static_mass(M)
     table = mode_table(bm, modes, M)
+    if stds is not None:
+        from ..problems.uncertainty import frequency_std
+
+        table.insert(2, "frequency_std_hz", frequency_std(bm, modes, stds))
     click.echo(f"\n{board.name} [{label}]: {mass * 1e3:.2f} g, {bm.model.n_dof} DOFs, "
                f"{sum(len(es.conn) for es in bm.model.sets.values() if es.etype in ('quad4', 'tri3'))} shells"
                + (f", {modes.n_rigid} rigid-body modes" if modes.n_rigid else ""))
@@ -48,11 +56,19 @@ def analyse(board, config, out: Path | None, pictures: bool = True, written: lis
     return {
         "configuration": label,
         "modes": [{"n": int(row.mode), "frequency_hz": float(row.frequency_hz), "eff_mass_z": float(row.eff_mass_z),
-                   "shape": row.shape} for row in table.itertuples()],
+                   "shape": row.shape, **({"frequency_std_hz": float(row.frequency_std_hz)} if stds is not None else {})}
+                  for row in table.itertuples()],
         "mass_kg": mass,
         "dofs": int(bm.model.n_dof),
         "rigid_body_modes": int(modes.n_rigid),
     }
+
+
+def uncertainty_note(stds: dict) -> str:
+    if not stds:
+        return "note: no part family of this board has a calibrated standard deviation in the library: +- 0"
+    return "library uncertainty: " + ", ".join(f"{f} {v * 1e3:.4g} +- {sd * 1e3:.2g} mm ({', '.join(refs)})"
+                                               for f, (v, sd, refs) in stds.items())
 
 
 @click.command("build")
@@ -60,9 +76,12 @@ def analyse(board, config, out: Path | None, pictures: bool = True, written: lis
 @click.option("--config", "config", default=None, help="configuration name from [[configurations]]")
 @click.option("--all-configs", is_flag=True, help="the base model and every configuration")
 @click.option("--no-pictures", is_flag=True, help="skip the PNG mode-shape pictures")
+@click.option("--uncertainty", is_flag=True,
+              help="frequencies +- the standard deviation the library's calibrated family values give them")
 @folder_outputs("folder for modes CSV, VTU (ParaView) and PNG mode shapes",
                 "write frequencies, mass and DOF count as JSON", html=True)
-def command(board_toml, config, all_configs, out, json_path, no_pictures, html):
+@library_option()
+def command(board_toml, config, all_configs, out, json_path, no_pictures, html, uncertainty):
     """Predict a board's resonances: frequencies, effective masses in z, mode shapes."""
     from ..domain import StructureError
     from ..fe import ModelError
@@ -76,13 +95,21 @@ def command(board_toml, config, all_configs, out, json_path, no_pictures, html):
         if config is not None and all_configs:
             raise click.UsageError("give --config NAME or --all-configs, not both")
         configs = [None] + board.configuration_names() if all_configs else [config]
-        written = []
-        results = [analyse(board, c, out, pictures=not no_pictures, written=written) for c in configs]
+        written, stds = [], None
+        if uncertainty:
+            from ..problems.uncertainty import library_uncertainty
+
+            board, stds = library_uncertainty(board)
+            click.echo(uncertainty_note(stds), err=True)
+        results = [analyse(board, c, out, pictures=not no_pictures, written=written, stds=stds) for c in configs]
     except (StructureError, ModelError) as exc:
         fail(str(exc))
     if json_path is not None:
         data = dict(results[0]) if len(results) == 1 else {**results[0], "configurations": results}
         data["board"] = board.name
+        if stds is not None:
+            data["uncertainty"] = {f: {"equivalent_thickness_m": v, "std_m": sd, "parts": refs}
+                                   for f, (v, sd, refs) in stds.items()}
         write_json(json_path, data)
     if html:
         from ..report.pages import build_page

@@ -76,14 +76,16 @@ def number_pair(text: str, option: str, unit: str | None = None) -> tuple:
     return tuple(out)
 
 
-def test_arguments(command):
+def test_arguments(command=None, *, board_required: bool = True):
     """The inputs of a command that fits a structure to its tests: BOARD_TOML, TEST_UFF, NAME=FILE
-    configurations, or ``--frequencies FILE.csv``."""
-    from pathlib import Path
-
+    configurations, or ``--frequencies FILE.csv`` (``board_required`` False: a command that takes its
+    boards from a file instead, as ``calibrate --joint``)."""
+    if command is None:
+        return functools.partial(test_arguments, board_required=board_required)
     file = click.Path(exists=True, dir_okay=False, path_type=Path)
     for decorate in reversed((
-            click.argument("board_toml", type=file), click.argument("test_uff", required=False, type=file),
+            click.argument("board_toml", required=board_required, type=file),
+            click.argument("test_uff", required=False, type=file),
             click.argument("configs", nargs=-1),
             click.option("--frequencies", "freq_csv", type=file, default=None,
                          help="CSV of measured frequencies (configuration, mode, frequency_hz) instead of UFF files; "
@@ -130,7 +132,7 @@ def parse_noise(text):
 
 
 #: command keyword -> the option users write, for messages
-OPTION_NAMES = {"json_path": "--json", "out": "--out", "bdf": "--nastran", "chart": "--chart"}
+OPTION_NAMES = {"json_path": "--json", "out": "--out", "bdf": "--nastran", "chart": "--chart", "plot_path": "--plot"}
 
 
 def check_writable(path: Path, option: str, folder: bool, shown=None) -> None:
@@ -204,5 +206,27 @@ def folder_outputs(out_help: str, json_help: str, html: bool = False, force: str
             command = click.option("--force", is_flag=True, help=force)(command)
         return click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=None,
                             help=out_help)(command)
+
+    return decorate
+
+
+def library_option(required: bool = False, keep: bool = False):
+    """The ``--library DIR`` option of every command that loads a board: DIR is searched first for part
+    families while the command runs (:func:`pcbdyn.components.library.chosen`), before a ``library/``
+    beside the board, PCBDYN_LIBRARY and the shipped library. ``keep``: the command also receives
+    ``library`` (the folder ``pcbdyn calibrate`` writes)."""
+
+    def decorate(f):
+        @functools.wraps(f)
+        def wrapper(*args, library=None, **kwargs):
+            from ..components.library import chosen
+
+            with chosen([] if library is None else [library]):
+                return f(*args, **({"library": library} if keep else {}), **kwargs)
+
+        help_text = ("component library folder, searched first for part families (then a library/ beside the "
+                     "board, PCBDYN_LIBRARY, the shipped library)")
+        return click.option("--library", type=click.Path(file_okay=False, path_type=Path), required=required,
+                            default=None, help=help_text)(wrapper)
 
     return decorate

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import click
 
-from .common import PROBE_TOL, done, fail, folder_outputs, solve_structure, step
+from .common import PROBE_TOL, done, fail, folder_outputs, library_option, solve_structure, step
 
 @click.command("correlate")
 @click.argument("board_toml", type=click.Path(exists=True, dir_okay=False, path_type=Path))
@@ -21,6 +21,7 @@ from .common import PROBE_TOL, done, fail, folder_outputs, solve_structure, step
               help="model modes to pair with (default: the board's [analysis] modes, at least 1.5 x the test's)")
 @folder_outputs("folder for pairs.csv, comac.csv and the PNG pictures",
                 "write pairs, unpaired test modes and COMAC as JSON", html=True)
+@library_option()
 def command(board_toml, test_uff, config, min_mac, n_modes, out, json_path, html):
     """Correlate a board model with a modal test (UFF): pair table, COMAC, pictures."""
     from ..correlation import correlate

@@ -15,7 +15,7 @@ from pathlib import Path
 import click
 
 from ..diagnosis import KINDS
-from .common import done, fail, folder_outputs, measured_configurations, parse_noise, result_path, step
+from .common import done, fail, folder_outputs, library_option, measured_configurations, parse_noise, result_path, step
 
 
 @click.command("diagnose")
@@ -31,6 +31,7 @@ from .common import done, fail, folder_outputs, measured_configurations, parse_n
 @folder_outputs("folder for the board with the effects declared, the evidence map and tables",
                 "write effects, before/after and statistics as JSON",
                 force="replace an earlier <board>.diagnosed.toml beside the board (default: a numbered name)")
+@library_option()
 def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size, out, force, json_path):
     """Find the effects a board model lacks from modal tests: TEST_UFF (with mode shapes) of the base
     configuration and NAME=FILE for each perturbed configuration of board.toml (e.g. c2=test2.uff)."""

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import click
 
-from .common import checked_outputs, done, fail, step
+from .common import checked_outputs, done, fail, library_option, step
 
 
 def changed_quantities(base, updated, base_name: str, updated_name: str) -> dict:
@@ -38,6 +38,7 @@ def changed_quantities(base, updated, base_name: str, updated_name: str) -> dict
 @click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="write the card counts, mass, changed values and notes as JSON")
 @checked_outputs(folders=(), files=("json_path", "bdf"))
+@library_option()
 def command(board_toml, bdf, updated, config, n_modes, json_path):
     """Write the board's FE model as a Nastran deck (GRID, CQUAD4/CTRIA3, PSHELL, CBAR, CONM2,
     springs, SPC1, MPC, EIGRL)."""

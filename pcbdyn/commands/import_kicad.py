@@ -8,7 +8,7 @@ from pathlib import Path
 
 import click
 
-from .common import checked_outputs, done, fail, step
+from .common import checked_outputs, done, fail, library_option, step
 
 
 @click.command("import-kicad")
@@ -21,6 +21,7 @@ from .common import checked_outputs, done, fail, step
 @click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="write what was placed, left out and found as JSON")
 @checked_outputs(folders=(), files=("json_path", "out"))
+@library_option()
 def command(pcb, map_toml, out, overwrite, json_path):
     """Make a board.toml from a KiCad board (.kicad_pcb, KiCad 6-8)."""
     from ..atomic import atomic_path

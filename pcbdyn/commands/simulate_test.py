@@ -10,7 +10,7 @@ from pathlib import Path
 
 import click
 
-from .common import PROBE_TOL, checked_outputs, done, fail, number_pair, solve_structure, step
+from .common import PROBE_TOL, checked_outputs, done, fail, library_option, number_pair, solve_structure, step
 
 
 def check_band(f_range, df: float) -> None:
@@ -43,6 +43,7 @@ def check_band(f_range, df: float) -> None:
 @click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="write a summary (frequencies, points, excitation, noise) as JSON")
 @checked_outputs(folders=(), files=("json_path", "out"))
+@library_option()
 def command(board_toml, points_csv, config, excite, noise, seed, f_range, df, damping, kind, n_modes, out, json_path):
     """Simulate a modal test on a board model: modes and FRFs at measurement points, with noise."""
     from ..domain import StructureError

@@ -39,7 +39,7 @@ from pathlib import Path
 
 import click
 
-from .common import check_writable, checked_outputs
+from .common import check_writable, checked_outputs, library_option
 
 KEYS = {"case", "levels_pct", "shots", "methods", "equations", "rank", "seed", "workers", "scheduler", "out", "board",
         "points"}
@@ -114,6 +114,7 @@ def read_spec(path: Path) -> dict:
                                                 "cluster instead of local processes (same results)")
 @click.option("--quiet", is_flag=True, help="no progress bar")
 @checked_outputs(folders=())
+@library_option()
 def command(study_toml: Path, json_path: Path | None, scheduler: str | None, quiet: bool):
     """Judge localisation methods by their success ratio over noisy random shots (thesis eq. 5.65-5.66)."""
     from ..report.files import write_json, write_text

@@ -26,8 +26,8 @@ from __future__ import annotations
 
 import click
 
-from .common import (done, fail, folder_outputs, measured_configurations, parse_extra, result_path, step,
-                     test_arguments)
+from .common import (done, fail, folder_outputs, library_option, measured_configurations, parse_extra, result_path,
+                     step, test_arguments)
 
 def parse_frf_freqs(text) -> list:
     """'150,230 Hz' or '150,230' -> frequencies [Hz]."""
@@ -60,6 +60,7 @@ def parse_frf_freqs(text) -> list:
 @folder_outputs("folder for board.updated.toml, the iteration plot and tables (default: board.updated.toml beside "
                 "the board)", "write parameters, status, before/after and history as JSON",
                 force="replace an earlier board.updated.toml beside the board (default: a numbered name)")
+@library_option()
 def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping, solver, params, max_iter, tol_pct,
             mesh_size, out, force, json_path):
     """Update a structure's [[parameters]] against modal tests: TEST_UFF for the base configuration and

@@ -1,14 +1,17 @@
 """The component library: one TOML file per part family (size, mass, default model, equivalent
-thickness and where those numbers come from).
+thickness with its standard deviation, the calibration runs behind it, and where the numbers come from).
 
-A board looks for a family first in a ``library/`` folder next to its board.toml, then in the
-folders named in the PCBDYN_LIBRARY path variable (``os.pathsep``-separated), then in the library
-shipped inside the package (``pcbdyn/library/``, package data, so a plain ``pip install`` has it).
+The one search path (:func:`search_path`): a board looks for a family first in the folders a command
+names with ``--library DIR`` (:func:`chosen`), then in a ``library/`` folder next to its board.toml,
+then in the folders named in the PCBDYN_LIBRARY path variable (``os.pathsep``-separated), then in the
+library shipped inside the package (``pcbdyn/library/``, package data, so a plain ``pip install`` has
+it).
 """
 
 from __future__ import annotations
 
 import os
+from contextlib import contextmanager
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
@@ -29,7 +32,9 @@ class Package:
     ``default_model`` (one of :data:`MODELS`), ``equivalent_thickness`` [m] of the board region under
     the part (thesis section 7.2.3), and free-text ``provenance``. Optional: ``steinberg_c``, the
     package constant of Steinberg's allowable board displacement (lead wires and solder joints;
-    used by ``pcbdyn vibe``), None when the entry does not give one."""
+    used by ``pcbdyn vibe``), None when the entry does not give one; ``equivalent_thickness_std``
+    [m], the standard deviation of a calibrated equivalent thickness (``pcbdyn calibrate``), None
+    for a value nobody measured."""
 
     name: str
     size: tuple
@@ -40,11 +45,27 @@ class Package:
     provenance: str
     path: Path
     steinberg_c: float | None = None
+    equivalent_thickness_std: float | None = None
+
+
+#: folders named on the command line (``--library DIR``), searched first; set with :func:`chosen`
+_CHOSEN: list = []
+
+
+@contextmanager
+def chosen(dirs):
+    """Search the folders ``dirs`` first while the block runs (a command's ``--library DIR``)."""
+    saved = list(_CHOSEN)
+    _CHOSEN[:0] = [Path(d) for d in dirs]
+    try:
+        yield
+    finally:
+        _CHOSEN[:] = saved
 
 
 def search_path(board_dir: Path | None = None) -> list[Path]:
-    """Folders searched for ``<package>.toml``, first match wins."""
-    dirs = []
+    """Folders searched for ``<package>.toml``, first match wins (see the module docstring)."""
+    dirs = list(_CHOSEN)
     if board_dir is not None:
         dirs.append(Path(board_dir) / "library")
     env = os.environ.get("PCBDYN_LIBRARY")
@@ -63,7 +84,7 @@ def available(board_dir: Path | None = None) -> list[str]:
     names = set()
     for d in search_path(board_dir):
         if d.is_dir():
-            names.update(p.stem for p in d.glob("*.toml"))
+            names.update(p.stem for p in d.glob("*.toml") if not p.name.startswith("."))
     return sorted(names)
 
 
@@ -95,9 +116,20 @@ def read_package(path: Path) -> Package:
             provenance=str(p.get("provenance", "")),
             path=path,
             steinberg_c=_steinberg_c(path, p),
+            equivalent_thickness_std=_std(path, p, where),
         )
     except UnitError as exc:
         raise LibraryError(str(exc)) from None
+
+
+def _std(path: Path, p: dict, where: str) -> float | None:
+    if "equivalent_thickness_std" not in p:
+        return None
+    sd = to_si(p["equivalent_thickness_std"], "mm", f"{where}.equivalent_thickness_std")
+    if not sd >= 0:
+        raise LibraryError(f"{path}: package.equivalent_thickness_std must not be negative, got "
+                           f"{p['equivalent_thickness_std']!r}")
+    return sd
 
 
 def _steinberg_c(path: Path, p: dict) -> float | None:
@@ -110,10 +142,16 @@ def _steinberg_c(path: Path, p: dict) -> float | None:
     return float(c)
 
 
-def find_package(name: str, board_dir: Path | None = None) -> Package | None:
-    """The family ``name`` from the first library folder that has it, or None."""
+def locate(name: str, board_dir: Path | None = None) -> Path | None:
+    """The file of family ``name`` in the first library folder that has it, or None."""
     for d in search_path(board_dir):
         f = d / f"{name}.toml"
         if f.is_file():
-            return read_package(f)
+            return f
     return None
+
+
+def find_package(name: str, board_dir: Path | None = None) -> Package | None:
+    """The family ``name`` from the first library folder that has it, or None."""
+    f = locate(name, board_dir)
+    return None if f is None else read_package(f)

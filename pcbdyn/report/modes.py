@@ -61,6 +61,7 @@ def mode_table(bm, modes, M) -> pd.DataFrame:
 
 
 def format_table(df: pd.DataFrame) -> str:
-    out = df.rename(columns={"frequency_hz": "frequency [Hz]", "eff_mass_z": "eff. mass z [%]"}).copy()
+    out = df.rename(columns={"frequency_hz": "frequency [Hz]", "frequency_std_hz": "+- sd [Hz]",
+                             "eff_mass_z": "eff. mass z [%]"}).copy()
     out["eff. mass z [%]"] = 100.0 * out["eff. mass z [%]"]
     return out.to_string(index=False, float_format=lambda v: f"{v:.2f}")

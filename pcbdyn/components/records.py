@@ -1,0 +1,171 @@
+"""The calibration runs of a part family's library entry (``[[calibrations]]`` of FAMILY.toml) and how
+the library pools them into the family's equivalent thickness and its standard deviation.
+
+Each run (``pcbdyn calibrate``) leaves one record: its estimate ``value`` with standard deviation
+``std``, the library value it started from (``before``), where it came from (boards and test files
+with their SHA-256, date, method) and the frequency errors before and after it. The family value is
+the inverse-variance weighted mean of the runs that are not ``flagged`` (the Bayesian posterior mean
+of independent Gaussian estimates under a flat prior). Its standard deviation is 1/sqrt(sum w),
+widened by the Birge ratio sqrt(chi^2 / (n - 1)) when the runs scatter more than their own standard
+deviations say (part-to-part and board-to-board scatter that no single run sees). A new run more than
+:data:`FLAG_SIGMA` standard deviations from the pooled others is flagged and left out, never averaged
+in silently; a user who trusts it sets ``flagged = false``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from datetime import datetime
+
+import tomlkit
+
+from ..units import UnitError, from_si, to_si
+from .library import LibraryError
+
+#: a run this many standard deviations from the pooled other runs is flagged (not averaged in)
+FLAG_SIGMA = 3.0
+
+
+@dataclass(frozen=True)
+class Record:
+    """One calibration run of one family: ``value``, ``std`` and ``before`` [m]; ``boards`` and ``tests``
+    (dicts with ``file``, ``sha256`` and, for a test, its ``board`` and ``configuration``);
+    ``max_freq_error_before_pct``/``_after_pct`` over the run's test configurations; ``flagged`` and
+    the ``reason``."""
+
+    run: str
+    date: datetime
+    method: str
+    value: float
+    std: float
+    before: float
+    boards: tuple = ()
+    tests: tuple = ()
+    max_freq_error_before_pct: float = math.nan
+    max_freq_error_after_pct: float = math.nan
+    flagged: bool = False
+    reason: str = ""
+    extra: dict = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class Pooled:
+    """The family value of the runs not flagged: ``value``, ``std`` [m], ``n`` runs used, ``birge`` ratio
+    (1 when the runs agree within their standard deviations)."""
+
+    value: float
+    std: float
+    n: int
+    birge: float
+
+
+#: keys of a record besides those of :data:`EXTRA_KEYS`, as written
+KEYS = ("run", "date", "method", "value", "std", "before", "flagged", "reason", "boards", "tests",
+        "max_freq_error_before_pct", "max_freq_error_after_pct")
+#: free-form provenance a record may carry (solver, noise, parts, library seed)
+EXTRA_KEYS = ("solver", "noise", "parts", "iterations", "converged")
+
+
+def read_records(path, data: dict) -> list:
+    """The ``[[calibrations]]`` of a parsed library file ``data`` (read from ``path``) as Records; a
+    LibraryError names the record, the field and the fix."""
+    raw = data.get("calibrations", [])
+    if not isinstance(raw, list):
+        raise LibraryError(f"{path}: calibrations must be an array of tables ([[calibrations]] blocks)")
+    return [_record(path, i, r) for i, r in enumerate(raw)]
+
+
+def _record(path, i, r) -> Record:
+    where = f"{path}: calibrations[{i}]"
+    if not isinstance(r, dict):
+        raise LibraryError(f"{where}: must be a table ([[calibrations]])")
+    unknown = [k for k in r if k not in KEYS + EXTRA_KEYS]
+    if unknown:
+        raise LibraryError(f"{where}: unknown field(s) {unknown}; a record has {', '.join(KEYS + EXTRA_KEYS)}")
+    for key in ("run", "date", "method", "value", "std", "before", "flagged"):
+        if key not in r:
+            raise LibraryError(f"{where}.{key}: missing; every record written by pcbdyn calibrate has it "
+                               "(restore it, or delete the whole record)")
+    if not isinstance(r["date"], datetime):
+        raise LibraryError(f"{where}.date: must be a TOML date-time such as 2026-11-25T10:00:00Z, got {r['date']!r}")
+    if not isinstance(r["flagged"], bool):
+        raise LibraryError(f"{where}.flagged: must be true or false, got {r['flagged']!r}")
+    try:
+        value, std, before = (to_si(r[k], "mm", f"{where}.{k}") for k in ("value", "std", "before"))
+    except UnitError as exc:
+        raise LibraryError(str(exc)) from None
+    if not (value > 0 and before > 0):
+        raise LibraryError(f"{where}: value and before must be positive lengths, got {r['value']!r}, {r['before']!r}")
+    if not std > 0:
+        raise LibraryError(f"{where}.std: must be a positive length (a run always has a standard deviation), "
+                           f"got {r['std']!r}")
+    errors = [r.get(k, math.nan) for k in ("max_freq_error_before_pct", "max_freq_error_after_pct")]
+    if any(isinstance(e, bool) or not isinstance(e, (int, float)) for e in errors):
+        raise LibraryError(f"{where}: max_freq_error_before_pct/after_pct must be numbers (percent), got {errors}")
+    return Record(str(r["run"]), r["date"], str(r["method"]), value, std, before, tuple(r.get("boards", ())),
+                  tuple(r.get("tests", ())), float(errors[0]), float(errors[1]), r["flagged"], str(r.get("reason", "")),
+                  {k: r[k] for k in EXTRA_KEYS if k in r})
+
+
+def pool(records) -> Pooled | None:
+    """The inverse-variance weighted mean of the records not flagged, with its standard deviation
+    widened by the Birge ratio (module docstring); None when every record is flagged (or none)."""
+    use = [r for r in records if not r.flagged]
+    if not use:
+        return None
+    w = [1.0 / r.std**2 for r in use]
+    W = sum(w)
+    mean = sum(wi * r.value for wi, r in zip(w, use)) / W
+    birge = math.sqrt(sum(wi * (r.value - mean) ** 2 for wi, r in zip(w, use)) / (len(use) - 1)) if len(use) > 1 else 1.0
+    return Pooled(mean, math.sqrt(1.0 / W) * max(1.0, birge), len(use), birge)
+
+
+def judge(record: Record, others) -> Record:
+    """``record`` flagged when it lies more than :data:`FLAG_SIGMA` combined standard deviations from
+    the pooled ``others`` (a record flagged already, e.g. at a bound, stays as it is)."""
+    ref = pool(others)
+    if record.flagged or ref is None:
+        return record
+    z = abs(record.value - ref.value) / math.hypot(record.std, ref.std)
+    if z <= FLAG_SIGMA:
+        return record
+    return replace(record, flagged=True, reason=(
+        f"{z:.1f} sigma from the pooled value of the other {ref.n} run(s), {from_si(ref.value, 'mm'):.4g} +- "
+        f"{from_si(ref.std, 'mm'):.2g} mm: not averaged in (a different part, board or model? set flagged = "
+        "false to count it)"))
+
+
+def record_table(rec: Record):
+    """``rec`` as a tomlkit table for ``[[calibrations]]`` (lengths as quantities in mm)."""
+    t = tomlkit.table()
+    t["run"] = rec.run
+    t["date"] = rec.date
+    t["method"] = rec.method
+    t["value"] = length(rec.value)
+    t["std"] = length(rec.std, 3)
+    t["before"] = length(rec.before)
+    t["flagged"] = rec.flagged
+    if rec.reason:
+        t["reason"] = rec.reason
+    for key in ("max_freq_error_before_pct", "max_freq_error_after_pct"):
+        v = getattr(rec, key)
+        if math.isfinite(v):
+            t[key] = round(float(v), 4)
+    for key, value in rec.extra.items():
+        t[key] = value
+    for key in ("boards", "tests"):
+        arr = tomlkit.array()
+        for item in getattr(rec, key):
+            it = tomlkit.inline_table()
+            it.update(item)
+            arr.append(it)
+        arr.multiline(len(arr) > 1)
+        t[key] = arr
+    t.add(tomlkit.nl())
+    return t
+
+
+def length(value: float, digits: int = 6) -> str:
+    """A length [m] as written in a library file, in mm to ``digits`` significant digits."""
+    return f"{from_si(float(value), 'mm'):.{digits}g} mm"
