@@ -55,7 +55,7 @@ def command(board_toml, test_uff, configs, freq_csv, joint_toml, families, with_
     """Calibrate part families' equivalent thicknesses from modal tests into a component library."""
     from ..domain import StructureError
     from ..problems.calibration import calibrate, calibration_problem
-    from ..problems.calibration_library import max_error, write_library
+    from ..problems.calibration_library import check_library, max_error, write_library
     from ..problems.joint import load_board_tests, read_joint
     from ..report import calibration_report as rep
     from ..report.files import write_json
@@ -78,6 +78,7 @@ def command(board_toml, test_uff, configs, freq_csv, joint_toml, families, with_
         ms = to_si(mesh_size, "mm", "--mesh-size") if mesh_size else None
         cal = calibration_problem(items, families.split(",") if families else None,
                                   [w.strip() for w in with_.split(",")] if with_ else (), ms)
+        check_library(cal, library)
         done(t0)
         t0 = step(f"calibrating {', '.join(cal.families)} on {len(items)} board(s) with {method}/{solver}")
         cal = calibrate(cal, method, solver, (f_pct, shape_pct), mesh_error, max_iter=max_iter, tol_freq_pct=tol_pct,

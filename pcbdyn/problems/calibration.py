@@ -182,6 +182,8 @@ def calibration_problem(items, families=None, with_=(), mesh_size=None) -> Calib
     """The :class:`Calibration` (not yet fitted) of ``items`` (:class:`BoardTests`): the families
     (:func:`choose_families`) from their library values, plus ``with_`` parameters on every board."""
     structures = [it.structure for it in items]
+    if families is not None:
+        library_start(families, structures[0].path.parent)  # a family nowhere in the library, before the boards
     fams = choose_families(structures, families)
     start = library_start(fams, structures[0].path.parent)
     several = len(items) > 1

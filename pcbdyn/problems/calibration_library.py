@@ -11,7 +11,7 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 from ..components.records import Record
-from ..components.writer import add_calibration
+from ..components.writer import add_calibration, read_entry
 
 
 def sha256(path) -> str:
@@ -45,12 +45,22 @@ def run_records(cal) -> dict:
     return out
 
 
+def check_library(cal, directory) -> None:
+    """Every library file the calibration ``cal`` will write into ``directory`` (or start it from) reads
+    as a valid entry: checked before the fit, so that a malformed file stops the run with nothing
+    written (a LibraryError names the file, the field and the fix)."""
+    for fam, (_, seed) in cal.start.items():
+        path = Path(directory) / f"{fam}.toml"
+        read_entry(path if path.is_file() else seed)
+
+
 def write_library(cal, directory) -> dict:
     """Write every family's record of ``cal`` into the library folder ``directory`` (started from the
     entry the search path found when the folder has none yet). Returns, per family, the JSON
     ``families`` entry: the library's pooled ``equivalent_thickness_m`` and ``std_m`` after this run,
     ``before_m`` (the value the run started from), ``n_calibrations`` (runs on file), ``flagged`` (this
     run), this run's own ``run_m`` and ``run_std_m``, the ``reason`` of a flag and the ``file``."""
+    check_library(cal, directory)
     out = {}
     for fam, rec in run_records(cal).items():
         written, pooled, n = add_calibration(directory, fam, rec, seed=cal.start[fam][1])

@@ -75,3 +75,12 @@ def write_case(tmp_path, name: str, seed: int, n_modes: int = 8):
     board = tmp_path / f"{name}.toml"
     board.write_text(board_text(name))
     return board, uff, t
+
+
+def simulated_test(board_path, uff_path, name: str, n_modes: int = 6, seed: int = 0):
+    """A test of ``board_path`` as it is (its own mesh, the thesis' noise) on the grid of layout ``name``."""
+    model = load_board(board_path).build().model
+    pts, dofs = grid(name)
+    write_uff(uff_path, simulate_on_model(model, solve_modes(model, n_modes=n_modes), pts, dofs, noise=NOISE,
+                                          seed=seed))
+    return uff_path
