@@ -11,7 +11,8 @@ deviations from the others is flagged, not averaged in.
 
 JSON: ``families`` = {FAMILY: {``equivalent_thickness_m``, ``std_m`` (the library's value after this run),
 ``before_m`` (the value this run started from), ``n_calibrations``, ``flagged`` (this run), ``run_m``,
-``run_std_m`` (this run's own estimate), ``reason``, ``file``}}, ``before``/``after``
+``run_std_m`` (this run's own estimate), ``run_std_mesh_m`` (the part of it the mesh makes), ``reason``,
+``file``}}, ``before``/``after``
 (``max_freq_error_pct``, per configuration), ``library`` (the folder written), ``with`` (the other
 parameters), ``method``, ``solver``, ``noise``, ``boards``, ``tests``.
 """
@@ -23,6 +24,11 @@ from pathlib import Path
 import click
 
 from .common import done, fail, library_option, parse_extra, parse_noise, step
+
+
+def names(text) -> list | None:
+    """'PGA, CQFP' -> ['PGA', 'CQFP']; None when not given."""
+    return [n.strip() for n in text.split(",") if n.strip()] if text else None
 
 
 @click.command("calibrate")
@@ -76,8 +82,7 @@ def command(board_toml, test_uff, configs, freq_csv, joint_toml, families, with_
         items = [] if board_toml is None else [load_board_tests(board_toml, test_uff, extras, freq_csv)]
         items += [] if joint_toml is None else read_joint(joint_toml)
         ms = to_si(mesh_size, "mm", "--mesh-size") if mesh_size else None
-        cal = calibration_problem(items, families.split(",") if families else None,
-                                  [w.strip() for w in with_.split(",")] if with_ else (), ms)
+        cal = calibration_problem(items, names(families), names(with_) or (), ms)
         check_library(cal, library)
         done(t0)
         t0 = step(f"calibrating {', '.join(cal.families)} on {len(items)} board(s) with {method}/{solver}")

@@ -2,14 +2,19 @@
 the library pools them into the family's equivalent thickness and its standard deviation.
 
 Each run (``pcbdyn calibrate``) leaves one record: its estimate ``value`` with standard deviation
-``std``, the library value it started from (``before``), where it came from (boards and test files
-with their SHA-256, date, method) and the frequency errors before and after it. The family value is
-the inverse-variance weighted mean of the runs that are not ``flagged`` (the Bayesian posterior mean
-of independent Gaussian estimates under a flat prior). Its standard deviation is 1/sqrt(sum w),
-widened by the Birge ratio sqrt(chi^2 / (n - 1)) when the runs scatter more than their own standard
-deviations say (part-to-part and board-to-board scatter that no single run sees). A new run more than
-:data:`FLAG_SIGMA` standard deviations from the pooled others is flagged and left out, never averaged
-in silently; a user who trusts it sets ``flagged = false``.
+``std`` and the part of it its mesh makes, ``std_mesh`` (systematic), the library value it started
+from (``before``), where it came from (boards and test files with their SHA-256, date, method) and the
+frequency errors before and after it. The family value is the inverse-variance weighted mean of the
+runs that are not ``flagged`` (the Bayesian posterior mean of independent Gaussian estimates under a
+flat prior), weighted by their statistical parts (std^2 - std_mesh^2). The statistical part of its
+standard deviation, 1/sqrt(sum w), is widened by the Birge ratio sqrt(chi^2 / (n - 1)) when the runs
+scatter more than they say (part-to-part and board-to-board scatter that no single run sees); the mesh
+parts are fully correlated (runs on meshes alike err alike), so their weighted mean is added whole,
+never averaged down. Generalised least squares with that correlation would be the textbook estimator,
+but with fully correlated parts of different sizes it can put the mean outside the runs (Peelle's
+puzzle); these weights cannot. A new run more than :data:`FLAG_SIGMA` standard
+deviations from the pooled others is flagged and left out, never averaged in silently; a user who
+trusts it sets ``flagged = false``.
 """
 
 from __future__ import annotations
@@ -18,6 +23,7 @@ import math
 from dataclasses import dataclass, field, replace
 from datetime import datetime
 
+import numpy as np
 import tomlkit
 
 from ..units import UnitError, from_si, to_si
@@ -29,7 +35,8 @@ FLAG_SIGMA = 3.0
 
 @dataclass(frozen=True)
 class Record:
-    """One calibration run of one family: ``value``, ``std`` and ``before`` [m]; ``boards`` and ``tests``
+    """One calibration run of one family: ``value``, ``std``, ``before`` and ``std_mesh`` (the systematic
+    part of ``std``) [m]; ``boards`` and ``tests``
     (dicts with ``file``, ``sha256`` and, for a test, its ``board`` and ``configuration``);
     ``max_freq_error_before_pct``/``_after_pct`` over the run's test configurations; ``flagged`` and
     the ``reason``."""
@@ -47,21 +54,26 @@ class Record:
     flagged: bool = False
     reason: str = ""
     extra: dict = field(default_factory=dict)
+    std_mesh: float = 0.0
 
 
 @dataclass(frozen=True)
 class Pooled:
     """The family value of the runs not flagged: ``value``, ``std`` [m], ``n`` runs used, ``birge`` ratio
-    (1 when the runs agree within their standard deviations)."""
+    (1 when the runs agree within their statistical standard deviations), ``mesh``, the systematic
+    part the pooled value carries (the runs' ``std_mesh`` weighted as the value is), and ``stat``, the
+    statistical part (std^2 = stat^2 + mesh^2)."""
 
     value: float
     std: float
     n: int
     birge: float
+    mesh: float = 0.0
+    stat: float = 0.0
 
 
 #: keys of a record besides those of :data:`EXTRA_KEYS`, as written
-KEYS = ("run", "date", "method", "value", "std", "before", "flagged", "reason", "boards", "tests",
+KEYS = ("run", "date", "method", "value", "std", "std_mesh", "before", "flagged", "reason", "boards", "tests",
         "max_freq_error_before_pct", "max_freq_error_after_pct")
 #: free-form provenance a record may carry (solver, noise, parts, library seed)
 EXTRA_KEYS = ("solver", "noise", "parts", "iterations", "converged")
@@ -93,8 +105,12 @@ def _record(path, i, r) -> Record:
         raise LibraryError(f"{where}.flagged: must be true or false, got {r['flagged']!r}")
     try:
         value, std, before = (to_si(r[k], "mm", f"{where}.{k}") for k in ("value", "std", "before"))
+        mesh = to_si(r.get("std_mesh", "0 mm"), "mm", f"{where}.std_mesh")
     except UnitError as exc:
         raise LibraryError(str(exc)) from None
+    if not 0 <= mesh <= std:
+        raise LibraryError(f"{where}.std_mesh: the mesh's part of std must lie between 0 and std ({r['std']!r}), "
+                           f"got {r['std_mesh']!r}")
     if not (value > 0 and before > 0):
         raise LibraryError(f"{where}: value and before must be positive lengths, got {r['value']!r}, {r['before']!r}")
     if not std > 0:
@@ -105,29 +121,36 @@ def _record(path, i, r) -> Record:
         raise LibraryError(f"{where}: max_freq_error_before_pct/after_pct must be numbers (percent), got {errors}")
     return Record(str(r["run"]), r["date"], str(r["method"]), value, std, before, tuple(r.get("boards", ())),
                   tuple(r.get("tests", ())), float(errors[0]), float(errors[1]), r["flagged"], str(r.get("reason", "")),
-                  {k: r[k] for k in EXTRA_KEYS if k in r})
+                  {k: r[k] for k in EXTRA_KEYS if k in r}, mesh)
 
 
 def pool(records) -> Pooled | None:
-    """The inverse-variance weighted mean of the records not flagged, with its standard deviation
-    widened by the Birge ratio (module docstring); None when every record is flagged (or none)."""
+    """The pooled value of the records not flagged (module docstring); None when every record is
+    flagged (or none)."""
     use = [r for r in records if not r.flagged]
     if not use:
         return None
-    w = [1.0 / r.std**2 for r in use]
-    W = sum(w)
-    mean = sum(wi * r.value for wi, r in zip(w, use)) / W
-    birge = math.sqrt(sum(wi * (r.value - mean) ** 2 for wi, r in zip(w, use)) / (len(use) - 1)) if len(use) > 1 else 1.0
-    return Pooled(mean, math.sqrt(1.0 / W) * max(1.0, birge), len(use), birge)
+    v = np.array([r.value for r in use])
+    mesh = np.array([r.std_mesh for r in use])
+    stat2 = np.maximum(np.array([r.std for r in use]) ** 2 - mesh**2, (1e-6 * np.array([r.std for r in use])) ** 2)
+    w = (1.0 / stat2) / np.sum(1.0 / stat2)
+    mean = float(w @ v)
+    n = len(use)
+    birge = float(np.sqrt(np.sum((v - mean) ** 2 / stat2) / (n - 1))) if n > 1 else 1.0
+    stat = float(np.sqrt(1.0 / np.sum(1.0 / stat2))) * max(1.0, birge)
+    return Pooled(mean, math.hypot(stat, float(w @ mesh)), n, birge, float(w @ mesh), stat)
 
 
 def judge(record: Record, others) -> Record:
-    """``record`` flagged when it lies more than :data:`FLAG_SIGMA` combined standard deviations from
-    the pooled ``others`` (a record flagged already, e.g. at a bound, stays as it is)."""
+    """``record`` flagged when it lies more than :data:`FLAG_SIGMA` standard deviations from the pooled
+    ``others``, the mesh parts counted as fully correlated (a record flagged already, e.g. at a bound,
+    stays as it is)."""
     ref = pool(others)
     if record.flagged or ref is None:
         return record
-    z = abs(record.value - ref.value) / math.hypot(record.std, ref.std)
+    stat2 = max(record.std**2 - record.std_mesh**2, 0.0)
+    z = abs(record.value - ref.value) / math.sqrt(max(stat2 + ref.stat**2 + (record.std_mesh - ref.mesh) ** 2,
+                                                      (1e-6 * record.std) ** 2))
     if z <= FLAG_SIGMA:
         return record
     return replace(record, flagged=True, reason=(
@@ -144,6 +167,7 @@ def record_table(rec: Record):
     t["method"] = rec.method
     t["value"] = length(rec.value)
     t["std"] = length(rec.std, 3)
+    t["std_mesh"] = length(rec.std_mesh, 3)
     t["before"] = length(rec.before)
     t["flagged"] = rec.flagged
     if rec.reason:

@@ -12,7 +12,9 @@ The standard deviation of each value comes from the posterior covariance of the 
 stated (uniform bounds in percent, thesis eqs. 5.72-5.73: standard deviation bound / sqrt 3; for
 shape equations the rows' noise is measured by redrawing it on the data, a parametric bootstrap) or,
 when none is stated, estimated from the residual. A stated noise never makes the estimate surer than
-the fit's own residual says (s^2 >= 1), so model error shows in the standard deviation too.
+the fit's own residual says (s^2 >= 1), so model error shows in the standard deviation too. What the
+mesh does to each mode (:mod:`.discretisation`) adds a systematic part, kept apart in the library
+record, since it does not average out over runs on similar meshes.
 """
 
 from __future__ import annotations
@@ -62,9 +64,10 @@ class Calibration:
     """A calibration's problem, fit and result: ``families`` (the family parameter names, first in
     ``problem.names``), ``start`` {family: (value [m], library file it came from)}, ``result``
     (:class:`~pcbdyn.updating.iteration.UpdateResult`), ``before``/``after`` correlation states,
-    ``std`` [SI] of every parameter, ``at_bound`` and ``undetermined`` parameter names, ``mesh_steps``
+    ``std`` [SI] of every parameter and ``std_mesh``, the part of it the mesh makes (a systematic error,
+    common to every run on meshes alike), ``at_bound`` and ``undetermined`` parameter names, ``mesh_steps``
     (per test configuration, the relative change h -> h/2 of each measured mode's model frequency),
-    ``noise`` (how the standard deviations were found) and ``notes`` for the user."""
+    and ``noise`` (how the standard deviations were found)."""
 
     problem: UpdateProblem
     families: list
@@ -76,14 +79,17 @@ class Calibration:
     before: list = field(default_factory=list)
     after: list = field(default_factory=list)
     std: np.ndarray | None = None
+    std_mesh: np.ndarray | None = None
     at_bound: list = field(default_factory=list)
     undetermined: list = field(default_factory=list)
     mesh_steps: list = field(default_factory=list)
     noise: str = ""
-    notes: list = field(default_factory=list)
 
     def value(self, name) -> float:
         return float(self.result.p[self.problem.names.index(name)])
+
+    def sd_mesh(self, name) -> float:
+        return float(self.std_mesh[self.problem.names.index(name)]) if self.std_mesh is not None else 0.0
 
     def sd(self, name) -> float:
         return float(self.std[self.problem.names.index(name)])
@@ -260,10 +266,12 @@ def calibrate(cal: Calibration, method: str = "freq", solver: str = "bounded", n
         cal.result, cal.before, cal.after = run(cal.problem, fit, solver, check=check, **run_options)
     p = cal.result.p
     cov, cal.noise, undetermined = posterior_covariance(cal, fit, p, noise, seed)
+    g = np.zeros(p.size)
     if mesh_error:
         cal.mesh_steps = measured_mesh_steps(cal.problem, cal.items, cal.after, p)
-        cov = cov + systematic_covariance(check, p, cal.mesh_steps)
-    cal.std = np.abs(p) * np.sqrt(np.clip(np.diag(cov), 0.0, None))
+        g = systematic_shift(check, p, cal.mesh_steps)
+    cal.std = np.abs(p) * np.sqrt(np.clip(np.diag(cov), 0.0, None) + g**2)
+    cal.std_mesh = np.abs(p * g)
     cal.std[undetermined] = np.inf
     cal.undetermined = [cal.problem.names[j] for j in np.flatnonzero(undetermined)]
     lo, hi = cal.problem.bounds
@@ -272,16 +280,15 @@ def calibrate(cal: Calibration, method: str = "freq", solver: str = "bounded", n
     return cal
 
 
-def systematic_covariance(check, p, sigmas) -> np.ndarray:
-    """g g^T: the change of the relative parameters x that a one-sigma error of the model's
-    frequencies would make, every mode erring together (a systematic error, such as the mesh's),
-    through the frequency equations at ``p`` with equal relative weights. ``sigmas``: per test
+def systematic_shift(check, p, sigmas) -> np.ndarray:
+    """g: the change of the relative parameters x that a one-sigma error of the model's frequencies
+    would make, every mode erring together (a systematic error, such as the mesh's; its covariance is
+    g g^T), through the frequency equations at ``p`` with equal relative weights. ``sigmas``: per test
     configuration, the relative standard deviation of each measured mode's model frequency."""
     (_, _), blocks, states = build_equations(check, p)
     A = np.vstack([blk.A / np.asarray(c.f_x, float)[st["used"]][:, None] for c, blk, st in zip(check, blocks, states)])
     u = np.concatenate([np.asarray(s, float)[st["used"]] for s, st in zip(sigmas, states)])
-    g = np.linalg.pinv(A) @ u
-    return np.outer(g, g)
+    return np.linalg.pinv(A) @ u
 
 
 def posterior_covariance(cal: Calibration, fit, p, noise, seed: int = 0) -> tuple:

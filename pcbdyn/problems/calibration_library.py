@@ -41,7 +41,8 @@ def run_records(cal) -> dict:
         extra = {"solver": cal.solver, "noise": cal.noise, "parts": parts, "iterations": int(cal.result.iterations),
                  "converged": bool(cal.result.converged)}
         out[fam] = Record(run, date, cal.method, cal.value(fam), cal.sd(fam), cal.start[fam][0], boards, tests,
-                          max_error(cal.before), max_error(cal.after), bool(reason), reason, extra)
+                          max_error(cal.before), max_error(cal.after), bool(reason), reason, extra,
+                          min(cal.sd_mesh(fam), cal.sd(fam)))
     return out
 
 
@@ -73,6 +74,7 @@ def write_library(cal, directory) -> dict:
             "reason": written.reason,
             "run_m": rec.value,
             "run_std_m": rec.std if math.isfinite(rec.std) else None,
+            "run_std_mesh_m": rec.std_mesh,
             "file": str(Path(directory) / f"{fam}.toml"),
         }
     return out

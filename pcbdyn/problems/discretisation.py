@@ -7,7 +7,7 @@ density repeats that error, so the two largely cancel, but the fitted value is o
 what the mesh does. The change h -> h/2 is taken as the standard deviation of that error, per mode
 (the converged value of an O(h^2) element lies 4/3 of a step away; part edges and the shells' shear
 layer at free edges converge more slowly): a calibration adds it to its covariance as a systematic
-error (:func:`pcbdyn.problems.calibration.systematic_covariance`).
+error (:func:`pcbdyn.problems.calibration.systematic_shift`).
 """
 
 from __future__ import annotations

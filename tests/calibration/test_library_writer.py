@@ -21,10 +21,11 @@ from pcbdyn.components.writer import add_calibration, read_entry
 SEED = shipped_library() / "PGA.toml"
 
 
-def record(value_mm, std_mm, run=None) -> Record:
+def record(value_mm, std_mm, run=None, mesh_mm=0.0) -> Record:
     return Record(run or uuid.uuid4().hex, datetime.now(timezone.utc).replace(microsecond=0), "freq", value_mm * 1e-3,
                   std_mm * 1e-3, 3.5e-3, ({"file": "b.toml", "sha256": "0" * 64},),
-                  ({"file": "t.uff", "sha256": "1" * 64, "board": "b.toml", "configuration": "base"},), 8.0, 0.5)
+                  ({"file": "t.uff", "sha256": "1" * 64, "board": "b.toml", "configuration": "base"},), 8.0, 0.5,
+                  std_mesh=mesh_mm * 1e-3)
 
 
 def test_pooling_inverse_variance_birge_and_flag(tmp_path):
@@ -49,10 +50,50 @@ def test_pooling_inverse_variance_birge_and_flag(tmp_path):
     assert 'std = "0.1 mm"' in text and "flagged = true" in text and text.count("[[calibrations]]") == 4
 
 
+def test_library_list_and_show(tmp_path):
+    """``pcbdyn library list`` finds the folder's entry first; ``library show`` tabulates the runs, plots
+    them against the pooled value and its band, and writes them as JSON."""
+    import json
+
+    from click.testing import CliRunner
+
+    from pcbdyn.cli import main
+
+    for v in (4.0, 4.2, 6.0):
+        add_calibration(tmp_path, "PGA", record(v, 0.1), seed=SEED)
+    r = CliRunner().invoke(main, ["library", "list", "--library", str(tmp_path), "--json", str(tmp_path / "l.json")])
+    assert r.exit_code == 0, r.output
+    rows = {row["family"]: row for row in json.loads((tmp_path / "l.json").read_text())["families"]}
+    assert rows["PGA"]["file"] == str(tmp_path / "PGA.toml") and rows["PGA"]["n_flagged"] == 1
+    assert rows["PGA"]["equivalent_thickness_m"] == pytest.approx(4.1e-3) and "CQFP" in rows
+    png, js = tmp_path / "pga.png", tmp_path / "s.json"
+    r = CliRunner().invoke(main, ["library", "show", "PGA", "--library", str(tmp_path), "--plot", str(png), "--json", str(js)])
+    assert r.exit_code == 0, r.output
+    data = json.loads(js.read_text())
+    assert [run["flagged"] for run in data["runs"]] == [False, False, True] and data["pooled"]["n"] == 2
+    assert "FLAGGED" in r.output and png.stat().st_size > 10_000
+    r = CliRunner().invoke(main, ["library", "show", "BGA", "--library", str(tmp_path)])
+    assert r.exit_code == 2 and "family 'BGA' is not in the library" in r.output
+
+
 def test_pool_of_one_and_of_none():
     assert pool([]) is None
     one = pool([record(4.0, 0.1)])
     assert (one.value, one.std, one.n) == pytest.approx((4e-3, 1e-4, 1))
+
+
+def test_mesh_part_does_not_average_out():
+    """Two runs of std 0.1 mm, 0.08 mm of it their meshes' (fully correlated): the pooled variance keeps
+    the whole mesh part, 0.06^2 / 2 + 0.08^2, instead of 0.1^2 / 2. A third run 0.3 mm off on a mesh
+    alike differs from them with variance 0.06^2 + 0.06^2 / 2 (the shared mesh error cancels): 4.1
+    sigma, flagged; a run without a mesh part (variance 0.1^2 + 0.06^2 / 2 + 0.08^2), 2.2 sigma: kept."""
+    from pcbdyn.components.records import judge
+
+    runs = [record(4.0, 0.1, mesh_mm=0.08), record(4.0, 0.1, mesh_mm=0.08)]
+    p = pool(runs)
+    assert p.std == pytest.approx(math.sqrt(0.06**2 / 2 + 0.08**2) * 1e-3, rel=1e-9) and p.mesh == pytest.approx(8e-5)
+    assert "4.1 sigma" in judge(record(4.3, 0.1, mesh_mm=0.08), runs).reason
+    assert not judge(record(4.3, 0.1), runs).flagged
 
 
 def _writer(directory, value, start, go):

@@ -60,7 +60,9 @@ def test_six_part_card_from_table_7_2(tmp_path):
     for name, data in results.items():
         print(f"{name}: max |df| {data['before']['max_freq_error_pct']:.2f} % -> {data['after']['max_freq_error_pct']:.2f} %")
         assert data["before"]["max_freq_error_pct"] > 5.0 > data["after"]["max_freq_error_pct"]
+        assert {"families", "before", "after", "library"} <= set(data) and data["library"].endswith(f"lib_{name}")
         for fam, d in data["families"].items():
+            assert {"equivalent_thickness_m", "std_m", "before_m", "n_calibrations", "flagged"} <= set(d)
             assert 0 < d["std_m"] < d["equivalent_thickness_m"] and d["before_m"] == pytest.approx(3.5e-3)
             assert d["n_calibrations"] == 1 and not d["flagged"]
     for fam in TABLE_7_6_RF:  # configuration 1 alone and with the perturbed configurations agree
