@@ -5,14 +5,14 @@ Each run (``pcbdyn calibrate``) leaves one record: its estimate ``value`` with s
 ``std`` and the part of it its mesh makes, ``std_mesh`` (systematic), the library value it started
 from (``before``), where it came from (boards and test files with their SHA-256, date, method) and the
 frequency errors before and after it. The family value is the inverse-variance weighted mean of the
-runs that are not ``flagged`` (the Bayesian posterior mean of independent Gaussian estimates under a
-flat prior), weighted by their statistical parts (std^2 - std_mesh^2). The statistical part of its
-standard deviation, 1/sqrt(sum w), is widened by the Birge ratio sqrt(chi^2 / (n - 1)) when the runs
-scatter more than they say (part-to-part and board-to-board scatter that no single run sees); the mesh
-parts are fully correlated (runs on meshes alike err alike), so their weighted mean is added whole,
-never averaged down. Generalised least squares with that correlation would be the textbook estimator,
-but with fully correlated parts of different sizes it can put the mean outside the runs (Peelle's
-puzzle); these weights cannot. A new run more than :data:`FLAG_SIGMA` standard
+runs that are not ``flagged`` (w_i proportional to 1/std_i^2: the Bayesian posterior mean of
+independent Gaussian estimates under a flat prior). Its standard deviation has two parts: the
+statistical one, sqrt(sum w_i^2 (std_i^2 - std_mesh_i^2)), widened by the Birge ratio
+sqrt(chi^2 / (n - 1)) when the runs scatter more than they say (part-to-part and board-to-board
+scatter that no single run sees), and the mesh one, sum w_i std_mesh_i, added whole: runs on meshes
+alike err alike, so it does not average down. (Generalised least squares with fully correlated mesh
+parts would be the textbook estimator, but with parts of different sizes it can put the mean outside
+the runs, Peelle's puzzle, and it leans on the runs whose error is mostly mesh.) A new run more than :data:`FLAG_SIGMA` standard
 deviations from the pooled others is flagged and left out, never averaged in silently; a user who
 trusts it sets ``flagged = false``.
 """
@@ -108,14 +108,14 @@ def _record(path, i, r) -> Record:
         mesh = to_si(r.get("std_mesh", "0 mm"), "mm", f"{where}.std_mesh")
     except UnitError as exc:
         raise LibraryError(str(exc)) from None
-    if not 0 <= mesh <= std:
-        raise LibraryError(f"{where}.std_mesh: the mesh's part of std must lie between 0 and std ({r['std']!r}), "
-                           f"got {r['std_mesh']!r}")
     if not (value > 0 and before > 0):
         raise LibraryError(f"{where}: value and before must be positive lengths, got {r['value']!r}, {r['before']!r}")
     if not std > 0:
         raise LibraryError(f"{where}.std: must be a positive length (a run always has a standard deviation), "
                            f"got {r['std']!r}")
+    if not 0 <= mesh <= std:
+        raise LibraryError(f"{where}.std_mesh: the mesh's part of std must lie between 0 and std ({r['std']!r}), "
+                           f"got {r.get('std_mesh')!r}")
     errors = [r.get(k, math.nan) for k in ("max_freq_error_before_pct", "max_freq_error_after_pct")]
     if any(isinstance(e, bool) or not isinstance(e, (int, float)) for e in errors):
         raise LibraryError(f"{where}: max_freq_error_before_pct/after_pct must be numbers (percent), got {errors}")
@@ -131,13 +131,13 @@ def pool(records) -> Pooled | None:
     if not use:
         return None
     v = np.array([r.value for r in use])
+    std = np.array([r.std for r in use])
     mesh = np.array([r.std_mesh for r in use])
-    stat2 = np.maximum(np.array([r.std for r in use]) ** 2 - mesh**2, (1e-6 * np.array([r.std for r in use])) ** 2)
-    w = (1.0 / stat2) / np.sum(1.0 / stat2)
+    w = (1.0 / std**2) / np.sum(1.0 / std**2)
     mean = float(w @ v)
     n = len(use)
-    birge = float(np.sqrt(np.sum((v - mean) ** 2 / stat2) / (n - 1))) if n > 1 else 1.0
-    stat = float(np.sqrt(1.0 / np.sum(1.0 / stat2))) * max(1.0, birge)
+    birge = float(np.sqrt(np.sum((v - mean) ** 2 / std**2) / (n - 1))) if n > 1 else 1.0
+    stat = float(np.sqrt(np.sum(w**2 * (std**2 - mesh**2)))) * max(1.0, birge)
     return Pooled(mean, math.hypot(stat, float(w @ mesh)), n, birge, float(w @ mesh), stat)
 
 

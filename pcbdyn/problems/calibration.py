@@ -224,11 +224,10 @@ def config_labels(items) -> list:
             for it in items for c, path in it.files]
 
 
-def check_pairing(cal: Calibration, check) -> list:
-    """The correlation at the start; a CalibrationError when a test's modes do not pair with its
-    board's (fewer than :data:`MIN_PAIRED` of them by MAC: a test of another board, or points in
-    another frame)."""
-    out = []
+def check_pairing(cal: Calibration, check) -> None:
+    """A CalibrationError when, at the start, a test's modes do not pair with its board's (fewer than
+    :data:`MIN_PAIRED` of them by MAC: a test of another board, or points in another frame; without
+    shapes, by number: none at all)."""
     for cfg, label in zip(check, config_labels(cal.items)):
         try:
             state = correlation_state([cfg], cal.problem.p0)[0]
@@ -236,11 +235,10 @@ def check_pairing(cal: Calibration, check) -> list:
             state = {"pairs": []}
         n = int(np.size(cfg.f_x))
         if len(state["pairs"]) < max(1, math.ceil(MIN_PAIRED * n)) and (cfg.phi_x is not None or not state["pairs"]):
+            how = "by MAC (>= 0.5)" if cfg.phi_x is not None else "by number"
             raise CalibrationError(f"{label}: only {len(state['pairs'])} of its {n} measured modes pair with the "
-                                   "model's by MAC (>= 0.5); is it a test of this board? Check the test file, the "
-                                   "board and the frame of the measurement points")
-        out.append(state)
-    return out
+                                   f"model's {how}; is it a test of this board? Check the test file, the board "
+                                   "and the frame of the measurement points")
 
 
 def calibrate(cal: Calibration, method: str = "freq", solver: str = "bounded", noise=(None, None),

@@ -84,7 +84,7 @@ def test_pool_of_one_and_of_none():
 
 def test_mesh_part_does_not_average_out():
     """Two runs of std 0.1 mm, 0.08 mm of it their meshes' (fully correlated): the pooled variance keeps
-    the whole mesh part, 0.06^2 / 2 + 0.08^2, instead of 0.1^2 / 2. A third run 0.3 mm off on a mesh
+    the whole mesh part, 0.06^2 / 2 + 0.08^2, instead of 0.1^2 / 2 (the other runs' weights are equal). A third run 0.3 mm off on a mesh
     alike differs from them with variance 0.06^2 + 0.06^2 / 2 (the shared mesh error cancels): 4.1
     sigma, flagged; a run without a mesh part (variance 0.1^2 + 0.06^2 / 2 + 0.08^2), 2.2 sigma: kept."""
     from pcbdyn.components.records import judge
