@@ -12,6 +12,7 @@ from pathlib import Path
 
 from ..components.records import Record
 from ..components.writer import add_calibration, read_entry
+from .calibration import FAMILY_RANGE
 
 
 def sha256(path) -> str:
@@ -35,8 +36,8 @@ def run_records(cal) -> dict:
     for fam in cal.families:
         parts = [f"{it.structure.path.name}:{c.ref}" for it in cal.items for c in it.structure.components
                  if c.package == fam]
-        reason = ("at a bound of the fit: the data ask for a value outside "
-                  f"[1/3, 3] x the library's" if fam in cal.at_bound else
+        reason = (f"at a bound of the fit: the data ask for a value outside [1/{FAMILY_RANGE:g}, {FAMILY_RANGE:g}] x "
+                  "the library's" if fam in cal.at_bound else
                   "not determined by the data (rank-deficient equations)" if fam in cal.undetermined else "")
         extra = {"solver": cal.solver, "noise": cal.noise, "parts": parts, "iterations": int(cal.result.iterations),
                  "converged": bool(cal.result.converged)}

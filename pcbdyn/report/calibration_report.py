@@ -9,8 +9,8 @@ from pathlib import Path
 from ..units import from_si
 from .update_report import format_correlation
 
-__all__ = ["format_correlation", "format_families", "format_runs", "format_with", "headline", "library_rows",
-           "format_library", "plot_runs", "with_rows"]
+__all__ = ["format_correlation", "format_families", "format_library", "format_runs", "format_with", "headline",
+           "library_rows", "plot_runs", "with_rows"]
 
 
 def _mm(v, digits=4) -> str:
@@ -107,8 +107,8 @@ def plot_runs(path, family: str, records, pooled, default: float | None = None) 
         ax.axhline(v, color="tab:blue", label=f"pooled {v:.4g} mm ({pooled.n} runs)")
     if default is not None:
         ax.axhline(from_si(default, "mm"), color="grey", ls="--", label="first run's starting value")
-    for flagged, style, label in ((False, dict(fmt="o", color="k"), "runs"), (True, dict(fmt="x", color="tab:red"),
-                                                                              "flagged runs")):
+    for flagged, style, label in ((False, {"fmt": "o", "color": "k"}, "runs"),
+                                  (True, {"fmt": "x", "color": "tab:red"}, "flagged runs")):
         sel = [(xi, r) for xi, r in zip(x, records) if r.flagged == flagged and math.isfinite(r.std)]
         if sel:
             ax.errorbar([xi for xi, _ in sel], [from_si(r.value, "mm") for _, r in sel],

@@ -64,7 +64,10 @@ def predict_unseen(d, board, lib, label):
     model = pm.model
     pts, dofs = grid("b4")
     mt, mm = solve_modes(truth, n_modes=10), solve_modes(model, n_modes=12)
-    read = lambda m, modes: np.asarray(model_probe(m, pts.xyz, dofs.directions).P @ modes.shapes)  # noqa: E731
+
+    def read(m, modes):
+        return np.asarray(model_probe(m, pts.xyz, dofs.directions).P @ modes.shapes)
+
     below = mt.frequencies < 1000.0
     pairs = mac(read(truth, mt)[:, below], read(model, mm)).argmax(axis=1)
     err = 100 * (mm.frequencies[pairs] / mt.frequencies[below] - 1)
