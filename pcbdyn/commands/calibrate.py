@@ -19,11 +19,12 @@ parameters), ``method``, ``solver``, ``noise``, ``boards``, ``tests``.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import click
 
-from .common import done, fail, library_option, parse_extra, parse_noise, step
+from .common import checked_outputs, done, fail, library_option, parse_extra, parse_noise, step, test_arguments
 
 
 def names(text) -> list | None:
@@ -32,11 +33,7 @@ def names(text) -> list | None:
 
 
 @click.command("calibrate")
-@click.argument("board_toml", required=False, type=click.Path(exists=True, dir_okay=False, path_type=Path))
-@click.argument("test_uff", required=False, type=click.Path(exists=True, dir_okay=False, path_type=Path))
-@click.argument("configs", nargs=-1)
-@click.option("--frequencies", "freq_csv", type=click.Path(exists=True, dir_okay=False, path_type=Path), default=None,
-              help="CSV of measured frequencies (configuration, mode, frequency_hz) instead of UFF tests")
+@test_arguments(board_required=False)
 @click.option("--joint", "joint_toml", type=click.Path(exists=True, dir_okay=False, path_type=Path), default=None,
               help="calibration file listing several boards with their tests, calibrated together")
 @click.option("--families", default=None, help="comma-separated part families (default: every family whose parts "
@@ -54,7 +51,9 @@ def names(text) -> list | None:
 @click.option("--mesh-size", default=None, help="override the boards' mesh_size, e.g. '5 mm'")
 @click.option("--mesh-error/--no-mesh-error", default=True, show_default=True,
               help="count what the mesh does to each mode (solved again twice as fine) in the standard deviation")
-@click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None)
+@click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="write the families, before/after and the library written as JSON ('-': standard output)")
+@checked_outputs(folders=())
 @library_option(required=True, keep=True)
 def command(board_toml, test_uff, configs, freq_csv, joint_toml, families, with_, method, solver, noise, max_iter,
             tol_pct, mesh_size, mesh_error, json_path, library):
@@ -63,8 +62,10 @@ def command(board_toml, test_uff, configs, freq_csv, joint_toml, families, with_
     from ..problems.calibration import calibrate, calibration_problem
     from ..problems.calibration_library import check_library, max_error, write_library
     from ..problems.joint import load_board_tests, read_joint
+    from ..problems.run import outcome
     from ..report import calibration_report as rep
     from ..report.files import write_json
+    from ..report.update_report import progress_line
     from ..testdata import TestDataError
     from ..units import to_si
 
@@ -87,14 +88,17 @@ def command(board_toml, test_uff, configs, freq_csv, joint_toml, families, with_
         done(t0)
         t0 = step(f"calibrating {', '.join(cal.families)} on {len(items)} board(s) with {method}/{solver}")
         cal = calibrate(cal, method, solver, (f_pct, shape_pct), mesh_error, max_iter=max_iter, tol_freq_pct=tol_pct,
-                        tol_param_pct=0.01)
+                        tol_param_pct=0.01, progress=lambda h: click.echo(progress_line(h), err=True))
         done(t0)
+        what = outcome(cal.problem, cal.result, cal.before, cal.after)
         t0 = step(f"writing the library {library}")
         fams = write_library(cal, library)
         done(t0)
     except (StructureError, TestDataError, ValueError) as exc:
         fail(str(exc))
-    click.echo(f"\n{rep.headline(cal)}")
+    click.echo(f"\n{rep.headline(cal, what['status'])}")
+    for line in what["details"]:
+        click.echo(f"  note: {line}")
     click.echo(rep.format_families(fams))
     if cal.problem.names[len(cal.families):]:
         click.echo("\n" + rep.format_with(cal))
@@ -105,12 +109,14 @@ def command(board_toml, test_uff, configs, freq_csv, joint_toml, families, with_
     click.echo(f"\nlibrary written: {library} ({', '.join(f'{f}.toml' for f in fams)})", err=True)
     if json_path is not None:
         def summary(states):
-            return {"max_freq_error_pct": max_error(states), "configurations": states}
+            v = max_error(states)
+            return {"max_freq_error_pct": v if math.isfinite(v) else None, "configurations": states}
 
         write_json(json_path, {
             "families": fams, "before": summary(cal.before), "after": summary(cal.after), "library": str(library),
             "with": rep.with_rows(cal), "method": method, "solver": solver, "noise": cal.noise,
-            "iterations": cal.result.iterations, "converged": bool(cal.result.converged), "reason": cal.result.reason,
+            "status": what["status"], "details": what["details"], "iterations": cal.result.iterations,
+            "converged": bool(cal.result.converged), "reason": cal.result.reason,
             "boards": [str(it.structure.path) for it in cal.items],
             "tests": [{"board": it.structure.path.name, "configuration": c or "base", "file": str(p)}
                       for it in cal.items for c, p in it.files],

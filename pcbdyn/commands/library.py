@@ -9,7 +9,7 @@ from pathlib import Path
 
 import click
 
-from .common import fail, library_option
+from .common import checked_outputs, fail, library_option
 
 
 @click.group("library")
@@ -18,7 +18,9 @@ def command():
 
 
 @command.command("list")
-@click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None)
+@click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="write the families as JSON ('-': standard output)")
+@checked_outputs(folders=())
 @library_option()
 def list_command(json_path):
     """The part families the library search path finds (first match of each name)."""
@@ -41,7 +43,9 @@ def list_command(json_path):
 @click.argument("family")
 @click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="PNG of the runs' values +- sd and the pooled value with its band")
-@click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None)
+@click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="write the entry and its runs as JSON ('-': standard output)")
+@checked_outputs(folders=(), files=("json_path", "plot_path"))
 @library_option()
 def show_command(family, plot_path, json_path):
     """A family's library entry and the calibration runs behind its value."""

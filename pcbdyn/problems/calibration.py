@@ -20,7 +20,6 @@ record, since it does not average out over runs on similar meshes.
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -29,7 +28,7 @@ from .. import targets
 from ..components.library import locate, read_package, search_path
 from ..domain import StructureError
 from ..updating.iteration import build_equations
-from ..updating.solvers import RankDeficiencyWarning, covariance
+from ..updating.solvers import covariance
 from ..updating.success import add_noise
 from ..updating.weighting import NOISE_REDRAWS
 from .discretisation import measured_mesh_steps
@@ -259,9 +258,7 @@ def calibrate(cal: Calibration, method: str = "freq", solver: str = "bounded", n
                 raise CalibrationError(f"{path.name}: --method {method} needs mode shapes (a UFF test with dataset 55)")
     check, fit = configurations(cal.problem, cal.items, method)
     check_pairing(cal, check)
-    with warnings.catch_warnings():  # the solvers' decade-jump rank is no verdict here: see posterior_covariance
-        warnings.simplefilter("ignore", RankDeficiencyWarning)
-        cal.result, cal.before, cal.after = run(cal.problem, fit, solver, check=check, **run_options)
+    cal.result, cal.before, cal.after = run(cal.problem, fit, solver, check=check, **run_options)
     p = cal.result.p
     cov, cal.noise, undetermined = posterior_covariance(cal, fit, p, noise, seed)
     g = np.zeros(p.size)

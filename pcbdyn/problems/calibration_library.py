@@ -21,8 +21,8 @@ def sha256(path) -> str:
 
 
 def max_error(states) -> float:
-    """The largest |frequency error| [%] over correlation states."""
-    return max(s["max_freq_error_pct"] for s in states)
+    """The largest |frequency error| [%] over correlation states (nan when no mode paired)."""
+    return max((s["max_freq_error_pct"] for s in states if s["max_freq_error_pct"] is not None), default=math.nan)
 
 
 def run_records(cal) -> dict:

@@ -17,10 +17,10 @@ def _mm(v, digits=4) -> str:
     return "-" if v is None or not math.isfinite(v) else f"{from_si(v, 'mm'):.{digits}g}"
 
 
-def headline(cal) -> str:
+def headline(cal, status: str) -> str:
     r = cal.result
     return (f"calibration of {', '.join(cal.families)} from {len(cal.items)} board(s), method {cal.method}/"
-            f"{cal.solver}: {r.reason} after {r.iterations} iteration(s); {cal.noise}")
+            f"{cal.solver}: {status} after {r.iterations} iteration(s) ({r.reason}); {cal.noise}")
 
 
 def format_families(fams: dict) -> str:
