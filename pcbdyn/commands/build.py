@@ -88,8 +88,6 @@ def command(board_toml, config, all_configs, out, json_path, no_pictures, html, 
     from ..problems import load_structure
     from ..report.files import write_json
 
-    if html and out is None:
-        raise click.UsageError("--html writes report.html into --out: give --out DIR")
     try:
         board = load_structure(board_toml)
         if config is not None and all_configs:

@@ -152,12 +152,15 @@ def check_writable(path: Path, option: str, folder: bool, shown=None) -> None:
 
 def checked_outputs(folders=("out",), files=("json_path",)):
     """A command decorator: its output options (keywords ``folders`` for folders, ``files`` for files)
-    are checked before any work, so that a run never fails after its computation for want of a place
-    to write; ``--json -`` writes the JSON to the standard output and the report to stderr."""
+    are checked before any work (and ``--html`` needs ``--out``), so that a run never fails after its
+    computation for want of a place to write; ``--json -`` writes the JSON to the standard output and the
+    report to stderr."""
 
     def decorate(command):
         @functools.wraps(command)
         def run(*args, **kwargs):
+            if kwargs.get("html") and kwargs.get("out") is None:
+                raise click.UsageError("--html writes report.html into --out: give --out DIR")
             for keys, folder in ((folders, True), (files, False)):
                 for key in keys:
                     if kwargs.get(key) is not None and str(kwargs[key]) != "-":

@@ -33,8 +33,6 @@ def command(board_toml, test_uff, config, min_mac, n_modes, out, json_path, html
     from ..testdata import TestDataError
     from ..testdata.measured import read_modes
 
-    if html and out is None:
-        raise click.UsageError("--html writes report.html into --out: give --out DIR")
     try:
         board = load_structure(board_toml)
         test_modes = read_modes(test_uff)

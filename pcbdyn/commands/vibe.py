@@ -48,8 +48,6 @@ def command(board_toml, psd_text, sine_csv, sweep_rate, sweeps, damping_text, du
     from ..vibration import (VibrationError, analysis_band, assess, judged_parts, load_psd, parse_damping,
                              read_sine_csv)
 
-    if html and out is None:
-        raise click.UsageError("--html writes report.html into --out: give --out DIR")
     try:
         board = load_board(board_toml)
         psd = load_psd(psd_text)
