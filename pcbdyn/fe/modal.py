@@ -67,7 +67,7 @@ class Modes:
 
 
 def reduced_system(model, K=None, M=None):
-    """(reduction, Kr, Mr): the constrained matrices as CSC.
+    """(reduction, Kr, Mr): the constrained matrices as CSR.
 
     When the model has no multi-point constraints, the reduction only drops DOFs, and
     :meth:`Reduction.reduce` takes the reduced matrices by row/column selection instead of the
@@ -79,7 +79,7 @@ def reduced_system(model, K=None, M=None):
     return red, reduce_matrix(red, K), reduce_matrix(red, M)
 
 
-def reduce_matrix(red: Reduction, A) -> sp.csc_matrix:
+def reduce_matrix(red: Reduction, A) -> sp.csr_matrix:
     """T^T A T (see :meth:`Reduction.reduce`: by selection when there are no MPCs)."""
     return red.reduce(A)
 
