@@ -10,43 +10,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .model import ModelError
-
-
-@dataclass
-class _Selection:
-    """Where the entries of A[idx][:, idx] sit in A's CSR value array, for one pattern of A (the
-    index arrays themselves are kept, so that K and M, which share them, share the plan)."""
-
-    indptr: np.ndarray
-    indices: np.ndarray
-    positions: np.ndarray
-    sub_indptr: np.ndarray
-    sub_indices: np.ndarray
-
-    @classmethod
-    def of(cls, A: sp.csr_matrix, idx: np.ndarray) -> "_Selection":
-        n, m = A.shape[0], idx.size
-        itype = A.indices.dtype
-        newcol = np.full(n, -1, dtype=itype)
-        newcol[idx] = np.arange(m, dtype=itype)
-        lengths = np.diff(A.indptr)
-        cols = newcol[A.indices]
-        keep = np.zeros(cols.size + 1, dtype=bool)  # one False past the end for reduceat
-        np.logical_and(cols >= 0, np.repeat(newcol >= 0, lengths), out=keep[:-1])
-        counts = np.add.reduceat(keep, A.indptr[:-1], dtype=np.int64)
-        counts[lengths == 0] = 0  # reduceat gives an empty row its next entry
-        sub_indptr = np.zeros(m + 1, dtype=itype)
-        np.cumsum(counts[idx], out=sub_indptr[1:])
-        positions = np.flatnonzero(keep)
-        return cls(A.indptr, A.indices, positions, sub_indptr, cols[positions])
-
-    def fits(self, A: sp.csr_matrix) -> bool:
-        same = lambda a, b: a is b or (a.shape == b.shape and np.array_equal(a, b))  # noqa: E731
-        return same(A.indptr, self.indptr) and same(A.indices, self.indices)
-
-    def apply(self, A: sp.csr_matrix) -> sp.csr_matrix:
-        m = self.sub_indptr.size - 1
-        return sp.csr_matrix((A.data[self.positions], self.sub_indices, self.sub_indptr), shape=(m, m), copy=False)
+from .sparsity import Gather, canonical_csr, selection
 
 
 @dataclass
@@ -55,7 +19,7 @@ class Reduction:
 
     T: sp.csr_matrix  # (n_full, n_red)
     independent: np.ndarray  # full DOF number of each reduced DOF
-    _selection: _Selection | None = field(default=None, repr=False, compare=False)
+    _selection: Gather | None = field(default=None, repr=False, compare=False)
 
     def expand(self, x: np.ndarray) -> np.ndarray:
         """Full vectors (n_full, ...) from reduced ones (n_red, ...)."""
@@ -73,13 +37,10 @@ class Reduction:
         """
         if not self.is_selection:
             return (self.T.T @ A @ self.T).tocsr()
-        A = A.tocsr()
-        if not A.has_canonical_format:
-            A = A.copy()
-            A.sum_duplicates()
+        A = canonical_csr(A)
         if self._selection is None or not self._selection.fits(A):
-            self._selection = _Selection.of(A, self.independent)
-        return self._selection.apply(A)
+            self._selection = selection(A, self.independent)
+        return self._selection.apply(A.data)
 
 
 def build_reduction(model, K=None, M=None) -> Reduction:
