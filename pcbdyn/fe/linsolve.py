@@ -24,6 +24,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from .model import ModelError
+from .sparsity import same_array
 
 try:
     from sksparse.cholmod import CholmodNotPositiveDefiniteError, analyze, cholesky
@@ -63,7 +64,8 @@ def cholmod_factor(L: sp.csc_matrix, mode: str = "supernodal"):
     the identity of its index arrays, as plans reuse them, else by their digest).
     ``mode`` "supernodal" gives L L^T; "simplicial" gives L D L^T. Raises
     CholmodNotPositiveDefiniteError like scikit-sparse's ``cholesky``."""
-    key = next((k for k, (p, i, _) in _symbolic.items() if k[0] == mode and p is L.indptr and i is L.indices), None)
+    key = next((k for k, (p, i, _) in _symbolic.items()
+                if k[0] == mode and same_array(p, L.indptr) and same_array(i, L.indices)), None)
     if key is None:  # not the very index arrays of a kept analysis: compare digests
         key = (mode, L.shape, pattern_key(L.indptr, L.indices))
     if key in _symbolic:
@@ -130,6 +132,14 @@ class Factorization:
 
     def __call__(self, b):
         return self.solve(b)
+
+    def forward(self, b):
+        """L^-1 P b, where A = P^T L L^T P (CHOLMOD only): half a solve, for symmetric operators."""
+        return self.factor.solve_L(self.factor.apply_P(b), use_LDLt_decomposition=False)
+
+    def backward(self, y):
+        """P^T L^-T y, the other half: ``backward(forward(b))`` is ``solve(b)``."""
+        return self.factor.apply_Pt(self.factor.solve_Lt(y, use_LDLt_decomposition=False))
 
     def operator(self) -> spla.LinearOperator:
         """A^-1 as a LinearOperator (for eigsh's OPinv)."""

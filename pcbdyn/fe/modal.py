@@ -33,6 +33,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from . import lanczos
 from .assembly import assemble
 from .blocks import DENSE_MAX, ShiftedInverse, layout, uncoupled_blocks
 from .constraints import Reduction, build_reduction
@@ -53,6 +54,11 @@ STURM_MARGIN = 1e-6
 #: the solves of tol=0 (machine precision). ARPACK's default ncv = max(2k+1, 20) is kept: more
 #: Lanczos vectors cost more solves than they save on plates (measured at 60k DOF, k = 20).
 EIGSH_TOL = 1e-10
+#: groups from this size up are solved by block Lanczos (:mod:`.lanczos`) instead of ARPACK, with
+#: blocks of this many vectors and at most this many basis vectors (max(6 k, this))
+LANCZOS_MIN = 100_000
+LANCZOS_BLOCK = 8
+LANCZOS_BASIS = 160
 @dataclass
 class Modes:
     """Elastic modes (frequencies in Hz, full-length mass-normalised shapes as columns) and the
@@ -133,7 +139,7 @@ class _Block:
         """The lower triangle of K - s M (CSC), on the pattern of K and M."""
         if self._lower is None:
             plan = self._lower_plan()
-            self._lower = (plan, self.K.data[plan.positions], self.M.data[plan.positions])
+            self._lower = (plan, self.K.data[plan.mask], self.M.data[plan.mask])
         plan, Kl, Ml = self._lower
         return plan.matrix(Kl - s * Ml)
 
@@ -192,16 +198,29 @@ class _Block:
                 raise
             exhausted = True
         else:
-            op = self.solver().operator()
-            v0 = np.random.default_rng(0).standard_normal(self.K.shape[0])  # repeatable runs
-            _, vec = spla.eigsh(
-                self.K, k=want, M=self.M, sigma=self.sigma, which="LM", OPinv=op, tol=EIGSH_TOL, v0=v0
-            )
+            vec = self._block_lanczos(want) if n >= LANCZOS_MIN else None
+            if vec is None:
+                op = self.solver().operator()
+                v0 = np.random.default_rng(0).standard_normal(n)  # repeatable runs
+                _, vec = spla.eigsh(
+                    self.K, k=want, M=self.M, sigma=self.sigma, which="LM", OPinv=op, tol=EIGSH_TOL, v0=v0
+                )
             exhausted = False
         vec = _mass_normalise(vec, self.M)
         lam = np.einsum("ij,ij->j", vec, self.K @ vec)
-        gross = np.einsum("ij,ij->j", np.abs(vec), abs(self.K) @ np.abs(vec))
+        absK = sp.csr_matrix((np.abs(self.K.data), self.K.indices, self.K.indptr), shape=self.K.shape)
+        gross = np.einsum("ij,ij->j", np.abs(vec), absK @ np.abs(vec))
         return lam, vec, np.abs(lam) <= RIGID_RTOL * gross, exhausted
+
+    def _block_lanczos(self, want: int):
+        """The lowest ``want`` eigenvectors by block Lanczos on L^-1 P M P^T L^-T, or None (not
+        a Cholesky factor, or no convergence within the basis: ARPACK then)."""
+        f = self.solver()
+        if f.method != "cholmod":
+            return None
+        out = lanczos.largest(lambda Y: f.forward(self.M @ f.backward(Y)), self.K.shape[0], want,
+                              LANCZOS_BLOCK, EIGSH_TOL, max(6 * want, LANCZOS_BASIS))
+        return None if out is None else f.backward(out[1])
 
     def modes(self, want: int, n_needed: int | None):
         """Mass-normalised eigenpairs from the lowest up, until ``n_needed`` elastic modes are
