@@ -3,6 +3,7 @@
 import click
 
 from .commands import build, correlate, diagnose, localize, simulate_test, study, update
+from .fe.threads import limit_process
 
 
 @click.group()
@@ -10,6 +11,7 @@ from .commands import build, correlate, diagnose, localize, simulate_test, study
 def main():
     """Vibration of electronic equipment: build FE models of boards, correlate them with modal
     tests, update them and find what they lack."""
+    limit_process()  # one BLAS thread unless PCBDYN_BLAS_THREADS or OPENBLAS_NUM_THREADS say otherwise
 
 
 for _module in (build, simulate_test, correlate, update, localize, study, diagnose):

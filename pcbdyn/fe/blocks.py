@@ -21,7 +21,6 @@ from collections import OrderedDict
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 from scipy.sparse.csgraph import connected_components
 
 from .linsolve import pattern_key
@@ -40,7 +39,6 @@ def _components(K: sp.csr_matrix, nonzero: np.ndarray) -> list[np.ndarray]:
     n = K.shape[0]
     plan = Gather.kept(K, nonzero, np.arange(n), K.indices, K.shape)
     graph = plan.matrix(np.ones(plan.sub_indices.size))
-    del plan
     # the graph is symmetric, so its strongly connected components are the connected ones, and
     # SciPy finds those without the transposed copy its undirected search makes (2x faster)
     n_comp, label = connected_components(graph, directed=True, connection="strong")
@@ -136,7 +134,3 @@ class ShiftedInverse:
         for _ in range(steps):
             x = x + self.solve(b - K @ x)
         return x
-
-    def operator(self) -> spla.LinearOperator:
-        """The inverse as a LinearOperator."""
-        return spla.LinearOperator(self.shape, matvec=self.solve, matmat=self.solve, dtype=float)
