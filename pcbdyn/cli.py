@@ -11,7 +11,7 @@ from .fe.threads import limit_process
 def main():
     """Vibration of electronic equipment: build FE models of boards, correlate them with modal
     tests, update them and find what they lack."""
-    limit_process()  # one BLAS thread unless PCBDYN_BLAS_THREADS or OPENBLAS_NUM_THREADS say otherwise
+    limit_process()  # one BLAS and OpenMP thread unless PCBDYN_BLAS_THREADS or the environment say otherwise
 
 
 for _module in (build, simulate_test, correlate, update, localize, study, diagnose):

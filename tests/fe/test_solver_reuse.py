@@ -169,13 +169,13 @@ def test_index_plans_equal_fancy_indexing():
 def test_thread_limit_from_the_environment(monkeypatch):
     for name in ("PCBDYN_BLAS_THREADS", "OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
         monkeypatch.delenv(name, raising=False)
-    assert threads.thread_limit() == 1
+    assert threads.thread_limit() == {"blas": 1, "openmp": 1}
     monkeypatch.setenv("OPENBLAS_NUM_THREADS", "2")
-    assert threads.thread_limit() is None  # the environment already chose
+    assert threads.thread_limit() == {"openmp": 1}  # the environment already chose for BLAS
     monkeypatch.setenv("PCBDYN_BLAS_THREADS", "3")
-    assert threads.thread_limit() == 3
+    assert threads.thread_limit() == {"blas": 3, "openmp": 3}
     monkeypatch.setenv("PCBDYN_BLAS_THREADS", "0")
-    assert threads.thread_limit() is None
+    assert threads.thread_limit() == {}
     monkeypatch.setenv("PCBDYN_BLAS_THREADS", "many")
     with pytest.raises(ValueError, match="PCBDYN_BLAS_THREADS"):
         threads.thread_limit()
