@@ -37,12 +37,17 @@ from . import lanczos
 from .assembly import assemble
 from .blocks import DENSE_MAX, ShiftedInverse, layout, uncoupled_blocks
 from .constraints import Reduction, build_reduction
-from .linsolve import SingularMatrixError, factorize, has_no_negative_eigenvalue, negative_eigenvalue_count
+from .linsolve import (
+    SingularMatrixError,
+    factorize,
+    has_no_negative_eigenvalue,
+    negative_eigenvalue_count,
+)
 from .mesh import DOF_NAMES, NDOF
 from .model import ModelError
 from .threads import limited
 
-__all__ = ["DENSE_MAX", "Modes", "eigenpairs", "reduced_system", "reduce_matrix", "solve_modes", "uncoupled_blocks"]
+__all__ = ["DENSE_MAX", "Modes", "eigenpairs", "reduce_matrix", "reduced_system", "solve_modes", "uncoupled_blocks"]
 
 #: strain energy / gross energy below which a mode counts as a rigid-body (zero-frequency) mode
 RIGID_RTOL = 1e-12

@@ -7,10 +7,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-import pcbdyn.fe.blocks as blocks
-import pcbdyn.fe.linsolve as linsolve
-import pcbdyn.fe.modal as modal
-from pcbdyn.fe import threads
+from pcbdyn.fe import blocks, linsolve, modal, threads
 from pcbdyn.fe.assembly import assemble
 from pcbdyn.fe.generate import rectangle, rectangle_edges
 from pcbdyn.fe.model import Model
@@ -132,7 +129,7 @@ def test_kept_factorisation_solves_the_shifted_system(support):
     K, M = assemble(model)
     modes = modal.solve_modes(model, n_modes=6, K=K, M=M, keep_factor=True)
     assert modal.solve_modes(model, n_modes=6, K=K, M=M).shifted is None
-    red, Kr, Mr = modal.reduced_system(model, K, M)
+    _, Kr, Mr = modal.reduced_system(model, K, M)
     S = sp.lil_matrix(Kr.shape)
     for idx, sigma, _ in modes.shifted.groups:
         S[np.ix_(idx, idx)] = sigma * Mr[idx][:, idx]
