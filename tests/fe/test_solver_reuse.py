@@ -47,23 +47,31 @@ def cold(monkeypatch):
     linsolve.clear_symbolic_cache()
 
 
-@pytest.mark.parametrize("tilt, support", [(0.0, "free"), (0.0, "clamped"), (0.6, "simple")])
-def test_repeated_solves_on_one_pattern_match_cold_solves(tilt, support, monkeypatch):
+@pytest.fixture
+def warm_solves():
+    """The plates solved with everything kept, three times on one pattern (other values)."""
+    out = {}
+    for tilt, support in CASES:
+        model = plate(16, tilt, support)
+        K, M = assemble(model)
+        warm = [modal.solve_modes(model, n_modes=12, K=K * s, M=M * (2 - s)) for s in SCALES]
+        analyses = len(linsolve._symbolic)
+        assert_same_modes(modal.solve_modes(model, n_modes=12, K=K * 1.1, M=M * 0.9), warm[1], M)
+        assert len(linsolve._symbolic) == analyses  # no new symbolic analysis for the same pattern
+        out[tilt, support] = model, K, M, warm
+    return out
+
+
+CASES = [(0.0, "free"), (0.0, "clamped"), (0.6, "simple")]
+SCALES = (1.0, 1.1, 0.9)
+
+
+def test_repeated_solves_on_one_pattern_match_cold_solves(warm_solves, cold):
     """Solving again with other values (stiffer, heavier) reuses the layout, the block order and the
-    symbolic analysis; the modes equal those of a solve that kept nothing."""
-    model = plate(16, tilt, support)
-    K, M = assemble(model)
-    warm = [modal.solve_modes(model, n_modes=12, f_max=None, K=K * s, M=M * (2 - s)) for s in (1.0, 1.1, 0.9)]
-    analyses = len(linsolve._symbolic)
-    again = modal.solve_modes(model, n_modes=12, K=K * 1.1, M=M * 0.9)
-    assert len(linsolve._symbolic) == analyses  # no new symbolic analysis for the same pattern
-    assert_same_modes(again, warm[1], M)
-    monkeypatch.setattr(blocks, "LAYOUT_CACHE_SIZE", 0)
-    monkeypatch.setattr(linsolve, "SYMBOLIC_CACHE_SIZE", 0)
-    blocks._layouts.clear()
-    linsolve.clear_symbolic_cache()
-    for s, w in zip((1.0, 1.1, 0.9), warm):
-        assert_same_modes(modal.solve_modes(model, n_modes=12, K=K * s, M=M * (2 - s)), w, M)
+    symbolic analysis; the modes equal those of solves that kept nothing."""
+    for model, K, M, warm in warm_solves.values():
+        for s, w in zip(SCALES, warm):
+            assert_same_modes(modal.solve_modes(model, n_modes=12, K=K * s, M=M * (2 - s)), w, M)
 
 
 def test_cached_block_order_is_the_spectrum_order():
