@@ -15,6 +15,7 @@ import click
 
 from .commands import (build, calibrate, correlate, diagnose, export, identify, import_kicad, library, localize,
                        simulate_test, study, update, vibe, wedgelock)
+from .fe.threads import limit_process
 
 
 def _warning(message, category, filename, lineno, file=None, line=None):
@@ -41,6 +42,7 @@ class _Group(click.Group):
 def main():
     """Vibration of electronic equipment: build FE models of boards and housings, correlate them with
     modal tests, update them and find what they lack."""
+    limit_process()  # one BLAS and OpenMP thread unless PCBDYN_BLAS_THREADS or the environment say otherwise
 
 
 for _module in (build, simulate_test, correlate, update, wedgelock, localize, study, diagnose, vibe, identify,

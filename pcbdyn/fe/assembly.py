@@ -2,8 +2,10 @@
 
 Every element couples all six DOFs of each of its nodes, so the global sparsity pattern is made
 of dense 6 x 6 node blocks. The pattern is built once per call from node pairs (36 times fewer
-keys than DOF triplets) and the element matrices of K and M are both summed into it, in chunks
-of cells, so that neither DOF-level triplet lists nor a second COO->CSR conversion are needed.
+keys than DOF triplets); element matrices are computed ``CHUNK_CELLS`` cells at a time, their node
+blocks summed per pattern slot, and the sums added straight into the CSR value arrays of K and
+M, which share one index array. So no DOF-level triplet list, COO copy or format conversion is
+ever made: at 1M DOF the peak is the two value arrays, one int32 index array and one chunk.
 
 Subset assembly is what makes parameter sensitivities cheap: dK/dp of a parameter that
 touches one set needs only that set's element matrices.
@@ -19,6 +21,7 @@ from .mesh import NDOF
 
 #: element matrices are computed and summed this many cells at a time (bounds the peak memory)
 CHUNK_CELLS = 4096
+_NN = NDOF * NDOF
 
 
 def element_matrices(model, name: str, prop=None):
@@ -35,57 +38,83 @@ def _node_pairs(conn: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _node_blocks(Ae: np.ndarray) -> np.ndarray:
-    """Element matrices (n_cells, 6 npc, 6 npc) as 6 x 6 node blocks (n_cells * npc^2, 6, 6),
+    """Element matrices (n_cells, 6 npc, 6 npc) as flattened 6 x 6 node blocks (n_cells * npc^2, 36),
     in the order of :func:`_node_pairs`."""
     nc, nd, _ = Ae.shape
     npc = nd // NDOF
-    return Ae.reshape(nc, npc, NDOF, npc, NDOF).transpose(0, 1, 3, 2, 4).reshape(nc * npc * npc, NDOF, NDOF)
+    return Ae.reshape(nc, npc, NDOF, npc, NDOF).transpose(0, 1, 3, 2, 4).reshape(nc * npc * npc, _NN)
 
 
 class _Pattern:
-    """The node-block sparsity pattern of a set of cells: sorted unique (row, col) node pairs and,
-    for each pair of each cell, its block number."""
+    """The node-block sparsity pattern of a set of cells and its DOF-level CSR layout.
+
+    ``slot[s]`` gives, for each node pair of each cell of conn ``s``, its block number in the
+    sorted unique (row node, column node) pairs. Block k of node row r, at position p in that
+    row of L_r blocks, holds CSR values ``base[k] + stride[k] * i + j`` (DOF row 6 r + i,
+    DOF column 6 c + j): node row r's 6 DOF rows are contiguous, each 6 L_r values long.
+    """
 
     def __init__(self, n_nodes: int, conns: list[np.ndarray]):
         keys = [r * n_nodes + c for r, c in map(_node_pairs, conns)]
         allkeys = np.concatenate(keys) if keys else np.zeros(0, dtype=np.int64)
-        self.keys, inverse = np.unique(allkeys, return_inverse=True)
+        ukeys, inverse = np.unique(allkeys, return_inverse=True)
+        del allkeys
         self.n_nodes = n_nodes
+        self.nnz = _NN * ukeys.size
+        self.idx = np.int32 if max(self.nnz, NDOF * n_nodes) < np.iinfo(np.int32).max else np.int64
+        inverse = inverse.astype(self.idx, copy=False)
         bounds = np.cumsum([0] + [k.size for k in keys])
-        self.slot = [inverse[a:b].astype(np.int64, copy=False) for a, b in zip(bounds[:-1], bounds[1:])]
+        self.slot = [inverse[a:b] for a, b in zip(bounds[:-1], bounds[1:])]
+        rows, self.cols = np.divmod(ukeys, n_nodes)
+        counts = np.bincount(rows, minlength=n_nodes)
+        first = np.zeros(n_nodes + 1, dtype=np.int64)
+        np.cumsum(counts, out=first[1:])
+        self.base = _NN * first[rows] + NDOF * (np.arange(ukeys.size) - first[rows])
+        self.stride = NDOF * counts[rows]
+        self.row_len = counts
 
-    def empty(self) -> np.ndarray:
-        return np.zeros((self.keys.size, NDOF, NDOF))
+    def positions(self, blocks: np.ndarray) -> np.ndarray:
+        """CSR value positions (len(blocks), 36) of the 6 x 6 entries of node blocks ``blocks``."""
+        i, j = np.divmod(np.arange(_NN), NDOF)
+        return self.base[blocks][:, None] + self.stride[blocks][:, None] * i + j
 
-    def to_csr(self, data: np.ndarray) -> sp.csr_matrix:
-        """The global DOF matrix (CSR, sorted indices) from summed node blocks ``data``."""
-        nn = self.n_nodes
-        rows, cols = np.divmod(self.keys, nn)
-        indptr = np.zeros(nn + 1, dtype=np.int64)
-        np.cumsum(np.bincount(rows, minlength=nn), out=indptr[1:])
-        idx = np.int32 if max(self.keys.size, NDOF * nn) < np.iinfo(np.int32).max else np.int64  # CSR widens if needed
-        A = sp.bsr_matrix((data, cols.astype(idx), indptr.astype(idx)), shape=(NDOF * nn, NDOF * nn))
-        return A.tocsr()
+    def csr_index(self) -> tuple[np.ndarray, np.ndarray]:
+        """(indptr, indices) of the DOF-level CSR matrix, sorted column indices."""
+        indptr = np.zeros(NDOF * self.n_nodes + 1, dtype=self.idx)
+        np.cumsum(np.repeat(NDOF * self.row_len, NDOF), out=indptr[1:])
+        indices = np.empty(self.nnz, dtype=self.idx)
+        cols6 = (NDOF * self.cols)[:, None] + np.arange(NDOF)
+        for i in range(NDOF):
+            indices[(self.base + self.stride * i)[:, None] + np.arange(NDOF)] = cols6
+        return indptr, indices
+
+    def to_csr(self, data: np.ndarray, index=None) -> sp.csr_matrix:
+        """The n_dof x n_dof CSR matrix with values ``data``; ``index`` = (indptr, indices) to share."""
+        indptr, indices = self.csr_index() if index is None else index
+        n = NDOF * self.n_nodes
+        return sp.csr_matrix((data, indices, indptr), shape=(n, n), copy=False)
 
 
-def _accumulate(data: np.ndarray, slot: np.ndarray, blocks: np.ndarray) -> None:
-    """data[slot[i]] += blocks[i] for every i, duplicates included: one sort of the slots, then
-    the sums of each run as a 0/1 sparse matrix times the blocks (36 values per row)."""
+def _accumulate(pattern: _Pattern, targets, slot: np.ndarray, blocks) -> None:
+    """Add node blocks ``blocks[t]`` (m, 36) into CSR values ``targets[t]`` at pattern slots ``slot``
+    (duplicates summed): one sort of the slots, shared by all targets, gives the runs of equal
+    slots as a 0/1 sparse matrix whose product with the blocks sums each run."""
     order = np.argsort(slot, kind="stable")
     s = slot[order]
     starts = np.flatnonzero(np.r_[True, s[1:] != s[:-1]])
-    indptr = np.r_[starts, s.size]
-    S = sp.csr_matrix((np.ones(s.size), order, indptr), shape=(starts.size, s.size))
-    data[s[starts]] += (S @ blocks.reshape(s.size, NDOF * NDOF)).reshape(-1, NDOF, NDOF)
+    S = sp.csr_matrix((np.ones(s.size), order, np.r_[starts, s.size]), shape=(starts.size, s.size))
+    pos = pattern.positions(s[starts]).ravel()
+    for data, b in zip(targets, blocks):
+        data[pos] += (S @ b).ravel()
 
 
 def scatter(n_dof: int, conn: np.ndarray, Ae: np.ndarray) -> sp.csr_matrix:
     """Sum element matrices ``Ae`` (n_cells, nd, nd) of cells ``conn`` into an n_dof x n_dof CSR matrix."""
     conn = np.asarray(conn, dtype=np.int64)
     pattern = _Pattern(n_dof // NDOF, [conn])
-    data = pattern.empty()
+    data = np.zeros(pattern.nnz)
     if conn.size:
-        _accumulate(data, pattern.slot[0], _node_blocks(np.asarray(Ae)))
+        _accumulate(pattern, [data], pattern.slot[0], [_node_blocks(np.asarray(Ae))])
     return pattern.to_csr(data)
 
 
@@ -94,21 +123,21 @@ def assemble(model, sets=None, props=None):
 
     ``sets``: names of the element sets to include (default: all). ``props``: optional
     {set name: property} overrides, used to evaluate a perturbed set without copying the model.
-    Both matrices share one node-block pattern (explicit zeros kept: every element couples all
-    six DOFs of its nodes). Element matrices are computed ``CHUNK_CELLS`` cells at a time, and
-    the node blocks of small sets are pooled before they are summed in.
+    Both matrices share one node-block pattern, index arrays included (explicit zeros kept: every
+    element couples all six DOFs of its nodes); indices are int32 below 2^31 entries. Element
+    matrices are computed ``CHUNK_CELLS`` cells at a time, and the node blocks of small sets are
+    pooled before they are summed in.
     """
     names = list(model.sets) if sets is None else list(sets)
     props = props or {}
     names = [nm for nm in names if len(model.sets[nm].conn) > 0]
     pattern = _Pattern(model.n_dof // NDOF, [model.sets[nm].conn for nm in names])
-    K, M = pattern.empty(), pattern.empty()
+    K, M = np.zeros(pattern.nnz), np.zeros(pattern.nnz)
     pending, size = [], 0
 
     def flush():
         slot = np.concatenate([p[0] for p in pending])
-        _accumulate(K, slot, np.concatenate([p[1] for p in pending]))
-        _accumulate(M, slot, np.concatenate([p[2] for p in pending]))
+        _accumulate(pattern, (K, M), slot, [np.concatenate([p[t] for p in pending]) for t in (1, 2)])
         pending.clear()
 
     for name, slot in zip(names, pattern.slot):
@@ -127,4 +156,5 @@ def assemble(model, sets=None, props=None):
                 size = 0
     if pending:
         flush()
-    return pattern.to_csr(K), pattern.to_csr(M)
+    index = pattern.csr_index()
+    return pattern.to_csr(K, index), pattern.to_csr(M, index)

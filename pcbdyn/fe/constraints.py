@@ -4,12 +4,13 @@ through their masters. Reduced matrices are T^T K T and T^T M T.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
 
 from .model import ModelError
+from .sparsity import Gather, canonical_csr, selection
 
 
 @dataclass
@@ -18,6 +19,7 @@ class Reduction:
 
     T: sp.csr_matrix  # (n_full, n_red)
     independent: np.ndarray  # full DOF number of each reduced DOF
+    _selection: Gather | None = field(default=None, repr=False, compare=False)
 
     def expand(self, x: np.ndarray) -> np.ndarray:
         """Full vectors (n_full, ...) from reduced ones (n_red, ...)."""
@@ -28,12 +30,17 @@ class Reduction:
         """True when T only drops DOFs (one unit entry per column: no MPC terms survive)."""
         return self.T.nnz == self.independent.size
 
-    def reduce(self, A: sp.spmatrix) -> sp.csc_matrix:
-        """T^T A T as CSC; by row/column selection when T only drops DOFs (cheaper, exact)."""
-        if self.is_selection:
-            idx = self.independent
-            return sp.csr_matrix(A)[idx][:, idx].tocsc()
-        return (self.T.T @ A @ self.T).tocsc()
+    def reduce(self, A: sp.spmatrix) -> sp.csr_matrix:
+        """T^T A T as CSR. When T only drops DOFs, by row/column selection (exact, no products):
+        the entries' positions are found once per sparsity pattern and reused, so K and M (which
+        share their index arrays) cost one search, and the reduced pair shares its index arrays too.
+        """
+        if not self.is_selection:
+            return (self.T.T @ A @ self.T).tocsr()
+        A = canonical_csr(A)
+        if self._selection is None or not self._selection.fits(A):
+            self._selection = selection(A, self.independent)
+        return self._selection.apply(A.data)
 
 
 def build_reduction(model, K=None, M=None) -> Reduction:
@@ -53,7 +60,10 @@ def build_reduction(model, K=None, M=None) -> Reduction:
         fixed[np.fromiter(model.fixed, dtype=np.int64)] = True
     untouched = np.zeros(n, dtype=bool)
     if K is not None and M is not None:
-        touched = (abs(K).sum(axis=1).A1 > 0) | (abs(M).sum(axis=1).A1 > 0)
+        touched = np.zeros(n, dtype=bool)
+        for A in (K, M):  # symmetric: a DOF with a nonzero in its row has one in its column
+            A = A.tocsr()
+            touched[A.indices[A.data != 0]] = True
         for s, terms in slaves.items():  # a slave's stiffness reaches its masters
             if touched[s]:
                 for m, _ in terms:
@@ -78,15 +88,10 @@ def build_reduction(model, K=None, M=None) -> Reduction:
             return []
         return [(dof, 1.0)]
 
-    rows = list(independent)
-    cols = list(range(independent.size))
-    vals = [1.0] * independent.size
-    for s in slaves:
-        if fixed[s]:
-            continue
-        for m, c in resolve(s):
-            rows.append(s)
-            cols.append(col[m])
-            vals.append(c)
+    terms = [(s, col[m], c) for s in slaves if not fixed[s] for m, c in resolve(s)]
+    rows, cols, vals = (np.array(v) for v in zip(*terms)) if terms else (np.zeros(0, dtype=np.int64),) * 3
+    rows = np.concatenate([independent, rows]).astype(np.int64)
+    cols = np.concatenate([np.arange(independent.size), cols]).astype(np.int64)
+    vals = np.concatenate([np.ones(independent.size), vals]).astype(float)
     T = sp.csr_matrix((vals, (rows, cols)), shape=(n, independent.size))
     return Reduction(T, independent)

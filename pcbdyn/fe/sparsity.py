@@ -1,0 +1,120 @@
+"""Index plans on CSR patterns: which entries of a matrix make a submatrix or its lower triangle.
+
+A plan is found once per sparsity pattern and then turns any value array on that pattern into
+the new matrix by one gather, so K and M (which share their pattern) and every later solve of
+the same model (other parameter values) pay the index search once. Nothing here is a COO or a
+fancy-indexing copy of the whole matrix.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+
+def same_array(a: np.ndarray, b: np.ndarray) -> bool:
+    """True when ``a`` and ``b`` are views of the very same memory (SciPy wraps shared index
+    arrays in new views, so ``is`` cannot tell): O(1), no comparison of contents."""
+    return a.shape == b.shape and a.dtype == b.dtype and a.strides == b.strides and (
+        a.__array_interface__["data"][0] == b.__array_interface__["data"][0])
+
+
+def _same(a: np.ndarray, b: np.ndarray) -> bool:
+    return same_array(a, b) or (a.shape == b.shape and np.array_equal(a, b))
+
+
+@dataclass
+class Gather:
+    """The entries of a source pattern (``indptr``, ``indices``) where ``mask`` is set, forming a
+    new compressed matrix (``sub_indptr``, ``sub_indices``) of ``shape`` in format ``fmt`` ("csr"
+    or "csc"). A boolean mask streams through the values faster than a gather by positions and
+    takes an eighth of their memory."""
+
+    indptr: np.ndarray
+    indices: np.ndarray
+    mask: np.ndarray
+    sub_indptr: np.ndarray
+    sub_indices: np.ndarray
+    shape: tuple
+    fmt: str = "csr"
+
+    @classmethod
+    def kept(cls, A, keep: np.ndarray, rows: np.ndarray, cols: np.ndarray, shape, fmt: str = "csr") -> Gather:
+        """The plan keeping the entries of CSR ``A`` where ``keep`` (one bool per entry, False in
+        every row not in ``rows``) is set, the rows ``rows`` (sorted) of A becoming the new rows and
+        ``cols`` (one per entry of A) giving the new column numbers."""
+        padded = np.zeros(keep.size + 1, dtype=bool)  # a False past the end: reduceat may index it
+        padded[:-1] = keep
+        counts = np.add.reduceat(padded, A.indptr[rows], dtype=np.int32)
+        counts[A.indptr[rows] == A.indptr[rows + 1]] = 0  # reduceat gives an empty row its next entry
+        sub_indptr = np.zeros(rows.size + 1, dtype=A.indices.dtype)
+        np.cumsum(counts, out=sub_indptr[1:])
+        return cls(A.indptr, A.indices, keep, sub_indptr, cols[keep], shape, fmt)
+
+    def fits(self, A) -> bool:
+        """True when ``A`` has the source pattern of this plan."""
+        return _same(A.indptr, self.indptr) and _same(A.indices, self.indices)
+
+    def apply(self, data: np.ndarray):
+        """The new matrix from the values ``data`` on the source pattern."""
+        return self.matrix(data[self.mask])
+
+    def matrix(self, values: np.ndarray):
+        """The new matrix from its own values (``data[mask]``, or sums of such)."""
+        make = sp.csr_matrix if self.fmt == "csr" else sp.csc_matrix
+        return make((values, self.sub_indices, self.sub_indptr), shape=self.shape, copy=False)
+
+
+def selection(A: sp.csr_matrix, idx: np.ndarray) -> Gather:
+    """The plan of A[idx][:, idx] (``idx`` sorted, CSR ``A`` with sorted indices), as CSR."""
+    n, m = A.shape[0], idx.size
+    newcol = np.full(n, -1, dtype=A.indices.dtype)
+    newcol[idx] = np.arange(m, dtype=A.indices.dtype)
+    cols = newcol[A.indices]
+    keep = (cols >= 0) & np.repeat(newcol >= 0, np.diff(A.indptr))
+    return Gather.kept(A, keep, idx, cols, (m, m))
+
+
+def lower_triangle(A: sp.csr_matrix) -> Gather:
+    """The plan of the lower triangle of a symmetric CSR ``A`` as CSC: its upper entries row by row
+    are the lower ones column by column, so CHOLMOD gets it without a transpose."""
+    n = A.shape[0]
+    keep = A.indices >= np.repeat(np.arange(n, dtype=A.indices.dtype), np.diff(A.indptr))
+    return Gather.kept(A, keep, np.arange(n), A.indices, A.shape, fmt="csc")
+
+
+def canonical_csr(A) -> sp.csr_matrix:
+    """``A`` as CSR with sorted, summed indices (no copy when it already is)."""
+    A = A.tocsr()
+    if not A.has_canonical_format:
+        A = A.copy()
+        A.sum_duplicates()
+    return A
+
+
+def common_pattern(K, M) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+    """K and M as canonical CSR on one pattern, index arrays shared. Assembled and reduced pairs
+    already share theirs; otherwise the union of their nonzeros is taken (an entry zero in both
+    is dropped)."""
+    K, M = canonical_csr(K), canonical_csr(M)
+    if same_array(K.indices, M.indices) and same_array(K.indptr, M.indptr):
+        return K, M
+    if _same(K.indptr, M.indptr) and _same(K.indices, M.indices):
+        return K, sp.csr_matrix((M.data, K.indices, K.indptr), shape=M.shape, copy=False)
+    union = canonical_csr(abs(K) + abs(M))
+    n = K.shape[0]
+
+    def keys(A):
+        return np.repeat(np.arange(n, dtype=np.int64), np.diff(A.indptr)) * n + A.indices
+
+    where = keys(union)
+
+    def place(A):
+        data = np.zeros(union.nnz)
+        nz = A.data != 0
+        data[np.searchsorted(where, keys(A)[nz])] = A.data[nz]
+        return sp.csr_matrix((data, union.indices, union.indptr), shape=A.shape, copy=False)
+
+    return place(K), place(M)
