@@ -15,6 +15,8 @@ from pcbdyn.fe.properties import BeamProperty, MassProperty, ShellProperty, Spri
 
 from reference import thesis_case
 
+from frames import three_member_frame
+
 
 def chain(ks, ms, wall=True, axes=(0,)):
     """wall-k1-m1-k2-m2-...: node 0 is the wall, node i carries mass m_i; springs act along ``axes``
@@ -179,24 +181,8 @@ def test_free_translational_network_has_three_rigid_modes():
 
 
 def beam_frame():
-    """A free, non-planar frame of three steel tubes with rotary inertia: six rigid-body modes."""
-    nodes = np.array([[0, 0, 0], [0.2, 0, 0], [0.2, 0.15, 0], [0.2, 0.15, 0.1]], dtype=float)
-    n_el = 4
-    pts, conn = [nodes[0]], []
-    for a, b in zip(nodes[:-1], nodes[1:]):
-        for t in np.linspace(0, 1, n_el + 1)[1:]:
-            pts.append(a + t * (b - a))
-            conn.append([len(pts) - 2, len(pts) - 1])
-    model = Model(np.array(pts))
-    conn = np.array(conn)
-    props = [
-        BeamProperty(210e9, 0.3, 7850, 1e-4, 2e-9, 3e-9, 4e-9, orientation=(0, 0, 1)),
-        BeamProperty(70e9, 0.33, 2700, 2e-4, 4e-9, 1e-9, 3e-9, orientation=(0, 0, 1)),
-        BeamProperty(210e9, 0.3, 7850, 1.5e-4, 3e-9, 3e-9, 5e-9, orientation=(1, 0, 0)),
-    ]
-    for i, p in enumerate(props):
-        model.add(f"b{i}", "beam2", conn[i * n_el:(i + 1) * n_el], p)
-    return model
+    """A free, non-planar frame of three steel and aluminium tubes with rotary inertia: six rigid-body modes."""
+    return three_member_frame([[0, 0, 0], [0.2, 0, 0], [0.2, 0.15, 0], [0.2, 0.15, 0.1]], 4)
 
 
 def test_free_beam_frame_has_six_rigid_modes():
@@ -305,22 +291,13 @@ def test_free_flat_plate_membrane_block_asks_only_its_modes_below_the_cut(monkey
     modes, which may sit in a tight cluster of drilling modes). Frequencies, rigid-mode count and
     M-orthonormality agree with a dense solve of the whole pencil, for n_modes and for f_max."""
     pytest.importorskip("pcbdyn.fe.elements.shell_quad4")
-    import pcbdyn.fe.modal as modal
-
     model = _square_plate(14, 0.0)
     red, Kr, Mr = reduced_system(model)
     blocks = uncoupled_blocks(Kr, Mr)
     assert len(blocks) == 2 and min(b.size for b in blocks) > DENSE_MAX
     lam = sla.eigh(Kr.toarray(), Mr.toarray(), eigvals_only=True)
     f_ref = np.sqrt(lam[6:]) / (2 * np.pi)
-    asked = []
-    eigsh = modal.spla.eigsh
-
-    def spy(A, k, **kw):
-        asked.append(k)
-        return eigsh(A, k=k, **kw)
-
-    monkeypatch.setattr(modal.spla, "eigsh", spy)
+    asked = eigsh_requests(monkeypatch)
     modes = solve_modes(model, n_modes=10)
     assert modes.n_rigid == 6
     np.testing.assert_allclose(modes.frequencies, f_ref[:10], rtol=1e-8)
@@ -336,8 +313,6 @@ def test_clamped_block_with_nothing_below_the_cut_is_skipped(monkeypatch):
     of K - s M proves it, so eigsh runs on the bending block only; the frequencies match a dense
     solve of the whole pencil."""
     pytest.importorskip("pcbdyn.fe.elements.shell_quad4")
-    import pcbdyn.fe.modal as modal
-
     nodes, quads = rectangle(0.2, 0.2, 16, 16)
     model = Model(nodes)
     model.add("plate", "quad4", quads, ShellProperty(E=210e9, nu=0.3, rho=7850.0, t=2e-3))
@@ -346,14 +321,7 @@ def test_clamped_block_with_nothing_below_the_cut_is_skipped(monkeypatch):
     _, Kr, Mr = reduced_system(model)
     assert [b.size > DENSE_MAX for b in uncoupled_blocks(Kr, Mr)] == [True, True]
     lam = sla.eigh(Kr.toarray(), Mr.toarray(), eigvals_only=True)
-    asked = []
-    eigsh = modal.spla.eigsh
-
-    def spy(A, k, **kw):
-        asked.append(k)
-        return eigsh(A, k=k, **kw)
-
-    monkeypatch.setattr(modal.spla, "eigsh", spy)
+    asked = eigsh_requests(monkeypatch)
     modes = solve_modes(model, n_modes=8)
     np.testing.assert_allclose(modes.omega2, lam[:8], rtol=1e-8)
     assert asked == [8]
@@ -391,3 +359,17 @@ def test_assembly_equals_sum_of_element_matrices():
     for dofs, ke in zip(element_dofs(model.sets["stiffener"].conn), Ke):
         Kb[np.ix_(dofs, dofs)] += ke
     np.testing.assert_allclose(sub_K.toarray(), Kb, rtol=0, atol=1e-12 * np.abs(Kb).max())
+
+
+def eigsh_requests(monkeypatch) -> list:
+    """The number of modes each eigsh call of the modal solver asks for, appended as it runs."""
+    import pcbdyn.fe.modal as modal
+
+    asked, eigsh = [], modal.spla.eigsh
+
+    def spy(A, k, **kw):
+        asked.append(k)
+        return eigsh(A, k=k, **kw)
+
+    monkeypatch.setattr(modal.spla, "eigsh", spy)
+    return asked

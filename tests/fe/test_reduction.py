@@ -6,29 +6,15 @@ import pytest
 import scipy.linalg as sla
 
 from pcbdyn.fe.modal import reduced_system, solve_modes
-from pcbdyn.fe.model import Model, ModelError
-from pcbdyn.fe.properties import BeamProperty
+from pcbdyn.fe.model import ModelError
 from pcbdyn.fe.reduction import dynamic_expansion, dynamic_reduction, guyan, master_index, serep
+
+from frames import three_member_frame
 
 
 def frame():
-    """A non-planar frame of three members, clamped at both ends (6 DOF per node, 15 nodes)."""
-    corners = np.array([[0, 0, 0], [0.3, 0, 0], [0.3, 0.2, 0], [0.3, 0.2, 0.15]], dtype=float)
-    n_el = 5
-    pts, conn = [corners[0]], []
-    for a, b in zip(corners[:-1], corners[1:]):
-        for t in np.linspace(0, 1, n_el + 1)[1:]:
-            pts.append(a + t * (b - a))
-            conn.append([len(pts) - 2, len(pts) - 1])
-    model = Model(np.array(pts))
-    conn = np.array(conn)
-    props = [
-        BeamProperty(210e9, 0.3, 7850, 1e-4, 2e-9, 3e-9, 4e-9, orientation=(0, 0, 1)),
-        BeamProperty(70e9, 0.33, 2700, 2e-4, 4e-9, 1e-9, 3e-9, orientation=(0, 0, 1)),
-        BeamProperty(210e9, 0.3, 7850, 1.5e-4, 3e-9, 3e-9, 5e-9, orientation=(1, 0, 0)),
-    ]
-    for i, p in enumerate(props):
-        model.add(f"b{i}", "beam2", conn[i * n_el:(i + 1) * n_el], p)
+    """A non-planar frame of three members, clamped at both ends (6 DOF per node, 16 nodes)."""
+    model = three_member_frame([[0, 0, 0], [0.3, 0, 0], [0.3, 0.2, 0], [0.3, 0.2, 0.15]], 5)
     model.fix([0, model.n_nodes - 1])
     return model
 
