@@ -36,6 +36,28 @@ def main():
     run_study(case, LEVELS, shots=20, methods=METHODS, kinds=("frf", "frf+pbc"), rank=-1,
               workers=workers, progress=False)
     print(f"same study with FRF and FRF+PBC equations: {time.perf_counter() - t2:.2f} s")
+    bundled()
+
+
+def bundled() -> None:
+    """``pcbdyn study examples/studies/study.toml`` as a user runs it (issue 23 target: <= 60 s)."""
+    import shutil
+    import subprocess
+    import sys
+    import tempfile
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    with tempfile.TemporaryDirectory() as d:
+        shutil.copy(root / "examples/studies/study.toml", d)
+        load, t0 = os.getloadavg()[0], time.perf_counter()
+        before = os.times()
+        subprocess.run([sys.executable, "-m", "pcbdyn.cli", "study", str(Path(d) / "study.toml"), "--quiet"],
+                       check=True, capture_output=True)
+        after = os.times()
+        cpu = (after.children_user + after.children_system) - (before.children_user + before.children_system)
+        print(f"pcbdyn study examples/studies/study.toml: {time.perf_counter() - t0:.1f} s wall, {cpu:.1f} s CPU "
+              f"(load {load:.1f}; target <= 60 s)")
 
 
 if __name__ == "__main__":

@@ -48,3 +48,7 @@ def main():
 for _module in (build, simulate_test, correlate, update, wedgelock, localize, study, diagnose, vibe, identify,
                 import_kicad, export, calibrate, library):
     main.add_command(_module.command)
+
+
+if __name__ == "__main__":
+    main()
