@@ -24,7 +24,16 @@ A built model (:class:`pcbdyn.fe.parametric.ParametricModel`) adds what a diagno
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Protocol
+
+
+@dataclass
+class Analysis:
+    """A structure's ``[analysis]``: how many modes to solve, up to which frequency f_max [Hz]."""
+
+    modes: int = 12
+    f_max: float | None = None
 
 
 class StructureError(ValueError):

@@ -191,13 +191,7 @@ def parse_board(data: dict, path: Path) -> Board:
         if not outline.contains(pt)[0]:
             r.fail(f"points[{i}]", f"{p} is not on the board; move it inside the outline")
         board.points.append(pt)
-    if "analysis" in data:
-        a = r.table(data["analysis"], "analysis", ["modes", "f_max"])
-        modes = a.get("modes", 12)
-        if isinstance(modes, bool) or not isinstance(modes, int) or modes < 1:
-            r.fail("analysis.modes", f"must be a positive whole number, got {modes!r}")
-        f_max = r.q(a["f_max"], "Hz", "analysis.f_max", positive=True) if "f_max" in a else None
-        board.analysis = Analysis(modes, f_max)
+    board.analysis = r.analysis(data)
     for i, p in enumerate(r.list(data, "parameters")):
         try:
             board.parameters.append(targets.parameter_spec(p, f"parameters[{i}]", board.quantity, r.file, COLLECTIONS))
