@@ -16,6 +16,8 @@ A structure has a ``name``, the ``path`` of its file, its ``parameters``
   ``source``, a file) that lie off the structure;
 - ``write_updated(values, dst, source)``: its file with parameter ``values`` {name: SI} written into
   their targets, the user's comments and layout kept; returns the path written;
+- ``write_enriched(effects, dst)``: its file with the effects a diagnosis found declared in it (the
+  user's comments and layout kept); returns the path written;
 - ``outlines(config=None)``: what a mode-shape picture outlines (plain data: kind, label, points).
 
 A built model (:class:`pcbdyn.fe.parametric.ParametricModel`) adds what a diagnosis asks of it:
@@ -54,5 +56,7 @@ class Structure(Protocol):
     def check_points(self, xyz, source) -> None: ...
 
     def write_updated(self, values: dict, dst, source: str = "pcbdyn update"): ...
+
+    def write_enriched(self, effects, dst): ...
 
     def outlines(self, config=None) -> list: ...

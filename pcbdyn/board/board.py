@@ -126,6 +126,12 @@ class Board:
         """What a mode-shape picture outlines, as plain data (:func:`.outlines.board_outlines`)."""
         return board_outlines(self, config)
 
+    def write_enriched(self, effects, dst) -> Path:
+        """``dst``: this board.toml with the effects a diagnosis found declared (:mod:`.enrich`)."""
+        from .enrich import write_enriched
+
+        return write_enriched(self.path, effects, dst)
+
     def write_updated(self, values: dict, dst, source: str = "pcbdyn update") -> Path:
         """``dst``: this board.toml with the parameters' ``values`` {name: SI} written into their targets
         (comments and layout kept), checked by loading it before it replaces ``dst``."""

@@ -116,6 +116,12 @@ class Box:
                   for m in self.masses + added]
         return items
 
+    def write_enriched(self, effects, dst) -> Path:
+        """``dst``: this box.toml with the effects a diagnosis found declared (:mod:`.enrich`)."""
+        from .enrich import write_enriched
+
+        return write_enriched(self, effects, dst)
+
     def write_updated(self, values: dict, dst, source: str = "pcbdyn update") -> Path:
         """``dst``: this box.toml with the parameters' ``values`` {name: SI} written into their targets
         (comments and layout kept), checked by loading it before it replaces ``dst``."""
