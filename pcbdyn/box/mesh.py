@@ -102,7 +102,10 @@ def mesh_box(plates, lines, points, size: float) -> BoxMesh:
             objects = [(2, _surface(occ, p.corners())) for p in plates]
             tools = [(1, occ.addLine(occ.addPoint(*map(float, a)), occ.addPoint(*map(float, b)))) for a, b in lines]
             tools += [(0, occ.addPoint(*map(float, p))) for p in points]
-            _, out_map = occ.fragment(objects, tools)
+            if tools or len(objects) > 1:
+                _, out_map = occ.fragment(objects, tools)
+            else:  # one plate alone: nothing to fragment
+                out_map = [objects]
             occ.synchronize()
             surfaces = [[t for d, t in m if d == 2] for m in out_map[:len(plates)]]
             point_tags = out_map[len(out_map) - len(points):] if len(points) else []

@@ -7,8 +7,8 @@ gives exact dK/dp, dM/dp.
 Element sets: ``plates.<name>`` (flat shells in 3-D, 6 DOF per node; triangles in ``plates.<name>.tri3``),
 ``ribs.<name>`` (eccentric beams on the rib line, or a shell strip: :mod:`.ribs`), ``joints.<name>``
 (rotational springs per unit length about an edge two plates share: the second plate gets its own copy
-of the edge's nodes, tied to the first's in translation and in the rotations across the edge; corners
-where the edge meets another edge of that plate stay rigid), ``masses.<name>`` and
+of the edge's nodes, tied to the first's in translation and in the rotations across the edge; nodes
+where the edge meets another shared or supported edge of that plate stay rigid), ``masses.<name>`` and
 ``configurations.<config>.<name>`` (point masses). Edges two plates share are rigid unless a joint
 names them (one mesh, shared nodes). Supports hold a plate's edge: clamped (every DOF) or hinged (the
 rotation about the edge free).
@@ -139,8 +139,9 @@ def _joint_nodes(box, mesh, model, plate_map: dict, q: dict, makers: dict) -> No
         a, b = (box.plate(n) for n in j.plates)
         for c in (c for c in box.contacts if set(c.plates) == set(j.plates)):
             chain = mesh.chain(c.start, c.end, mesh.plate_nodes(b.name))
-            others = [d for d in box.contacts if b.name in d.plates and d is not c]
-            dup = np.array([not any(segment_gap(x, x, d.start, d.end) < 1e-7 for d in others) for x in mesh.nodes[chain]])
+            others = [(d.start, d.end) for d in box.contacts if b.name in d.plates and d is not c]
+            others += [b.edge(s.edge) for s in box.supports if s.plate == b.name]
+            dup = np.array([not any(segment_gap(x, x, *d) < 1e-7 for d in others) for x in mesh.nodes[chain]])
             new = model.add_nodes(mesh.nodes[chain[dup]])
             plate_map[b.name][chain[dup]] = new
             for orig, copy in zip(chain[dup], new):
@@ -161,16 +162,28 @@ def _edge_nodes(box, mesh, plate_map, s) -> np.ndarray:
     return plate_map[plate.name][mesh.chain(*plate.edge(s.edge), mesh.plate_nodes(plate.name))]
 
 
-def _support(box, mesh, model, plate_map, s) -> None:
-    nodes = _edge_nodes(box, mesh, plate_map, s)
-    p0, p1 = box.plate(s.plate).edge(s.edge)
-    if s.type == "clamped":
-        model.fix(nodes)
-        return
-    model.fix(nodes, supports.TRANSLATIONS)
-    e = (p1 - p0) / np.linalg.norm(p1 - p0)
-    for n in nodes:
-        _tie_across(model, int(n), None, e)
+def _hold(box, mesh, model, plate_map) -> None:
+    """The supports: a clamped edge holds every DOF of its nodes, a hinged one their translations and the
+    rotations across the edge (about its direction they stay free); where hinged edges of different
+    directions meet, nothing is left free to turn."""
+    clamped, free_axis = set(), {}
+    for s in box.supports:
+        nodes = [int(n) for n in _edge_nodes(box, mesh, plate_map, s)]
+        if s.type == "clamped":
+            model.fix(nodes)
+            clamped.update(nodes)
+            continue
+        model.fix(nodes, supports.TRANSLATIONS)
+        p0, p1 = box.plate(s.plate).edge(s.edge)
+        for n in nodes:
+            free_axis.setdefault(n, []).append((p1 - p0) / np.linalg.norm(p1 - p0))
+    for n, axes in free_axis.items():
+        if n in clamped:
+            continue
+        if all(abs(abs(a @ axes[0]) - 1.0) < 1e-9 for a in axes):
+            _tie_across(model, n, None, axes[0])
+        else:
+            model.fix([n], (3, 4, 5))
 
 
 def build_model(box, config: str | None = None, mesh_size: float | None = None, shared_mesh: bool = False) -> BoxModel:
@@ -215,8 +228,7 @@ def build_model(box, config: str | None = None, mesh_size: float | None = None, 
             makers[name] = SetMaker("quad4", conn, (SHEAR_KEY,),
                                     lambda q, prop=prop: replace(prop, shear_factor=5.0 / 6.0 * q[SHEAR_KEY]))
         hold_ends(model, ends, {int(n): s.type for s in box.supports for n in _edge_nodes(box, mesh, plate_map, s)})
-    for s in box.supports:
-        _support(box, mesh, model, plate_map, s)
+    _hold(box, mesh, model, plate_map)
     point_nodes = {name: int(plate_map[plate][n]) for (name, plate, _), n in zip(named, mesh.point_nodes)}
     masses = [(f"masses.{m.name}", m) for m in box.masses] + [(f"configurations.{cfg.name}.{m.name}", m)
                                                                for m in (cfg.masses if cfg else [])]

@@ -146,13 +146,12 @@ def check_plates(r, plates, supports) -> list:
     loose = [g for g in parts if not (g & held)] if held else (parts if len(parts) > 1 else [])
     if loose:
         g = min(loose, key=len)
-        others = [p for p in plates if p.name not in g]
-        mine = [p for p in plates if p.name in g]
-        if not others:
+        near = [(*nearest_edges(a, b), i, b) for i, a in enumerate(plates) if a.name in g for b in plates
+                if b.name not in g]
+        if not near:
             r.fail("supports", "no plate of the box is held; add [[supports]] or leave the box free (no supports)")
-        gap, pa, pb, ea, eb = min((*nearest_edges(a, b)[:1], a, b, *nearest_edges(a, b)[1:])
-                                  for a in mine for b in others)
-        i = next(k for k, p in enumerate(plates) if p.name == pa.name)
+        gap, ea, eb, i, pb = min(near, key=lambda t: t[0])
+        pa = plates[i]
         r.fail(f"plates[{i}]", f"plate '{pa.name}' does not meet the rest of the box: the nearest edges, {pa.name}.{ea} "
                                f"and {pb.name}.{eb}, are {gap * 1e3:.4g} mm apart; move its origin or change u, v so "
                                "that the plates share the edge (or hold it with a [[supports]] entry)")
