@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..board.mesh import _LOCK as GMSH_LOCK
+from ..board.mesh import generate_quads, gmsh_session, mesh_nodes, surface_cells, tagged_nodes, used_nodes
 
 
 @dataclass
@@ -70,66 +70,31 @@ def _surface(occ, corners) -> int:
     return occ.addPlaneSurface([occ.addCurveLoop(lines)])
 
 
-def _generate(gmsh, size: float) -> None:
-    """Quads at ``size``; where blossom leaves triangles, twice as coarse and every cell split."""
-    gmsh.option.setNumber("Mesh.Algorithm", 6)
-    gmsh.option.setNumber("Mesh.RecombineAll", 1)
-    gmsh.option.setNumber("Mesh.RecombinationAlgorithm", 1)
-    gmsh.option.setNumber("Mesh.MeshSizeMin", 0.0)
-    gmsh.option.setNumber("Mesh.MeshSizeMax", size)
-    gmsh.model.mesh.generate(2)
-    if 2 in gmsh.model.mesh.getElementTypes(2):
-        gmsh.model.mesh.clear()
-        gmsh.option.setNumber("Mesh.Algorithm", 8)
-        gmsh.option.setNumber("Mesh.MeshSizeMax", 2.0 * size)
-        gmsh.option.setNumber("Mesh.SubdivisionAlgorithm", 1)
-        gmsh.model.mesh.generate(2)
-
-
 def mesh_box(plates, lines, points, size: float) -> BoxMesh:
     """Mesh ``plates`` (:class:`.entries.Plate`) at element size ``size`` [m] with the straight ``lines``
     [(p0, p1)] [m] (ribs) as element edges and ``points`` (k, 3) [m] as nodes."""
-    import gmsh
-
     points = np.asarray(points, dtype=float).reshape(-1, 3)
-    with GMSH_LOCK:
-        gmsh.initialize(readConfigFiles=False, interruptible=False)
-        try:
-            gmsh.option.setNumber("General.Terminal", 0)
-            gmsh.option.setNumber("General.Verbosity", 1)
-            gmsh.model.add("box")
-            occ = gmsh.model.occ
-            objects = [(2, _surface(occ, p.corners())) for p in plates]
-            tools = [(1, occ.addLine(occ.addPoint(*map(float, a)), occ.addPoint(*map(float, b)))) for a, b in lines]
-            tools += [(0, occ.addPoint(*map(float, p))) for p in points]
-            if tools or len(objects) > 1:
-                _, out_map = occ.fragment(objects, tools)
-            else:  # one plate alone: nothing to fragment
-                out_map = [objects]
-            occ.synchronize()
-            surfaces = [[t for d, t in m if d == 2] for m in out_map[:len(plates)]]
-            point_tags = out_map[len(out_map) - len(points):] if len(points) else []
-            _generate(gmsh, size)
-            tags, coords, _ = gmsh.model.mesh.getNodes()
-            xyz = coords.reshape(-1, 3)
-            index = np.full(int(tags.max()) + 1, -1, dtype=np.int64)
-            index[tags.astype(np.int64)] = np.arange(tags.size)
-            cells: dict = {}
-            for plate, tags_p in zip(plates, surfaces):
-                for t in tags_p:
-                    types, _, enodes = gmsh.model.mesh.getElements(2, t)
-                    for et, en in zip(types, enodes):
-                        npc = {2: 3, 3: 4}.get(int(et))
-                        if npc is None:
-                            raise RuntimeError(f"gmsh produced element type {et}; only triangles and quads are expected")
-                        conn = _oriented(xyz, index[np.asarray(en, dtype=np.int64).reshape(-1, npc)], plate)
-                        cells.setdefault(plate.name, {}).setdefault("quad4" if npc == 4 else "tri3", []).append(conn)
-            point_nodes = []
-            for pt in point_tags:
-                ntags = gmsh.model.mesh.getNodes(0, pt[0][1])[0] if pt and pt[0][0] == 0 else []
-                point_nodes.append(int(index[int(ntags[0])]) if len(ntags) else -1)
-        finally:
-            gmsh.finalize()
+    with gmsh_session("box") as gmsh:
+        occ = gmsh.model.occ
+        objects = [(2, _surface(occ, p.corners())) for p in plates]
+        tools = [(1, occ.addLine(occ.addPoint(*map(float, a)), occ.addPoint(*map(float, b)))) for a, b in lines]
+        tools += [(0, occ.addPoint(*map(float, p))) for p in points]
+        if tools or len(objects) > 1:
+            _, out_map = occ.fragment(objects, tools)
+        else:  # one plate alone: nothing to fragment
+            out_map = [objects]
+        occ.synchronize()
+        surfaces = [[t for d, t in m if d == 2] for m in out_map[:len(plates)]]
+        point_tags = out_map[len(out_map) - len(points):] if len(points) else []
+        generate_quads(gmsh, size)
+        xyz, index = mesh_nodes(gmsh)
+        cells: dict = {}
+        for plate, tags_p in zip(plates, surfaces):
+            for t in tags_p:
+                for conn in surface_cells(gmsh, t, index):
+                    key = "quad4" if conn.shape[1] == 4 else "tri3"
+                    cells.setdefault(plate.name, {}).setdefault(key, []).append(_oriented(xyz, conn, plate))
+        point_nodes = tagged_nodes(gmsh, point_tags, index)
     return _compact(xyz, cells, point_nodes, points)
 
 
@@ -149,17 +114,8 @@ def _oriented(xyz, conn, plate) -> np.ndarray:
 
 def _compact(xyz, cells, point_nodes, points) -> BoxMesh:
     """The mesh on the nodes that cells use (gmsh keeps construction points), renumbered."""
-    used = np.zeros(len(xyz), dtype=bool)
-    for c in cells.values():
-        for k in c:
-            c[k] = np.concatenate(c[k])
-            used[c[k].ravel()] = True
-    new = np.cumsum(used) - 1
-    for c in cells.values():
-        for k in c:
-            c[k] = new[c[k]]
-    nodes = xyz[used].copy()
-    pn = np.array([new[p] if p >= 0 and used[p] else -1 for p in point_nodes], dtype=np.int64)
+    nodes, new = used_nodes(xyz, cells)
+    pn = np.array([new[p] if p >= 0 else -1 for p in point_nodes], dtype=np.int64)
     for i in np.flatnonzero(pn < 0):  # a point gmsh merged into an existing vertex: the coincident node
         d = np.linalg.norm(nodes - points[i], axis=1)
         if d.min() > 1e-7:

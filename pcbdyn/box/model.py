@@ -20,6 +20,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ..domain import check_mesh_size, configuration_of
 from ..fe import EdgeSpringProperty, Model, OrthotropicShellProperty, ShellProperty, dof_index
 from ..fe.assembly import assemble
 from ..fe.parametric import ParametricModel, SetMaker
@@ -189,15 +190,13 @@ def _hold(box, mesh, model, plate_map) -> None:
 def build_model(box, config: str | None = None, mesh_size: float | None = None, shared_mesh: bool = False) -> BoxModel:
     """The FE model of ``box`` in configuration ``config`` (None: the base one); ``shared_mesh``: every
     configuration's masses are nodes, so that all configurations share one mesh node for node."""
-    cfg = None
-    if config is not None:
-        cfg = box.configuration(config)
-        if cfg is None:
-            names = ", ".join(c.name for c in box.configurations) or "none defined"
-            raise BoxError(f"{box.path.name}: configuration '{config}' does not exist (configurations: {names})")
+    cfg = configuration_of(box, config, BoxError)
     named = _named_points(box, cfg, shared_mesh)
     lines = [(box.plate(r.plate).point(*r.start), box.plate(r.plate).point(*r.end)) for r in box.ribs]
     size = mesh_size or box.mesh_size
+    check_mesh_size(f"{box.path.name}: box.mesh_size", min(min(p.lengths) for p in box.plates),
+                    sum(float(np.linalg.norm(np.cross(p.u, p.v))) for p in box.plates), size, BoxError,
+                    "the smallest plate's")
     try:
         mesh = mesh_box(box.plates, lines, [p for _, _, p in named], size)
     except RuntimeError as exc:
