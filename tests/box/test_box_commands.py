@@ -1,7 +1,7 @@
 """Every command that takes a board.toml takes a box.toml (the top-level table decides), with the JSON keys
 boards write: build (3-D pictures of the whole box with its ribs, VTU with the rib lines, CSV, JSON),
-simulate-test with a 3-D excitation, correlate, update (the updated box.toml with its comments) and
-localize."""
+simulate-test with a 3-D excitation, correlate, update (the updated box.toml with its comments), localize
+and study."""
 
 import json
 
@@ -72,3 +72,19 @@ def test_simulate_test_correlate_update_and_localize_on_a_box(tmp_path):
     invoke("localize", model, uff, "--params", "E_upper,rho_upper,h_back", "--json", loc, "--out", tmp_path / "loc")
     assert json.loads(loc.read_text())["selected"] == ["E_upper"]
     assert (tmp_path / "loc" / "localisation.png").is_file()
+
+
+def test_a_localisation_study_on_a_box(tmp_path):
+    """A success-ratio study (thesis eqs. 5.65-5.66) whose model is a box.toml: with exact data TLS/QR-F finds
+    the one wrong parameter, the upper plate's modulus, every time."""
+    edited(tmp_path, {"box.mesh_size": '"20 mm"'}, name="box.toml")
+    (tmp_path / "study.toml").write_text(
+        f'[study]\ncase = "board"\nboard = "box.toml"\npoints = "{POINTS}"\nlevels_pct = [0, 0.5]\nshots = 3\n'
+        'methods = ["tls-qrf"]\nequations = ["freq"]\n\n[truth]\nE_upper = "60 GPa"\n\n'
+        '[case]\nn_modes = 6\nparams = ["E_upper", "h_side", "h_back"]\n')
+    js = tmp_path / "study.json"
+    invoke("study", tmp_path / "study.toml", "--json", js, "--quiet")
+    data = json.loads(js.read_text())
+    assert data["true_errors"] == ["E_upper"]
+    exact = next(r for r in data["summary"] if r["level_pct"] == 0 and r["method"] == "tls-qrf")
+    assert exact["mean"] == pytest.approx(100.0)

@@ -104,3 +104,9 @@ def test_write_updated_keeps_the_comments_and_rebuilds_the_changed_model(tmp_pat
     old_pm, new_pm = (b.build(mesh_size=0.02) for b in (box, new))
     assert np.array_equal(old_pm.model.nodes, new_pm.model.nodes)  # same geometry and mesh
     assert new_pm.quantities["plates.upper.E"] == 52.5e9 and new_pm.quantities["ribs.left_v2.height"] == 12e-3
+
+
+def test_a_board_only_command_says_it_takes_a_board():
+    res = CliRunner().invoke(main, ["vibe", str(EXAMPLE), "--psd", "gevs-qual"])
+    assert res.exit_code == 2
+    assert "error: box.toml: top level: describes a box ([box]); this command takes a board.toml" in res.output
