@@ -110,11 +110,12 @@ def main():
         t = time.perf_counter()
         res, before, after = run(prob, cfgs, "bounded", max_iter=5, tol_freq_pct=0.1)
         print(f"  update of {len(prob.names)} parameters on {test.n_modes} modes below 1.5 kHz: {res.iterations} "
-              f"iterations in {time.perf_counter() - t:.1f} s ({res.reason}); max |df| {before[0]['max_freq_error_pct']:.2f}"
-              f" % -> {after[0]['max_freq_error_pct']:.2f} %")
+              f"iterations in {time.perf_counter() - t:.1f} s ({res.reason}); max |df| "
+              f"{before[0]['max_freq_error_pct']:.2f} % -> {after[0]['max_freq_error_pct']:.2f} %")
         r = res.p / prob.p0
         print(f"  upper plate E x {r[0]:.4f} (true 0.7: {100 * (r[0] / 0.7 - 1):+.2f} %), rho x {r[1]:.4f} (true 1.3: "
-              f"{100 * (r[1] / 1.3 - 1):+.2f} %); rib heights x {np.round(r[2:], 4).tolist()} (the strips and the mesh)")
+              f"{100 * (r[1] / 1.3 - 1):+.2f} %); rib heights x {np.round(r[2:], 4).tolist()} (the strips and the "
+              "mesh)")
 
 
 if __name__ == "__main__":

@@ -77,10 +77,11 @@ def contacts(plates, tol: float = GEOM_TOL) -> list:
                 b0, b1 = pb.edge(eb)
                 if np.all(pa.distance(np.array([b0, b1])) <= tol):
                     found.append((b0, b1))
+            pair = (pa.name, pb.name)
             for s0, s1 in found:
-                if not any(segment_gap(s0, s1, c.start, c.end) <= tol and
-                           abs(np.linalg.norm(s1 - s0) - c.length) <= tol for c in out if c.plates == (pa.name, pb.name)):
-                    out.append(Contact((pa.name, pb.name), s0, s1))
+                if not any(segment_gap(s0, s1, c.start, c.end) <= tol and abs(np.linalg.norm(s1 - s0) - c.length) <= tol
+                           for c in out if c.plates == pair):
+                    out.append(Contact(pair, s0, s1))
     return out
 
 

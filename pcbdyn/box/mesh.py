@@ -51,16 +51,15 @@ class BoxMesh:
         on = cand[(off < tol) & (s > -tol) & (s < L + tol)]
         chain = on[np.argsort((self.nodes[on] - p0) @ d)]
         ends = (self.nodes[chain[[0, -1]]] - p0) @ d / L if chain.size >= 2 else None
+        where = f"segment {np.round(p0 * 1e3, 3).tolist()} -> {np.round(p1 * 1e3, 3).tolist()} mm"
         if ends is None or abs(ends[0]) > tol or abs(ends[1] - L) > tol:
-            raise RuntimeError(f"segment {np.round(p0 * 1e3, 3).tolist()} -> {np.round(p1 * 1e3, 3).tolist()} mm is not "
-                               "a line of mesh nodes")
+            raise RuntimeError(f"{where} is not a line of mesh nodes")
         known = set()
         for _, conn in self.shells():
             e = np.sort(np.stack([conn, np.roll(conn, -1, axis=1)], axis=-1).reshape(-1, 2), axis=1)
             known.update(map(tuple, e.tolist()))
         if any((min(a, b), max(a, b)) not in known for a, b in zip(chain[:-1], chain[1:])):
-            raise RuntimeError(f"segment {np.round(p0 * 1e3, 3).tolist()} -> {np.round(p1 * 1e3, 3).tolist()} mm does "
-                               "not follow element edges")
+            raise RuntimeError(f"{where} does not follow element edges")
         return chain
 
 

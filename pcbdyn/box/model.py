@@ -217,8 +217,10 @@ def build_model(box, config: str | None = None, mesh_size: float | None = None, 
             plate = box.plate(r.plate)
             m = plate.normal * (1.0 if r.side == "+n" else -1.0)
             keys = (f"ribs.{r.name}.height", f"ribs.{r.name}.width", f"plates.{plate.name}.thickness")
-            makers[f"ribs.{r.name}"] = SetMaker("beam2", np.column_stack([chain[:-1], chain[1:]]), keys, lambda q, r=r, m=m, k=keys: rib_section(
-                r.material.E, r.material.nu, r.material.rho, q[k[0]], q[k[1]], m, q[k[2]]))
+            makers[f"ribs.{r.name}"] = SetMaker(
+                "beam2", np.column_stack([chain[:-1], chain[1:]]), keys,
+                lambda q, r=r, m=m, k=keys: rib_section(r.material.E, r.material.nu, r.material.rho, q[k[0]], q[k[1]],
+                                                        m, q[k[2]]))
     else:
         strips = [(f"ribs.{r.name}", chain, box.plate(r.plate).normal * (1.0 if r.side == "+n" else -1.0),
                    box.plate(r.plate).thickness, r.height, r.width, r.material) for r, chain in zip(box.ribs, chains)]

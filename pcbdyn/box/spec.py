@@ -87,7 +87,8 @@ def read_rib(r, e, where, name, plates, materials) -> Rib:
         r.fail(f"{where}.to", "is where the rib starts; a rib needs a length")
     side = e.get("side", "+n")
     if side not in RIB_SIDES:
-        r.fail(f"{where}.side", f"{side!r} is not \"+n\" or \"-n\" (the side of the plate the rib stands on, n = u x v)")
+        r.fail(f"{where}.side", f"{side!r} is not \"+n\" or \"-n\" (the side of the plate the rib stands on, "
+                                "n = u x v)")
     mat = material_of(r, e["material"], f"{where}.material", materials) if "material" in e else plate.declared
     if mat.orthotropic:
         r.fail(f"{where}.material", f"a rib needs an isotropic material (one E), and plate '{plate.name}' has an "
@@ -152,7 +153,7 @@ def check_plates(r, plates, supports) -> list:
             r.fail("supports", "no plate of the box is held; add [[supports]] or leave the box free (no supports)")
         gap, ea, eb, i, pb = min(near, key=lambda t: t[0])
         pa = plates[i]
-        r.fail(f"plates[{i}]", f"plate '{pa.name}' does not meet the rest of the box: the nearest edges, {pa.name}.{ea} "
-                               f"and {pb.name}.{eb}, are {gap * 1e3:.4g} mm apart; move its origin or change u, v so "
-                               "that the plates share the edge (or hold it with a [[supports]] entry)")
+        r.fail(f"plates[{i}]", f"plate '{pa.name}' does not meet the rest of the box: the nearest edges, "
+                               f"{pa.name}.{ea} and {pb.name}.{eb}, are {gap * 1e3:.4g} mm apart; move its origin or "
+                               "change u, v so that the plates share the edge (or hold it with a [[supports]] entry)")
     return found

@@ -52,10 +52,11 @@ class CatalogueError(ValueError):
 @dataclass(frozen=True, eq=False)
 class Candidate:
     """One candidate effect. ``at`` (x, y) [m] (x, y, z on a structure in 3-D) is its representative
-    point (node, segment or path midpoint, region centroid); ``geometry`` holds its extent in metres (``segment``: two end
-    points, ``path``/``polygon``: vertices); ``nodes`` the nodes it touches; ``data`` what its
-    kind needs to build it (edges, cells, weights). ``prime``: a prime suspect (an excitation
-    or response point). The parameter's nominal value is zero."""
+    point (node, segment or path midpoint, region centroid); ``geometry`` holds its extent in metres
+    (``segment``: two end points, ``path``/``polygon``: vertices); ``nodes`` the nodes it touches;
+    ``data`` what its kind needs to build it (edges, cells, weights; on a structure of several plates
+    the ``plate``, reported). ``prime``: a prime suspect (an excitation or response point). The
+    parameter's nominal value is zero."""
 
     kind: str
     name: str

@@ -56,8 +56,10 @@ def _candidate(layout, label: str, polygon) -> Candidate | None:
     cells = {etype: np.concatenate(c) for etype, c in found.items()}
     nodes = np.unique(np.concatenate([c.ravel() for c in cells.values()]))
     plate = label.removeprefix("plates.") if label.startswith("plates.") and layout.plates else None
-    return Candidate("region_stiffness", f"region_stiffness@{label}", tuple(_centroid(list(cells.values()), layout.points)),
-                     nodes, {"polygon": np.asarray(polygon, dtype=float)}, {"cells": cells, **({"plate": plate} if plate else {})})
+    centroid = tuple(_centroid(list(cells.values()), layout.points))
+    return Candidate("region_stiffness", f"region_stiffness@{label}", centroid, nodes,
+                     {"polygon": np.asarray(polygon, dtype=float)},
+                     {"cells": cells, **({"plate": plate} if plate else {})})
 
 
 def _rows(a: np.ndarray) -> np.ndarray:
@@ -102,7 +104,8 @@ class _RegionStiffness:
         if not patch > 0:
             raise ValueError(f"patch must be > 0 m, got {patch}")
         if not layout.planar:  # a box: its plates
-            return [c for label, poly in layout.footprints.items() if (c := _candidate(layout, label, poly)) is not None]
+            found = (_candidate(layout, label, poly) for label, poly in layout.footprints.items())
+            return [c for c in found if c is not None]
         xy = layout.xy[layout.shell_nodes()]
         lo, hi = xy.min(axis=0), xy.max(axis=0)
         polys = []

@@ -194,8 +194,8 @@ def _render_child(vtu: Path, folder: Path, names: list, quantity: str = "w") -> 
     env = {**os.environ, "VTK_DEFAULT_OPENGL_WINDOW": os.environ.get("VTK_DEFAULT_OPENGL_WINDOW",
                                                                        "vtkEGLRenderWindow")}
     try:
-        res = subprocess.run([sys.executable, "-c", code, json.dumps([str(vtu), str(folder), names, quantity])], env=env,
-                             capture_output=True, timeout=600)
+        res = subprocess.run([sys.executable, "-c", code, json.dumps([str(vtu), str(folder), names, quantity])],
+                             env=env, capture_output=True, timeout=600)
     except subprocess.TimeoutExpired:
         return False
     return res.returncode == 0 and all((folder / n).is_file() for n in names)

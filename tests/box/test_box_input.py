@@ -55,7 +55,8 @@ def test_a_support_on_an_edge_that_is_not_there(tmp_path, field, value, expected
 def test_a_joint_of_plates_that_share_no_edge(tmp_path):
     path = edited(tmp_path)
     doc = tomlkit.parse(path.read_text())
-    doc["joints"] = tomlkit.parse('[[joints]]\nname = "j"\nplates = ["left", "right"]\nk_rot = "1e4 N*m/rad/m"\n')["joints"]
+    joint = '[[joints]]\nname = "j"\nplates = ["left", "right"]\nk_rot = "1e4 N*m/rad/m"\n'
+    doc["joints"] = tomlkit.parse(joint)["joints"]
     path.write_text(tomlkit.dumps(doc))
     with pytest.raises(BoxError, match=r"joints\[0\].plates: plates 'left' and 'right' share no edge"):
         load_box(path)
