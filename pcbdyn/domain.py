@@ -16,6 +16,8 @@ A structure has a ``name``, the ``path`` of its file, its ``parameters``
   ``source``, a file) that lie off the structure;
 - ``write_updated(values, dst, source)``: its file with parameter ``values`` {name: SI} written into
   their targets, the user's comments and layout kept; returns the path written;
+- ``write_enriched(effects, dst)``: its file with the effects a diagnosis found declared in it (the
+  user's comments and layout kept); returns the path written;
 - ``outlines(config=None)``: what a mode-shape picture outlines (plain data: kind, label, points).
 
 A built model (:class:`pcbdyn.fe.parametric.ParametricModel`) adds what a diagnosis asks of it:
@@ -24,7 +26,16 @@ A built model (:class:`pcbdyn.fe.parametric.ParametricModel`) adds what a diagno
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Protocol
+
+
+@dataclass
+class Analysis:
+    """A structure's ``[analysis]``: how many modes to solve, up to which frequency f_max [Hz]."""
+
+    modes: int = 12
+    f_max: float | None = None
 
 
 class StructureError(ValueError):
@@ -46,4 +57,43 @@ class Structure(Protocol):
 
     def write_updated(self, values: dict, dst, source: str = "pcbdyn update"): ...
 
+    def write_enriched(self, effects, dst): ...
+
     def outlines(self, config=None) -> list: ...
+
+
+#: fewest elements across a structure's smallest plate a mesh must have
+MIN_ELEMENTS_ACROSS = 4
+#: most DOFs a structure's mesh may have (estimated before meshing); the PCBDYN_MAX_DOFS variable raises it
+MAX_DOFS = 1_200_000
+
+
+def check_mesh_size(where: str, span: float, area: float, size: float, error, what: str = "the board's") -> None:
+    """``error`` (a StructureError), with the estimate, for a mesh ``size`` [m] that gives fewer than
+    :data:`MIN_ELEMENTS_ACROSS` elements across ``span`` [m] (``what``: whose span, for the message) or more
+    DOFs than the limit (6 per node, about one node per element of size^2 on ``area`` [m^2]): before gmsh
+    spends minutes on it. ``where``: the file and field, e.g. "board.toml: board.mesh_size"."""
+    import os
+
+    across = span / size
+    if across < MIN_ELEMENTS_ACROSS:
+        raise error(f"{where}: {size * 1e3:g} mm gives {across:.1f} elements across {what} "
+                    f"{span * 1e3:g} mm; use at most {span / MIN_ELEMENTS_ACROSS * 1e3:g} mm")
+    limit = int(float(os.environ.get("PCBDYN_MAX_DOFS", MAX_DOFS)))
+    dofs = 6.0 * area / size**2
+    if dofs > limit:
+        raise error(f"{where}: {size * 1e3:g} mm gives about {dofs:,.0f} DOFs, more than the limit of "
+                    f"{limit:,}; use a larger mesh size (about {(6.0 * area / limit) ** 0.5 * 1e3:.2g} "
+                    "mm or more), or raise the limit with the PCBDYN_MAX_DOFS variable")
+
+
+def configuration_of(structure, name, error):
+    """The ``[[configurations]]`` entry ``name`` of ``structure`` (None for None, the base one), or
+    ``error`` naming the configurations there are."""
+    if name is None:
+        return None
+    cfg = structure.configuration(name)
+    if cfg is None:
+        names = ", ".join(structure.configuration_names()) or "none defined"
+        raise error(f"{structure.path.name}: configuration '{name}' does not exist (configurations: {names})")
+    return cfg

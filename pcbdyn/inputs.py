@@ -82,6 +82,18 @@ class Reader:
             self.fail(where, f"must be a point [{example}], got {value!r}")
         return tuple(self.q(v, "mm", f"{where}[{i}]") for i, v in enumerate(value))
 
+    def analysis(self, data):
+        """The ``[analysis]`` table of ``data`` as an :class:`pcbdyn.domain.Analysis` (defaults without it)."""
+        from .domain import Analysis
+
+        if "analysis" not in data:
+            return Analysis()
+        a = self.table(data["analysis"], "analysis", ["modes", "f_max"])
+        modes = a.get("modes", 12)
+        if isinstance(modes, bool) or not isinstance(modes, int) or modes < 1:
+            self.fail("analysis.modes", f"must be a positive whole number, got {modes!r}")
+        return Analysis(modes, self.q(a["f_max"], "Hz", "analysis.f_max", positive=True) if "f_max" in a else None)
+
     def number(self, value, where, lo=None, hi=None):
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             self.fail(where, f"must be a number, got {value!r}")

@@ -80,6 +80,12 @@ KINDS = {(k.collection, k.attribute): k for k in (
     Kind("line_masses", "mass", "g", "mass of a line mass"),
     Kind("stiffeners", "EI", "N*m^2", "bending stiffness of a stiffener"),
     Kind("regions", "stiffness_factor", "1", "stiffness factor of a region", number=True),
+    Kind("plates", "E", "Pa", "Young's modulus of an isotropic box plate (overrides its material's)"),
+    Kind("plates", "rho", "kg/m^3", "density of a box plate (overrides its material's)"),
+    Kind("plates", "thickness", "mm", "thickness of a box plate"),
+    Kind("ribs", "height", "mm", "height of a box rib (a beam rib)"),
+    Kind("ribs", "width", "mm", "width of a box rib (a beam rib)"),
+    Kind("joints", "k_rot", "N*m/rad/m", "rotational stiffness of a box joint about its edge", log=True),
 )}
 
 

@@ -126,6 +126,12 @@ class Board:
         """What a mode-shape picture outlines, as plain data (:func:`.outlines.board_outlines`)."""
         return board_outlines(self, config)
 
+    def write_enriched(self, effects, dst) -> Path:
+        """``dst``: this board.toml with the effects a diagnosis found declared (:mod:`.enrich`)."""
+        from .enrich import write_enriched
+
+        return write_enriched(self.path, effects, dst)
+
     def write_updated(self, values: dict, dst, source: str = "pcbdyn update") -> Path:
         """``dst``: this board.toml with the parameters' ``values`` {name: SI} written into their targets
         (comments and layout kept), checked by loading it before it replaces ``dst``."""
@@ -151,6 +157,10 @@ def load_board(path) -> Board:
 def parse_board(data: dict, path: Path) -> Board:
     """The Board of parsed board.toml ``data`` read from ``path``; a BoardError names the first bad field."""
     r = Reader(path, BoardError)
+    if "box" in data and "board" not in data:
+        r.fail("top level", "describes a box ([box]); this command takes a board.toml ([board]): boxes are built, "
+                            "tested, updated, localised and diagnosed by build, simulate-test, correlate, update, "
+                            "localize, diagnose and study")
     r.table(data, "top level", ["board", "components", "fixtures", "masses", "configurations", "parameters",
                                 "analysis", "points", "line_masses", "stiffeners", "regions"], required=["board"])
     b = r.table(data["board"], "board", ["name", "outline", "thickness", "material", "stackup", "mesh_size",
@@ -191,13 +201,7 @@ def parse_board(data: dict, path: Path) -> Board:
         if not outline.contains(pt)[0]:
             r.fail(f"points[{i}]", f"{p} is not on the board; move it inside the outline")
         board.points.append(pt)
-    if "analysis" in data:
-        a = r.table(data["analysis"], "analysis", ["modes", "f_max"])
-        modes = a.get("modes", 12)
-        if isinstance(modes, bool) or not isinstance(modes, int) or modes < 1:
-            r.fail("analysis.modes", f"must be a positive whole number, got {modes!r}")
-        f_max = r.q(a["f_max"], "Hz", "analysis.f_max", positive=True) if "f_max" in a else None
-        board.analysis = Analysis(modes, f_max)
+    board.analysis = r.analysis(data)
     for i, p in enumerate(r.list(data, "parameters")):
         try:
             board.parameters.append(targets.parameter_spec(p, f"parameters[{i}]", board.quantity, r.file, COLLECTIONS))

@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from matplotlib.path import Path as PolyPath
 
-from ..domain import StructureError
+from ..domain import Analysis, StructureError  # noqa: F401  (Analysis: a board entry too)
 
 FIXTURE_TYPES = ("free", "clamped_edge", "hinged_edge", "wedge_lock", "standoff", "point_spring", "edge_spring")
 MIN_SEGMENT = 1e-4  # [m] shortest segment of an edge spring, line mass or stiffener piece
@@ -152,7 +152,3 @@ class Configuration:
     masses: list
 
 
-@dataclass
-class Analysis:
-    modes: int = 12
-    f_max: float | None = None

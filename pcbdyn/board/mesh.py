@@ -12,6 +12,7 @@ split into quads (gmsh's all-quad subdivision), so the result is always all-quad
 from __future__ import annotations
 
 import threading
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -72,6 +73,70 @@ class BoardMesh:
         return chain
 
 
+@contextmanager
+def gmsh_session(name: str):
+    """gmsh, initialised quietly for one model called ``name`` and finalised after, one session at a time
+    in this process (gmsh is one global state)."""
+    import gmsh
+
+    with _LOCK:
+        gmsh.initialize(readConfigFiles=False, interruptible=False)
+        try:
+            gmsh.option.setNumber("General.Terminal", 0)
+            gmsh.option.setNumber("General.Verbosity", 1)
+            gmsh.model.add(name)
+            yield gmsh
+        finally:
+            gmsh.finalize()
+
+
+def generate_quads(gmsh, size: float) -> None:
+    """Quads at ``size`` (frontal-Delaunay triangles recombined by blossom); where triangles remain, the
+    mesh twice as coarse with every cell split into quads, by the frontal-Delaunay for quads (algorithm
+    6 on this pass gave other meshes run to run)."""
+    gmsh.option.setNumber("Mesh.Algorithm", 6)
+    gmsh.option.setNumber("Mesh.RecombineAll", 1)
+    gmsh.option.setNumber("Mesh.RecombinationAlgorithm", 1)
+    gmsh.option.setNumber("Mesh.MeshSizeMin", 0.0)
+    gmsh.option.setNumber("Mesh.MeshSizeMax", size)
+    gmsh.model.mesh.generate(2)
+    if 2 in gmsh.model.mesh.getElementTypes(2):
+        gmsh.model.mesh.clear()
+        gmsh.option.setNumber("Mesh.Algorithm", 8)
+        gmsh.option.setNumber("Mesh.MeshSizeMax", 2.0 * size)
+        gmsh.option.setNumber("Mesh.SubdivisionAlgorithm", 1)
+        gmsh.model.mesh.generate(2)
+
+
+def mesh_nodes(gmsh) -> tuple:
+    """(xyz (n, 3) of every node gmsh made, index: node tag -> row)."""
+    tags, coords, _ = gmsh.model.mesh.getNodes()
+    index = np.full(int(tags.max()) + 1, -1, dtype=np.int64)
+    index[tags.astype(np.int64)] = np.arange(tags.size)
+    return coords.reshape(-1, 3), index
+
+
+def surface_cells(gmsh, tag: int, index) -> list:
+    """The cells of surface ``tag`` as rows of node rows, one array per element type (triangles, quads)."""
+    out = []
+    types, _, enodes = gmsh.model.mesh.getElements(2, tag)
+    for et, en in zip(types, enodes):
+        npc = {2: 3, 3: 4}.get(int(et))
+        if npc is None:
+            raise RuntimeError(f"gmsh produced element type {et}; only triangles and quads are expected")
+        out.append(index[np.asarray(en, dtype=np.int64).reshape(-1, npc)])
+    return out
+
+
+def tagged_nodes(gmsh, point_tags, index) -> list:
+    """The node row of each point entity of ``point_tags`` (fragment results; -1 where gmsh merged it)."""
+    out = []
+    for pt in point_tags:
+        ntags = gmsh.model.mesh.getNodes(0, pt[0][1])[0] if pt and pt[0][0] == 0 else []
+        out.append(int(index[int(ntags[0])]) if len(ntags) else -1)
+    return out
+
+
 def _polygon(occ, v):
     pts = [occ.addPoint(float(x), float(y), 0.0) for x, y in v]
     lines = [occ.addLine(pts[i], pts[(i + 1) % len(pts)]) for i in range(len(pts))]
@@ -92,97 +157,57 @@ def mesh_board(outline, regions, points, size: float, strips=(), lines=()) -> Bo
     follow (edge springs, line masses, stiffeners); ``points``: (k, 2) points that become nodes.
     Elements outside every region are labelled "board".
     """
-    import gmsh
-
     points = np.asarray(points, dtype=float).reshape(-1, 2)
-    with _LOCK:
-        gmsh.initialize(readConfigFiles=False, interruptible=False)
-        try:
-            gmsh.option.setNumber("General.Terminal", 0)
-            gmsh.option.setNumber("General.Verbosity", 1)
-            gmsh.model.add("board")
-            occ = gmsh.model.occ
-            board = _polygon(occ, outline.vertices)
-            if outline.holes:
-                cut, _ = occ.cut([(2, board)], [(2, _polygon(occ, h)) for h in outline.holes])
-                board_tags = [t for d, t in cut if d == 2]
-            else:
-                board_tags = [board]
-            tools = [(2, _polygon(occ, poly)) for _, poly in regions]
-            tools += [(2, _polygon(occ, poly)) for poly in strips]
-            tools += [(1, t) for line in lines for t in _polyline(occ, line)]
-            tools += [(0, occ.addPoint(float(x), float(y), 0.0)) for x, y in points]
-            objects = [(2, t) for t in board_tags]
-            if tools:
-                _, out_map = occ.fragment(objects, tools)
-            else:
-                out_map = [[o] for o in objects]
-            occ.synchronize()
-            nb = len(objects)
-            on_board = {t for m in out_map[:nb] for d, t in m if d == 2}
-            label_of = {}
-            for i, (label, _) in enumerate(regions):
-                for d, t in out_map[nb + i]:
-                    if d == 2 and t in on_board and t not in label_of:
-                        label_of[t] = label
-            extra = [(2, t) for m in out_map[nb:] for d, t in m if d == 2 and t not in on_board]
-            if extra:
-                gmsh.model.removeEntities(extra, recursive=True)
-            point_tags = [out_map[-len(points) + i] for i in range(len(points))] if len(points) else []
-            gmsh.option.setNumber("Mesh.Algorithm", 6)
-            gmsh.option.setNumber("Mesh.RecombineAll", 1)
-            gmsh.option.setNumber("Mesh.RecombinationAlgorithm", 1)
-            gmsh.option.setNumber("Mesh.MeshSizeMin", 0.0)
-            gmsh.option.setNumber("Mesh.MeshSizeMax", size)
-            gmsh.model.mesh.generate(2)
-            if 2 in gmsh.model.mesh.getElementTypes(2):
-                # blossom left triangles: mesh twice as coarse and split every cell into quads, with the
-                # frontal-Delaunay for quads (algorithm 6 on this pass gave other meshes run to run)
-                gmsh.model.mesh.clear()
-                gmsh.option.setNumber("Mesh.Algorithm", 8)
-                gmsh.option.setNumber("Mesh.MeshSizeMax", 2.0 * size)
-                gmsh.option.setNumber("Mesh.SubdivisionAlgorithm", 1)
-                gmsh.model.mesh.generate(2)
-            tags, coords, _ = gmsh.model.mesh.getNodes()
-            xyz = coords.reshape(-1, 3)
-            index = np.full(int(tags.max()) + 1, -1, dtype=np.int64)
-            index[tags.astype(np.int64)] = np.arange(tags.size)
-            cells: dict = {}
-            for t in sorted(on_board):
-                label = label_of.get(t, "board")
-                types, _, enodes = gmsh.model.mesh.getElements(2, t)
-                for et, en in zip(types, enodes):
-                    npc = {2: 3, 3: 4}.get(int(et))
-                    if npc is None:
-                        raise RuntimeError(f"gmsh produced element type {et}; only triangles and quads are expected")
-                    conn = index[np.asarray(en, dtype=np.int64).reshape(-1, npc)]
-                    area = _signed_area(xyz, conn)
-                    if area.min() < 0 < area.max():
-                        raise RuntimeError(
-                            f"gmsh folded {int(min((area < 0).sum(), (area > 0).sum()))} elements of surface {t}; "
-                            "change mesh_size slightly"
-                        )
-                    key = "quad4" if npc == 4 else "tri3"
-                    cells.setdefault(label, {}).setdefault(key, []).append(conn)
-            point_nodes = []
-            for pt in point_tags:
-                ntags = gmsh.model.mesh.getNodes(0, pt[0][1])[0] if pt and pt[0][0] == 0 else []
-                point_nodes.append(int(index[int(ntags[0])]) if len(ntags) else -1)
-        finally:
-            gmsh.finalize()
-    used = np.zeros(len(xyz), dtype=bool)
+    with gmsh_session("board") as gmsh:
+        occ = gmsh.model.occ
+        board = _polygon(occ, outline.vertices)
+        if outline.holes:
+            cut, _ = occ.cut([(2, board)], [(2, _polygon(occ, h)) for h in outline.holes])
+            board_tags = [t for d, t in cut if d == 2]
+        else:
+            board_tags = [board]
+        tools = [(2, _polygon(occ, poly)) for _, poly in regions]
+        tools += [(2, _polygon(occ, poly)) for poly in strips]
+        tools += [(1, t) for line in lines for t in _polyline(occ, line)]
+        tools += [(0, occ.addPoint(float(x), float(y), 0.0)) for x, y in points]
+        objects = [(2, t) for t in board_tags]
+        if tools:
+            _, out_map = occ.fragment(objects, tools)
+        else:
+            out_map = [[o] for o in objects]
+        occ.synchronize()
+        nb = len(objects)
+        on_board = {t for m in out_map[:nb] for d, t in m if d == 2}
+        label_of = {}
+        for i, (label, _) in enumerate(regions):
+            for d, t in out_map[nb + i]:
+                if d == 2 and t in on_board and t not in label_of:
+                    label_of[t] = label
+        extra = [(2, t) for m in out_map[nb:] for d, t in m if d == 2 and t not in on_board]
+        if extra:
+            gmsh.model.removeEntities(extra, recursive=True)
+        point_tags = [out_map[-len(points) + i] for i in range(len(points))] if len(points) else []
+        generate_quads(gmsh, size)
+        xyz, index = mesh_nodes(gmsh)
+        cells: dict = {}
+        for t in sorted(on_board):
+            label = label_of.get(t, "board")
+            for conn in surface_cells(gmsh, t, index):
+                npc = conn.shape[1]
+                area = _signed_area(xyz, conn)
+                if area.min() < 0 < area.max():
+                    raise RuntimeError(
+                        f"gmsh folded {int(min((area < 0).sum(), (area > 0).sum()))} elements of surface {t}; "
+                        "change mesh_size slightly"
+                    )
+                key = "quad4" if npc == 4 else "tri3"
+                cells.setdefault(label, {}).setdefault(key, []).append(conn)
+        point_nodes = tagged_nodes(gmsh, point_tags, index)
+    nodes, new = used_nodes(xyz, cells)
     for c in cells.values():
         for k in c:
-            c[k] = np.concatenate(c[k])
-            used[c[k].ravel()] = True
-    # renumber to the nodes that elements use (gmsh keeps construction points)
-    new = np.cumsum(used) - 1
-    for c in cells.values():
-        for k in c:
-            conn = new[c[k]]
-            c[k] = _counter_clockwise(xyz[used], conn)
-    pn = np.array([new[p] if p >= 0 and used[p] else -1 for p in point_nodes], dtype=np.int64)
-    nodes = xyz[used].copy()
+            c[k] = _counter_clockwise(nodes, c[k])
+    pn = np.array([new[p] if p >= 0 else -1 for p in point_nodes], dtype=np.int64)
     nodes[:, 2] = 0.0
     missing = np.flatnonzero(pn < 0)
     for i in missing:  # a point gmsh merged into an existing vertex: take the coincident node
@@ -192,6 +217,21 @@ def mesh_board(outline, regions, points, size: float, strips=(), lines=()) -> Bo
             raise RuntimeError(f"point {points[i]} did not become a mesh node")
         pn[i] = j
     return BoardMesh(nodes, cells, pn)
+
+
+def used_nodes(xyz, cells) -> tuple:
+    """(the nodes the cells use (k, 3), old row -> new row or -1): ``cells`` ({label: {etype: [conn, ...]}})
+    concatenated and renumbered in place onto them (gmsh keeps construction points)."""
+    used = np.zeros(len(xyz), dtype=bool)
+    for c in cells.values():
+        for k in c:
+            c[k] = np.concatenate(c[k])
+            used[c[k].ravel()] = True
+    new = np.where(used, np.cumsum(used) - 1, -1)
+    for c in cells.values():
+        for k in c:
+            c[k] = new[c[k]]
+    return xyz[used].copy(), new
 
 
 def _signed_area(xyz, conn):

@@ -18,6 +18,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..components import models as parts
+from ..domain import check_mesh_size as check_size
+from ..domain import configuration_of
 from ..fe import Model
 from ..fe.parametric import ParametricModel, SetMaker
 from ..fixtures import supports
@@ -48,30 +50,10 @@ class BoardModel(ParametricModel):
         return suspects, footprints, self.board.thickness
 
 
-#: fewest elements across the board's smaller side a mesh must have
-MIN_ELEMENTS_ACROSS = 4
-#: most DOFs a board's mesh may have (estimated before meshing); the PCBDYN_MAX_DOFS variable raises it
-MAX_DOFS = 1_200_000
-
-
 def check_mesh_size(board, size: float) -> None:
-    """A BoardError, with the estimate, for a mesh size that gives fewer than
-    :data:`MIN_ELEMENTS_ACROSS` elements across the board or more DOFs than the limit (6 per node, about
-    one node per element of size^2 on the board's area): before gmsh spends minutes on it."""
-    import os
-
+    """A BoardError for a mesh size far off the board (:func:`pcbdyn.domain.check_mesh_size`)."""
     lo, hi = board.outline.bbox
-    across = float(np.min(hi - lo)) / size
-    where = f"{board.path.name}: board.mesh_size"
-    if across < MIN_ELEMENTS_ACROSS:
-        raise BoardError(f"{where}: {size * 1e3:g} mm gives {across:.1f} elements across the board's "
-                         f"{float(np.min(hi - lo)) * 1e3:g} mm; use at most {float(np.min(hi - lo)) / MIN_ELEMENTS_ACROSS * 1e3:g} mm")
-    limit = int(float(os.environ.get("PCBDYN_MAX_DOFS", MAX_DOFS)))
-    dofs = 6.0 * board.outline.area() / size**2
-    if dofs > limit:
-        raise BoardError(f"{where}: {size * 1e3:g} mm gives about {dofs:,.0f} DOFs, more than the limit of "
-                         f"{limit:,}; use a larger mesh size (about {np.sqrt(6.0 * board.outline.area() / limit) * 1e3:.2g} "
-                         "mm or more), or raise the limit with the PCBDYN_MAX_DOFS variable")
+    check_size(f"{board.path.name}: board.mesh_size", float(np.min(hi - lo)), board.outline.area(), size, BoardError)
 
 
 def mesh_points(board, config, shared: bool = False) -> list:
@@ -98,12 +80,7 @@ def build_model(board, config: str | None = None, mesh_size: float | None = None
     """The FE model of ``board`` in configuration ``config`` (None: the base configuration).
     ``shared_mesh``: every configuration's points are nodes, so that the models of all
     configurations share one mesh node for node (diagnosis places effects by node)."""
-    cfg = None
-    if config is not None:
-        cfg = board.configuration(config)
-        if cfg is None:
-            names = ", ".join(c.name for c in board.configurations) or "none defined"
-            raise BoardError(f"{board.path.name}: configuration '{config}' does not exist (configurations: {names})")
+    cfg = configuration_of(board, config, BoardError)
     check_mesh_size(board, mesh_size or board.mesh_size)
     named = mesh_points(board, cfg, shared_mesh)
     regions = [(f"components.{c.ref}", c.corners()) for c in board.components] if board.smear == "none" else []

@@ -52,15 +52,16 @@ def solve_structure(structure, config: str | None, n_modes: int | None = None, f
     return pm, modes, K, M
 
 
-def number_pair(text: str, option: str, unit: str | None = None) -> tuple:
-    """Two comma-separated values such as "135,63.57" (in ``unit`` when the values carry none,
-    e.g. mm) or "135 mm, 63.57 mm", as SI floats; a clear usage error otherwise."""
+def number_pair(text: str, option: str, unit: str | None = None, counts=(2,)) -> tuple:
+    """Two (or as many as ``counts`` allows) comma-separated values such as "135,63.57" (in ``unit``
+    when the values carry none, e.g. mm) or "135 mm, 63.57 mm", as SI floats; a clear usage error
+    otherwise."""
     from ..units import UnitError, to_si
 
     parts = [p.strip() for p in str(text).split(",")]
-    if len(parts) != 2 or not all(parts):
-        raise click.BadParameter(f"'{text}' is not two comma-separated values, e.g. '135,63.57'",
-                                 param_hint=option)
+    if len(parts) not in counts or not all(parts):
+        raise click.BadParameter(f"'{text}' is not {' or '.join(('two', 'three')[c - 2] for c in counts)} "
+                                 "comma-separated values, e.g. '135,63.57'", param_hint=option)
     out = []
     for p in parts:
         try:

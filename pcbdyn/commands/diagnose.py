@@ -35,7 +35,6 @@ from .common import done, fail, folder_outputs, library_option, measured_configu
 def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size, out, force, json_path):
     """Find the effects a board model lacks from modal tests: TEST_UFF (with mode shapes) of the base
     configuration and NAME=FILE for each perturbed configuration of board.toml (e.g. c2=test2.uff)."""
-    from ..board.enrich import write_enriched
     from ..diagnosis.pipeline import diagnose
     from ..domain import StructureError
     from ..problems import load_structure
@@ -68,7 +67,7 @@ def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size,
     enriched, written = None, []
     if d.effects:
         try:
-            enriched = write_enriched(board_toml, rep.enriched_effects(d), result_path(out, board_toml, "diagnosed", force))
+            enriched = board.write_enriched(rep.enriched_effects(d), result_path(out, board_toml, "diagnosed", force))
             written.append(enriched)
             click.echo(f"\nboard with the effects declared written to {enriched}", err=True)
         except StructureError as exc:

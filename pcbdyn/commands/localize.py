@@ -91,7 +91,7 @@ def command(board_toml, test_uff, config_tests, method, eq_type, params, rank, a
         localisation_figure(written[0], tls, problem.names)
         measured = tests[0][1]
         if eq_type in ("qms", "fbm") and measured.shapes is not None:
-            xy = measured.xyz[:, :2]
+            xy = measured.xyz[:, :2] if getattr(board, "outline", None) is not None else measured.xyz  # 3-D: a box
             fbm, peak = fbm_map(configs[0], states[0])
             written.append(out / "fbm_map.png")
             save_map(written[-1], xy, None, fbm, "FBM residual forces at the test points (eq. 5.2)")

@@ -9,6 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import click
+import numpy as np
 
 from .common import PROBE_TOL, checked_outputs, done, fail, library_option, number_pair, solve_structure, step
 
@@ -27,7 +28,10 @@ def check_band(f_range, df: float) -> None:
 @click.option("--points", "points_csv", required=True, type=click.Path(exists=True, dir_okay=False, path_type=Path),
               help="measurement points CSV: point,x [mm],y [mm][,dir] (dir default +z)")
 @click.option("--config", default=None, help="configuration name from [[configurations]]")
-@click.option("--excite", required=True, help="excitation point x,y on the board, in mm unless units are given")
+@click.option("--excite", required=True, help="excitation point x,y on the board (x,y,z on a box), in mm unless units "
+                                              "are given")
+@click.option("--excite-dir", type=click.Choice(["+x", "-x", "+y", "-y", "+z", "-z"]), default="+z", show_default=True,
+              help="direction of the excitation force")
 @click.option("--noise", default="0", show_default=True,
               help="noise in percent: one number for all, or 'f=0.2,shape=2,frf=1' (thesis eq. 5.72-5.74)")
 @click.option("--seed", type=int, default=None, help="random seed, for repeatable noise")
@@ -44,7 +48,8 @@ def check_band(f_range, df: float) -> None:
               help="write a summary (frequencies, points, excitation, noise) as JSON")
 @checked_outputs(folders=(), files=("json_path", "out"))
 @library_option()
-def command(board_toml, points_csv, config, excite, noise, seed, f_range, df, damping, kind, n_modes, out, json_path):
+def command(board_toml, points_csv, config, excite, excite_dir, noise, seed, f_range, df, damping, kind, n_modes, out,
+            json_path):
     """Simulate a modal test on a board model: modes and FRFs at measurement points, with noise."""
     from ..domain import StructureError
     from ..problems import load_structure
@@ -53,7 +58,8 @@ def command(board_toml, points_csv, config, excite, noise, seed, f_range, df, da
     from ..testdata import Noise, Points, TestDataError, read_points_csv, write_uff
     from ..testdata.simulate import frequency_axis, simulate_on_model
 
-    xy = number_pair(excite, "--excite", "mm")
+    xyz = (number_pair(excite, "--excite", "mm", counts=(2, 3)) + (0.0,))[:3]
+    direction = (-1.0 if excite_dir[0] == "-" else 1.0) * np.eye(3)["xyz".index(excite_dir[1])]
     band = number_pair(f_range, "--f-range") if f_range is not None else None
     check_band(band, df)
     try:
@@ -66,12 +72,12 @@ def command(board_toml, points_csv, config, excite, noise, seed, f_range, df, da
         board = load_structure(board_toml)
         points, dofs = read_points_csv(points_csv)
         board.check_points(points, points_csv)
-        board.check_points(Points([0], [[xy[0], xy[1], 0.0]]), "--excite")
+        board.check_points(Points([0], [xyz]), "--excite")
         bm, modes, _, _ = solve_structure(board, config, n_modes=n_modes)
         f_axis = frequency_axis(band, df, float(modes.frequencies.max()))
         t0 = step(f"reading the model at {len(dofs)} DOFs and summing {modes.frequencies.size} modes "
                   f"over {f_axis.size} lines")
-        data = simulate_on_model(bm.model, modes, points, dofs, excite=(xy[0], xy[1], 0.0), f_axis=f_axis,
+        data = simulate_on_model(bm.model, modes, points, dofs, excite=xyz, excite_direction=direction, f_axis=f_axis,
                                  zeta=damping, kind=kind, noise=noise_levels, seed=seed, tol=PROBE_TOL)
         done(t0)
         write_uff(out, data)
@@ -79,7 +85,7 @@ def command(board_toml, points_csv, config, excite, noise, seed, f_range, df, da
         fail(str(exc))
     ref_id = int(data.frfs.reference.point_ids[0])
     click.echo(f"\n{board.name} [{config or 'base'}]: simulated test, {len(dofs)} response DOFs, "
-               f"excitation at point {ref_id} ({xy[0] * 1e3:g}, {xy[1] * 1e3:g} mm, +z)")
+               f"excitation at point {ref_id} ({', '.join(f'{v * 1e3:g}' for v in xyz)} mm, {excite_dir})")
     click.echo(f"noise: frequencies {noise_levels.frequency_pct:g} %, shapes {noise_levels.shape_pct:g} %, "
                f"FRFs {noise_levels.frf_pct:g} %; damping ratio {damping:g}; {kind} FRFs "
                f"{f_axis[0]:g}-{f_axis[-1]:g} Hz every {df:g} Hz")
@@ -94,7 +100,7 @@ def command(board_toml, points_csv, config, excite, noise, seed, f_range, df, da
                       for j, (f, z) in enumerate(zip(data.modes.frequencies, data.modes.damping))],
             "model_frequencies_hz": [float(f) for f in modes.frequencies],
             "points": len(points), "response_dofs": len(dofs),
-            "excitation": {"point": ref_id, "x_m": xy[0], "y_m": xy[1], "direction": "+z"},
+            "excitation": {"point": ref_id, "x_m": xyz[0], "y_m": xyz[1], "z_m": xyz[2], "direction": excite_dir},
             "noise_pct": {"frequency": noise_levels.frequency_pct, "shape": noise_levels.shape_pct,
                           "frf": noise_levels.frf_pct},
             "seed": seed, "frf": {"kind": kind, "f_min_hz": float(f_axis[0]), "f_max_hz": float(f_axis[-1]),

@@ -51,11 +51,12 @@ class CatalogueError(ValueError):
 
 @dataclass(frozen=True, eq=False)
 class Candidate:
-    """One candidate effect. ``at`` (x, y) [m] is its representative point (node, segment or
-    path midpoint, region centroid); ``geometry`` holds its extent in metres (``segment``: two end
-    points, ``path``/``polygon``: vertices); ``nodes`` the nodes it touches; ``data`` what its
-    kind needs to build it (edges, cells, weights). ``prime``: a prime suspect (an excitation
-    or response point). The parameter's nominal value is zero."""
+    """One candidate effect. ``at`` (x, y) [m] (x, y, z on a structure in 3-D) is its representative
+    point (node, segment or path midpoint, region centroid); ``geometry`` holds its extent in metres
+    (``segment``: two end points, ``path``/``polygon``: vertices); ``nodes`` the nodes it touches;
+    ``data`` what its kind needs to build it (edges, cells, weights; on a structure of several plates
+    the ``plate``, reported). ``prime``: a prime suspect (an excitation or response point). The
+    parameter's nominal value is zero."""
 
     kind: str
     name: str
@@ -81,6 +82,8 @@ class Candidate:
         """JSON-ready description in mm (the shape of diagnose's ``effects`` entries)."""
         d = {"type": self.spec.report_as, "name": self.name, "parameter": self.spec.param,
              "unit": self.unit, "at_mm": [round(1e3 * float(v), 3) for v in self.at]}
+        if self.data.get("plate") is not None:
+            d["plate"] = self.data["plate"]
         for key, pts in self.geometry.items():
             d[f"{key}_mm"] = (1e3 * np.asarray(pts)).round(3).tolist()
         return d
@@ -207,18 +210,20 @@ def generate(layout, kinds=None, **options) -> list:
 
 
 def node_candidates(kind_name: str, layout, spacing: float | None = None) -> list:
-    """One candidate per grid node (:meth:`Layout.grid_nodes`) plus one at every prime suspect."""
+    """One candidate per grid node (:meth:`Layout.grid_nodes`) plus one at every prime suspect; on a
+    structure of several plates each knows its node's plate (``data["plate"]``, reported)."""
     prime = {int(n): s for s, n in layout.suspects.items()}
     nodes = np.union1d(layout.grid_nodes(spacing), np.array(sorted(prime), dtype=np.int64))
-    xy = layout.xy
-    return [Candidate(kind_name, f"{kind_name}@{prime.get(int(n), f'n{n}')}", tuple(xy[n]), np.array([n]),
-                      prime=int(n) in prime) for n in nodes]
+    pts = layout.points
+    return [Candidate(kind_name, f"{kind_name}@{prime.get(int(n), f'n{n}')}", tuple(pts[n]), np.array([n]),
+                      data={"plate": layout.plate_of(n)} if layout.plates else {}, prime=int(n) in prime)
+            for n in nodes]
 
 
 def on_nearest_node(layout, candidate) -> Candidate:
     """``candidate`` (of one node) on the node of ``layout`` nearest to its point, at that node."""
     n = layout.nearest_node(candidate.at)
-    return replace(candidate, at=tuple(layout.xy[n]), nodes=np.array([n]))
+    return replace(candidate, at=tuple(layout.points[n]), nodes=np.array([n]))
 
 
 def weighted_centre(candidates, values) -> np.ndarray:
@@ -238,6 +243,8 @@ class AlongSides:
     options = ("segments",)
 
     def generate(self, layout, segments: int = 4) -> list:
+        if not layout.planar:  # sides of a plate in one plane only
+            return []
         return [chain_candidate(self.name, layout, f"{side}[{i}]", chain)
                 for side, i, chain in layout.segment_runs(segments)]
 

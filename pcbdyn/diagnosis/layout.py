@@ -3,8 +3,14 @@ boundary sides and support lines, prime-suspect points and part footprints.
 
 A :class:`Layout` is made from any ``fe.Model`` (:func:`from_model`) or from a structure's built model
 (:func:`from_structure`, which adds what the structure names as prime suspects and footprints: on a
-board, the measurement points, declared masses and part footprints). Candidate generators (the catalogue's plugins) only ask it
+board, the measurement points, declared masses and part footprints; on a box, its declared masses, its
+plates as footprints and each plate's nodes). Candidate generators (the catalogue's plugins) only ask it
 geometric questions: grid nodes, boundary segments, cells inside a polygon, the cells a line crosses.
+
+A plate in one plane z = const (a board) is described in x, y (``planar``); a structure in 3-D (a box)
+in x, y, z (``points``): its grid is a 3-D one, its footprints are planar polygons in space, and the
+kinds that act along sides, lines or in-plane axes (edge stiffness, stiffeners, line masses, point
+inertias) have no candidates there.
 """
 
 from __future__ import annotations
@@ -23,8 +29,9 @@ CORNER_DEG = 15.0
 @dataclass
 class Layout:
     """``sides``: {name: ordered node chain} of the straight boundary sides and the support lines of
-    edge springs (card guides); ``suspects``: {name: node}; ``footprints``: {name: polygon (m, 2) [m]};
-    ``thickness``: plate thickness [m] (for stiffener offsets)."""
+    edge springs (card guides); ``suspects``: {name: node}; ``footprints``: {name: polygon (m, 2) [m]}
+    (planar polygons (m, 3) in 3-D); ``thickness``: plate thickness [m] (for stiffener offsets);
+    ``plates``: {plate name: its nodes} of a structure made of several plates (empty on a board)."""
 
     model: object
     shell_sets: tuple
@@ -32,10 +39,39 @@ class Layout:
     suspects: dict = field(default_factory=dict)
     footprints: dict = field(default_factory=dict)
     thickness: float = 0.0
+    plates: dict = field(default_factory=dict)
 
     @property
     def xy(self) -> np.ndarray:
         return self.model.nodes[:, :2]
+
+    @property
+    def planar(self) -> bool:
+        """True for shells in one plane z = const (a board)."""
+        z = self.model.nodes[self.shell_nodes(), 2]
+        return float(np.ptp(z)) <= 1e-9 * max(float(np.ptp(self.xy, axis=0).max()), 1e-300)
+
+    @property
+    def points(self) -> np.ndarray:
+        """The node coordinates candidates are placed by: x, y on a plane, x, y, z in 3-D."""
+        return self.xy if self.planar else self.model.nodes
+
+    def plate_of(self, node: int) -> str | None:
+        """The (first) plate that holds ``node`` (None on a single plate)."""
+        return next((name for name, nodes in self.plates.items() if np.isin(node, nodes)), None)
+
+    def normal(self, node: int) -> np.ndarray:
+        """The unit normal of the shells at ``node`` (the mean of its cells' normals, their sense made
+        to agree with the first)."""
+        normals = []
+        for _, conn in self.cells():
+            for c in conn[np.any(conn == node, axis=1)]:
+                p = self.model.nodes[c]
+                normals.append(np.cross(p[2] - p[0], p[-1] - p[1] if len(c) == 4 else p[1] - p[0]))
+        n = np.array(normals)
+        n *= np.where(n @ n[0] < 0, -1.0, 1.0)[:, None]
+        m = n.sum(axis=0)
+        return m / np.linalg.norm(m)
 
     def cells(self):
         """[(set name, conn)] of the shell sets."""
@@ -51,6 +87,15 @@ class Layout:
             return nodes
         if not spacing > 0:
             raise ValueError(f"spacing must be > 0 m or None (every node), got {spacing}")
+        if not self.planar:  # one node per occupied cube of the 3-D grid: the one nearest the cube's nodes' mean
+            xyz = self.model.nodes[nodes]
+            _, cube = np.unique(np.floor((xyz - xyz.min(axis=0)) / spacing).astype(np.int64), axis=0,
+                                return_inverse=True)
+            cube = cube.ravel()
+            centre = np.array([np.bincount(cube, xyz[:, k]) for k in range(3)]).T / np.bincount(cube)[:, None]
+            d = np.linalg.norm(xyz - centre[cube], axis=1)
+            order = np.lexsort((d, cube))
+            return np.unique(nodes[order[np.r_[True, np.diff(cube[order]) != 0]]])
         xy = self.xy[nodes]
         lo, hi = xy.min(axis=0), xy.max(axis=0)
         gx = np.arange(lo[0] + 0.5 * spacing, hi[0], spacing)
@@ -89,9 +134,9 @@ class Layout:
         return out
 
     def nearest_node(self, xy) -> int:
-        """The shell node nearest to the point ``xy`` [m]."""
+        """The shell node nearest to the point ``xy`` [m] (x, y, z in 3-D)."""
         nodes = self.shell_nodes()
-        return int(nodes[np.linalg.norm(self.xy[nodes] - np.asarray(xy, float), axis=1).argmin()])
+        return int(nodes[np.linalg.norm(self.points[nodes] - np.asarray(xy, float), axis=1).argmin()])
 
     def side_chain(self, segment, tol: float = 0.01) -> np.ndarray:
         """The node chain of the side (or support line) that runs nearest to both ends of
@@ -111,11 +156,32 @@ class Layout:
         return best[1]
 
     def cells_in(self, polygon) -> list:
-        """[(set name, cell indices)] of the shell cells whose centroid lies in ``polygon`` [m]."""
-        path = PolyPath(np.asarray(polygon, dtype=float))
+        """[(set name, cell indices)] of the shell cells whose centroid lies in ``polygon`` [m] (a planar
+        polygon (m, 3) in 3-D: centroids in its plane, within a thousandth of its size, and inside)."""
+        polygon = np.asarray(polygon, dtype=float)
+        if polygon.shape[1] == 3:
+            return self._cells_in_3d(polygon)
+        path = PolyPath(polygon)
         out = []
         for name, conn in self.cells():
             inside = np.flatnonzero(path.contains_points(self.xy[conn].mean(axis=1)))
+            if inside.size:
+                out.append((name, inside))
+        return out
+
+    def _cells_in_3d(self, polygon) -> list:
+        o = polygon[0]
+        e1 = polygon[1] - o
+        e1 /= np.linalg.norm(e1)
+        n = np.cross(e1, polygon[-1] - o)
+        n /= np.linalg.norm(n)
+        frame = np.array([e1, np.cross(n, e1)])
+        path = PolyPath((polygon - o) @ frame.T)
+        tol = 1e-3 * float(np.ptp(polygon, axis=0).max())
+        out = []
+        for name, conn in self.cells():
+            c = self.model.nodes[conn].mean(axis=1) - o
+            inside = np.flatnonzero((np.abs(c @ n) < tol) & path.contains_points(c @ frame.T, radius=1e-9))
             if inside.size:
                 out.append((name, inside))
         return out
@@ -124,7 +190,7 @@ class Layout:
     def element_size(self) -> float:
         """Median length [m] of the shell cells' edges."""
         e = _edges([c for _, c in self.cells()])
-        return float(np.median(np.linalg.norm(self.xy[e[:, 0]] - self.xy[e[:, 1]], axis=1)))
+        return float(np.median(np.linalg.norm(self.points[e[:, 0]] - self.points[e[:, 1]], axis=1)))
 
     def line_cells(self, p0, p1):
         """The straight line from ``p0`` to ``p1`` cut where it crosses the shell cells' edges or
@@ -231,14 +297,16 @@ def _thickness(prop) -> float:
     return float(np.sqrt(12.0 * prop.bending()[0, 0] / prop.membrane()[0, 0]))
 
 
-def from_model(model, suspects=None, footprints=None, thickness: float | None = None) -> Layout:
+def from_model(model, suspects=None, footprints=None, thickness: float | None = None, plates=None) -> Layout:
     """The layout of the shell sets of any fe.Model; boundary sides from the cell edges used once,
     support lines from its edge-spring sets."""
     shells = tuple(n for n, s in model.sets.items() if s.etype in SHELLS and len(s.conn))
     if not shells:
         raise ValueError("the model has no shell elements: candidate effects are placed on a plate")
     e, count = np.unique(_edges([model.sets[n].conn for n in shells]), axis=0, return_counts=True)
-    xy = model.nodes[:, :2]
+    z = model.nodes[np.unique(e), 2]
+    xy = model.nodes[:, :2] if np.ptp(z) <= 1e-9 * max(float(np.ptp(model.nodes[:, :2], axis=0).max()), 1e-300) \
+        else model.nodes
     chains = [s for c in _chains(e[count == 1]) for s in _straight_sides(c, xy)]
     chains += [c for n, s in model.sets.items() if s.etype == "edge_spring" for c in _chains(np.sort(s.conn, axis=1))]
     sides: dict = {}
@@ -251,12 +319,14 @@ def from_model(model, suspects=None, footprints=None, thickness: float | None = 
         name = _side_name(xy[c], i)
         sides[name if name not in sides else f"{name}#{i}"] = c
     t = thickness if thickness is not None else _thickness(model.sets[shells[0]].prop)
-    return Layout(model, shells, sides, dict(suspects or {}), dict(footprints or {}), t)
+    return Layout(model, shells, sides, dict(suspects or {}), dict(footprints or {}), t, dict(plates or {}))
 
 
 def from_structure(pm) -> Layout:
     """The layout of a structure's built model ``pm`` (e.g. :class:`pcbdyn.board.BoardModel`), with the
     prime suspects, footprints and plate thickness of its ``layout_hints()`` (on a board: measurement
-    points and declared masses, part footprints)."""
+    points and declared masses, part footprints) and, for a structure of several plates, the nodes of
+    each (``plate_nodes()``)."""
     suspects, footprints, thickness = pm.layout_hints()
-    return from_model(pm.model, suspects, footprints, thickness)
+    plates = pm.plate_nodes() if hasattr(pm, "plate_nodes") else None
+    return from_model(pm.model, suspects, footprints, thickness, plates)

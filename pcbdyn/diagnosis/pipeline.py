@@ -29,6 +29,7 @@ whether what remains is noise, and otherwise find, place and size the effects th
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass, field
 
@@ -289,7 +290,7 @@ def _movable(cand) -> bool:
 
 def _rectangle(cand):
     """(x0, y0, x1, y1) [m] of a region candidate whose polygon is an axis-aligned rectangle, else None."""
-    if cand.kind != "region_stiffness":
+    if cand.kind != "region_stiffness" or np.shape(cand.geometry["polygon"])[1] != 2:
         return None
     poly = np.asarray(cand.geometry["polygon"], float)
     lo, hi = poly.min(axis=0), poly.max(axis=0)
@@ -366,7 +367,7 @@ def _linked(a, b, reach: float) -> bool:
     ``reach`` (a rib between two lines is fitted as shares on both), or overlapping rectangular
     regions (a region between two is fitted as both)."""
     if a.kind == b.kind and a.kind in POINT_KINDS:
-        return np.hypot(a.at[0] - b.at[0], a.at[1] - b.at[1]) <= reach
+        return math.dist(a.at, b.at) <= reach
     if a.kind == b.kind == "region_stiffness" and None not in (ra := _rectangle(a), rb := _rectangle(b)):
         return min(ra[2], rb[2]) > max(ra[0], rb[0]) and min(ra[3], rb[3]) > max(ra[1], rb[1])  # they overlap
     if a.kind == b.kind == "stiffener":

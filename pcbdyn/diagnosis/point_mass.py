@@ -29,6 +29,8 @@ class _Lumped:
         self.name, self.param, self.unit, self.scale = name, param, unit, scale
 
     def generate(self, layout, spacing: float | None = None) -> list:
+        if self.param == "inertia" and not layout.planar:  # its axes are a plate's in-plane axes x, y
+            return []
         return node_candidates(self.name, layout, spacing)
 
     def place(self, layout, candidate):
@@ -39,7 +41,8 @@ class _Lumped:
         if "radius" in candidate.data:
             return replace(placed, at=candidate.at)
         if self.param == "mass":
-            centre = (*map(float, candidate.at[:2]), float(layout.model.nodes[placed.nodes[0], 2]))
+            at = tuple(map(float, candidate.at))
+            centre = at if len(at) == 3 else (*at, float(layout.model.nodes[placed.nodes[0], 2]))
             return replace(placed, at=candidate.at, data={**candidate.data, "radius": 0.0, "centre": centre})
         return placed
 

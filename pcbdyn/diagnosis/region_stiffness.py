@@ -11,7 +11,8 @@ region effects add up.
 
 Candidates: a grid of square patches of side ``patch`` [m], grids of twice that side (aligned and
 shifted by half a patch, so that a larger region is met by one candidate of about its size) and
-every part footprint.
+every part footprint. On a structure in 3-D (a box) the footprints are its plates: a plate stiffer or
+softer than declared as a whole (its E, its thickness), reported with the plate's name.
 """
 
 from __future__ import annotations
@@ -24,7 +25,17 @@ from .catalogue import register, Blocks, Candidate, copy_model
 
 
 def _centroid(conns, xy) -> np.ndarray:
-    """Area centroid of a set of polygonal cells (shoelace formula per cell)."""
+    """Area centroid of a set of polygonal cells (shoelace formula per cell; in 3-D, ``xy`` (n, 3),
+    triangle fans of planar cells)."""
+    if xy.shape[1] == 3:
+        area, moment = 0.0, np.zeros(3)
+        for c in conns:
+            p = xy[c]
+            for k in range(1, c.shape[1] - 1):
+                a = 0.5 * np.linalg.norm(np.cross(p[:, k] - p[:, 0], p[:, k + 1] - p[:, 0]), axis=1)
+                area += a.sum()
+                moment += a @ ((p[:, 0] + p[:, k] + p[:, k + 1]) / 3.0)
+        return moment / area
     area, moment = 0.0, np.zeros(2)
     for c in conns:
         p, q = xy[c], xy[np.roll(c, -1, axis=1)]
@@ -44,8 +55,11 @@ def _candidate(layout, label: str, polygon) -> Candidate | None:
         return None
     cells = {etype: np.concatenate(c) for etype, c in found.items()}
     nodes = np.unique(np.concatenate([c.ravel() for c in cells.values()]))
-    return Candidate("region_stiffness", f"region_stiffness@{label}", tuple(_centroid(list(cells.values()), layout.xy)),
-                     nodes, {"polygon": np.asarray(polygon, dtype=float)}, {"cells": cells})
+    plate = label.removeprefix("plates.") if label.startswith("plates.") and layout.plates else None
+    centroid = tuple(_centroid(list(cells.values()), layout.points))
+    return Candidate("region_stiffness", f"region_stiffness@{label}", centroid, nodes,
+                     {"polygon": np.asarray(polygon, dtype=float)},
+                     {"cells": cells, **({"plate": plate} if plate else {})})
 
 
 def _rows(a: np.ndarray) -> np.ndarray:
@@ -89,6 +103,9 @@ class _RegionStiffness:
     def generate(self, layout, patch: float = 0.02) -> list:
         if not patch > 0:
             raise ValueError(f"patch must be > 0 m, got {patch}")
+        if not layout.planar:  # a box: its plates
+            found = (_candidate(layout, label, poly) for label, poly in layout.footprints.items())
+            return [c for c in found if c is not None]
         xy = layout.xy[layout.shell_nodes()]
         lo, hi = xy.min(axis=0), xy.max(axis=0)
         polys = []
@@ -110,7 +127,8 @@ class _RegionStiffness:
 
     def place(self, layout, candidate):
         """Over ``candidate``'s polygon (ValueError where it holds no cell centroid)."""
-        c = _candidate(layout, "placed", candidate.geometry["polygon"])
+        c = _candidate(layout, candidate.name.partition("@")[2] if candidate.data.get("plate") else "placed",
+                       candidate.geometry["polygon"])
         if c is None:
             raise ValueError(f"{candidate.name}: its polygon holds no cell")
         return c

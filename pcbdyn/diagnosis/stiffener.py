@@ -38,6 +38,8 @@ class _Stiffener:
         """Full-span rows (along x) and columns (along y) every ``path_spacing`` [m]."""
         if not path_spacing > 0:
             raise ValueError(f"path_spacing must be > 0 m, got {path_spacing}")
+        if not layout.planar:  # rows and columns of a plate in one plane only
+            return []
         lo, hi = _extent(layout)
         out = []
         for axis in (1, 0):

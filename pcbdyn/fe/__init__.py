@@ -10,6 +10,7 @@ from .properties import (
     EdgeSpringProperty,
     EmbeddedBeamProperty,
     MassProperty,
+    OrthotropicShellProperty,
     ShellProperty,
     SpringProperty,
 )
@@ -23,6 +24,7 @@ __all__ = [
     "EdgeSpringProperty",
     "EmbeddedBeamProperty",
     "MassProperty",
+    "OrthotropicShellProperty",
     "ShellProperty",
     "SpringProperty",
     "ElementSet",

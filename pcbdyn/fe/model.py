@@ -9,7 +9,8 @@ import numpy as np
 from .mesh import NDOF, dof_index
 
 #: nodes per cell for each element type
-NODES_PER_CELL = {"quad4": 4, "tri3": 3, "beam2": 2, "edge_spring": 2, "mass": 1, "embedded_beam2": 8}
+NODES_PER_CELL = {"quad4": 4, "tri3": 3, "beam2": 2, "edge_spring": 2, "edge_joint": 4, "mass": 1,
+                   "embedded_beam2": 8}
 
 
 class ModelError(ValueError):
@@ -21,8 +22,9 @@ class ElementSet:
     """Cells of one element type sharing one property.
 
     ``etype`` is one of quad4, tri3, beam2, spring (1 node: to ground, 2 nodes: node to node),
-    edge_spring, mass, embedded_beam2 (a beam between points of two host shell cells: their
-    4 + 4 nodes). ``conn`` holds node indices, shape (n_cells, nodes_per_cell).
+    edge_spring, edge_joint (springs between two coincident edges: a1, a2, b1, b2), mass,
+    embedded_beam2 (a beam between points of two host shell cells: their 4 + 4 nodes). ``conn`` holds
+    node indices, shape (n_cells, nodes_per_cell).
     """
 
     name: str

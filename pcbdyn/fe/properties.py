@@ -52,6 +52,48 @@ class ShellProperty:
 
 
 @dataclass(frozen=True)
+class OrthotropicShellProperty:
+    """Orthotropic shell (a plate whose hole pattern or stiffening differs along two directions, smeared):
+    Young's moduli ``Eu`` along the in-plane direction ``axis`` (global axes) and ``Ev`` across it, major
+    Poisson ratio ``nu`` (nu_uv; nu_vu = nu Ev / Eu), shear modulus ``G`` (default Huber's
+    sqrt(Eu Ev) / (2 (1 + nu))), density ``rho``, thickness ``t``. Its matrices are given with x along
+    ``axis``; the shell kernels rotate them into each element's frame
+    (:func:`pcbdyn.fe.elements.shell_common.oriented`)."""
+
+    Eu: float
+    Ev: float
+    nu: float
+    rho: float
+    t: float
+    axis: tuple = (1.0, 0.0, 0.0)
+    G: float | None = None
+    nsm: float = 0.0
+    shear_factor: float = 5.0 / 6.0
+
+    @property
+    def shear_modulus(self) -> float:
+        return self.G if self.G is not None else float(np.sqrt(self.Eu * self.Ev)) / (2.0 * (1.0 + self.nu))
+
+    def membrane(self) -> np.ndarray:
+        nu_vu = self.nu * self.Ev / self.Eu
+        d = 1.0 - self.nu * nu_vu
+        return self.t * np.array([[self.Eu / d, nu_vu * self.Eu / d, 0.0], [nu_vu * self.Eu / d, self.Ev / d, 0.0],
+                                  [0.0, 0.0, self.shear_modulus]])
+
+    def bending(self) -> np.ndarray:
+        return self.membrane() * (self.t**2 / 12.0)
+
+    def shear(self) -> np.ndarray:
+        return self.shear_factor * self.shear_modulus * self.t * np.eye(2)
+
+    def mass_per_area(self) -> float:
+        return self.rho * self.t + self.nsm
+
+    def rotary_inertia_per_area(self) -> float:
+        return self.rho * self.t**3 / 12.0
+
+
+@dataclass(frozen=True)
 class BeamProperty:
     """3-D beam section. ``orientation`` is a vector in the local x-y plane (not along the axis);
     local y follows it, local z = x cross y. ``Iy``/``Iz`` are second moments about local y/z.

@@ -1,15 +1,17 @@
-"""Reading any structure's file: the top-level table decides its kind (``[board]``: a board)."""
+"""Reading any structure's file: the top-level table decides its kind (``[board]``: a board, ``[box]``: a
+ribbed shell housing)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
 from ..board import BoardError, load_board
+from ..box import load_box
 from ..domain import StructureError
 from ..inputs import read_toml
 
 #: top-level table -> loader of that kind of structure
-LOADERS = {"board": load_board}
+LOADERS = {"board": load_board, "box": load_box}
 
 
 def load_structure(path):

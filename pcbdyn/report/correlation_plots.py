@@ -173,12 +173,20 @@ def shape_overlays(out_dir, model, outline, pairs, test_xy, test_w, model_at_tes
 
 
 def comac_map(path, outline, xy, values, labels) -> None:
-    """COMAC per measured DOF at its point on the board outline (low = test and model disagree)."""
+    """COMAC per measured DOF at its point on the board outline (low = test and model disagree); on a
+    structure in 3-D (``outline`` None, ``xy`` the points (k, 3)) a 3-D map."""
     plt = _plt()
+    lo = min(0.9, float(np.min(values)))
+    if outline is None:
+        from .pictures3d import point_map_3d
+
+        fig = plt.figure(figsize=(7.0, 6.0))
+        point_map_3d(fig, 111, xy, values, "COMAC", "RdYlGn", lo, 1.0, "COMAC per point over the pairs")
+        _save(fig, path)
+        return
     xy = np.asarray(xy) * 1e3
     fig, ax = plt.subplots(figsize=(6.0, 5.6))
-    _outline(ax, outline)
-    lo = min(0.9, float(np.min(values)))  # spread the usual 0.9-1 range over the colours
+    _outline(ax, outline)  # lo spreads the usual 0.9-1 range over the colours
     sc = ax.scatter(xy[:, 0], xy[:, 1], c=values, cmap="RdYlGn", vmin=lo, vmax=1.0, s=60, edgecolors="k", zorder=3)
     worst = np.argsort(values)[: min(5, len(values))]
     for i in worst:

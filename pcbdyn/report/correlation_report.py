@@ -52,9 +52,10 @@ def write_outputs(out: Path, board, bm, modes, test_modes, corr) -> list:
     write_text(out / "comac.csv", comac_csv(corr.dof_labels, xyz, corr.comac))
     plots.mac_matrix(out / "mac_matrix.png", pairing.mac, pairing.pairs, test_modes.frequencies, modes.frequencies)
     plots.frequency_plot(out / "frequencies.png", pairing.pairs)
-    plots.comac_map(out / "comac.png", board.outline, xyz[:, :2], corr.comac, corr.dof_labels)
+    outline = getattr(board, "outline", None)  # a board's; a structure in 3-D has none
+    plots.comac_map(out / "comac.png", outline, xyz if outline is None else xyz[:, :2], corr.comac, corr.dof_labels)
     rows, sign = z_rows(test_modes)
-    if rows.size:
+    if rows.size and outline is not None:  # the overlays show w on a plate
         model_w = pairing.model_shapes(modes.shapes)[2::6]
         at = pairing.model_shapes(corr.model_at_test)[rows] * sign[:, None]
         test_w = test_modes.shapes[np.ix_(rows, pairing.test_index)] * sign[:, None]

@@ -16,14 +16,19 @@ def shown(value: float, unit: str) -> tuple:
 
 
 def format_effects(effects) -> str:
+    """The effects as a table; on a structure of several plates with each effect's plate and its point in
+    x, y, z."""
     if not effects:
         return "no effect found"
-    rows = [f"{'type':>16} {'parameter':>16} {'at [mm]':>18} {'magnitude':>12} {'+-':>10} unit"]
+    plates = any("plate" in e for e in effects)
+    plate_head, width = (f" {'plate':>8}", 24) if plates else ("", 18)
+    rows = [f"{'type':>16} {'parameter':>16}{plate_head} {'at [mm]':>{width}} {'magnitude':>12} {'+-':>10} unit"]
     for e in effects:
         v, u = shown(e["magnitude"], e["unit"])
         s, _ = shown(e["uncertainty"], e["unit"])
-        at = f"({e['at_mm'][0]:.1f}, {e['at_mm'][1]:.1f})"
-        rows.append(f"{e['type']:>16} {e['parameter']:>16} {at:>18} {v:>12.4g} {s:>10.2g} {u}")
+        at = "(" + ", ".join(f"{c:.1f}" for c in e["at_mm"]) + ")"
+        where = f" {e.get('plate', ''):>8}" if plates else ""
+        rows.append(f"{e['type']:>16} {e['parameter']:>16}{where} {at:>{width}} {v:>12.4g} {s:>10.2g} {u}")
     return "\n".join(rows)
 
 
@@ -55,6 +60,18 @@ def plot_evidence(path, board, evidence, effects) -> None:
     from .correlation_plots import _plt, _save
 
     kinds = list(evidence)
+    if getattr(board, "outline", None) is None:  # a structure in 3-D: 3-D maps
+        from .pictures3d import point_map_3d
+
+        fig = _plt().figure(figsize=(6.5 * max(len(kinds), 1), 5.5))
+        for k, kind in enumerate(kinds):
+            xyz, gain = evidence[kind]
+            ax = point_map_3d(fig, (1, len(kinds), k + 1), xyz, gain, "chi^2 removed",
+                              title=f"evidence for a {kind.replace('_', ' ')}")
+            for e in effects:
+                ax.scatter(*np.asarray(e["at_mm"], float)[:, None], marker="*", s=200, c="r", edgecolors="w")
+        _save(fig, path)
+        return
     fig, axes = _plt().subplots(1, max(len(kinds), 1), figsize=(5.5 * max(len(kinds), 1), 5.0), squeeze=False)
     outline = np.vstack([board.outline.vertices, board.outline.vertices[:1]]) * 1e3
     for ax, kind in zip(axes[0], kinds):
@@ -74,6 +91,8 @@ def enriched_effects(diagnosis) -> list:
     out = []
     for e in diagnosis.effects:
         d = {"type": e["kind"], "name": e["name"], "value": e["magnitude"], "at": tuple(np.asarray(e["at_mm"]) / 1e3)}
+        if "plate" in e:
+            d["plate"] = e["plate"]
         for key in ("segment", "path", "polygon"):
             if f"{key}_mm" in e:
                 d[key] = (np.asarray(e[f"{key}_mm"]) / 1e3).tolist()

@@ -59,8 +59,17 @@ def element_map(ax, xy, cells, values, title: str = "", cmap: str = "viridis"):
 
 
 def save_map(path, xy, cells, values, title: str, per: str = "node") -> Path:
-    """Write one map (``per`` 'node' or 'element') with a colour bar to ``path`` (PNG)."""
+    """Write one map (``per`` 'node' or 'element') with a colour bar to ``path`` (PNG); points (k, 3) of a
+    structure in 3-D (a box) as a 3-D map of the values at the points."""
     plt = _pyplot()
+    if np.shape(xy)[1] == 3:
+        from .pictures3d import point_map_3d
+
+        fig = plt.figure(figsize=(6.5, 5.5))
+        point_map_3d(fig, 111, xy, values, "", title=title)
+        fig.savefig(path, dpi=120)
+        plt.close(fig)
+        return Path(path)
     fig, ax = plt.subplots(figsize=(5.5, 5))
     m = (node_map if per == "node" else element_map)(ax, xy, cells, values, title)
     fig.colorbar(m, ax=ax)

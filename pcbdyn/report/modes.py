@@ -49,14 +49,16 @@ def describe(nodes, w) -> str:
 
 
 def mode_table(bm, modes, M) -> pd.DataFrame:
-    """One row per elastic mode: n, frequency_hz, mass fraction in z, shape description."""
+    """One row per elastic mode: n, frequency_hz, mass fraction in z, shape description (nodal lines of
+    a plate; a structure in 3-D describes its modes itself, ``mode_descriptions``: the plates that move)."""
     frac = effective_mass_fraction_z(M, modes.shapes)
     w = modes.shapes[2::6]
+    own = getattr(bm, "mode_descriptions", None)
     return pd.DataFrame({
         "mode": np.arange(1, modes.frequencies.size + 1),
         "frequency_hz": modes.frequencies,
         "eff_mass_z": frac,
-        "shape": [describe(bm.model.nodes, w[:, j]) for j in range(w.shape[1])],
+        "shape": own(modes.shapes) if own else [describe(bm.model.nodes, w[:, j]) for j in range(w.shape[1])],
     })
 
 

@@ -45,23 +45,26 @@ def picture_names(prefix: str, n_modes: int) -> list:
     return [f"{prefix}_{k + 1:02d}.png" for k in range(n_modes)]
 
 
-def render_pyvista(vtu: Path, out_dir: Path, names: list) -> None:
+def render_pyvista(vtu: Path, out_dir: Path, names: list, quantity: str = "w") -> None:
     """Render the 3-D view of each mode of ``vtu`` (arrays mode_<k>, max |w| = 1), warped and
-    coloured by w on [-1, 1], to ``out_dir/names[k]`` (run in a child process)."""
+    coloured by w on [-1, 1] (``quantity`` "magnitude": a structure in 3-D, max |u| = 1, coloured by
+    |u| on [0, 1]), to ``out_dir/names[k]`` (run in a child process)."""
     os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
     import pyvista as pv
 
     grid = pv.read(str(vtu))
     grid.points = grid.points * 1e3  # mm, as the top view
-    span = float(np.ptp(grid.points[:, :2], axis=0).max())
+    flat = quantity == "w"
+    span = float(np.ptp(grid.points[:, :2] if flat else grid.points, axis=0).max())
     for k, name in enumerate(names, start=1):
         g = grid.copy()
-        g.point_data["w"] = g.point_data[f"mode_{k}"][:, 2]
-        warped = g.warp_by_vector(f"mode_{k}", factor=0.15 * span)
+        u = g.point_data[f"mode_{k}"]
+        g.point_data["w"] = u[:, 2] if flat else np.linalg.norm(u, axis=1)
+        warped = g.warp_by_vector(f"mode_{k}", factor=(0.15 if flat else 0.08) * span)
         p = pv.Plotter(off_screen=True, window_size=(700, 560))
         p.set_background("white")
-        p.add_mesh(warped, scalars="w", cmap=CMAP, clim=(-1.0, 1.0), show_edges=True, edge_color="gray",
-                   line_width=0.4, show_scalar_bar=False)
+        p.add_mesh(warped, scalars="w", cmap=CMAP, clim=(-1.0, 1.0) if flat else (0.0, 1.0), show_edges=True,
+                   edge_color="gray", line_width=0.4 if flat else 1.5, show_scalar_bar=False)
         p.add_mesh(g.extract_feature_edges(boundary_edges=True, feature_edges=False, manifold_edges=False),
                    color="gray", line_width=1.0)  # the board at rest, for scale
         p.view_isometric()
@@ -143,10 +146,21 @@ def mode_figure(tri, w, outlines, title: str, view3d=None):
     return fig
 
 
+def is_3d(model, outlines=()) -> bool:
+    """True for a structure that is not a plate in one plane z = const (a box)."""
+    span = float(np.ptp(model.nodes, axis=0).max()) or 1.0
+    return any("xyz" in item for item in outlines) or float(np.ptp(model.nodes[:, 2])) > 1e-9 * span
+
+
 def mode_pictures(vtu: Path, model, frequencies, shapes, out_dir: Path, prefix: str = "mode", title: str = "",
                   outlines=()) -> str:
     """Write ``<prefix>_<k>.png`` per mode (see :func:`picture_names`); ``title`` names the board
-    and configuration. Returns the 3-D renderer used ("pyvista" or "matplotlib")."""
+    and configuration. Returns the 3-D renderer used ("pyvista" or "matplotlib"). A structure in 3-D
+    (outlines in ``xyz``, or nodes off one plane z = const) gets :mod:`.pictures3d`'s pictures."""
+    if is_3d(model, outlines):
+        from .pictures3d import mode_pictures_3d
+
+        return mode_pictures_3d(vtu, model, frequencies, shapes, out_dir, prefix, title, outlines)
     import matplotlib
 
     matplotlib.use("Agg")
@@ -173,15 +187,15 @@ def mode_pictures(vtu: Path, model, frequencies, shapes, out_dir: Path, prefix: 
     return renderer
 
 
-def _render_child(vtu: Path, folder: Path, names: list) -> bool:
+def _render_child(vtu: Path, folder: Path, names: list, quantity: str = "w") -> bool:
     """Run :func:`render_pyvista` in a child process; True when every view was written."""
     code = ("import sys, json; from pathlib import Path; from pcbdyn.report.pictures import render_pyvista; "
-            "a = json.loads(sys.argv[1]); render_pyvista(Path(a[0]), Path(a[1]), a[2])")
+            "a = json.loads(sys.argv[1]); render_pyvista(Path(a[0]), Path(a[1]), a[2], a[3])")
     env = {**os.environ, "VTK_DEFAULT_OPENGL_WINDOW": os.environ.get("VTK_DEFAULT_OPENGL_WINDOW",
                                                                        "vtkEGLRenderWindow")}
     try:
-        res = subprocess.run([sys.executable, "-c", code, json.dumps([str(vtu), str(folder), names])], env=env,
-                             capture_output=True, timeout=600)
+        res = subprocess.run([sys.executable, "-c", code, json.dumps([str(vtu), str(folder), names, quantity])],
+                             env=env, capture_output=True, timeout=600)
     except subprocess.TimeoutExpired:
         return False
     return res.returncode == 0 and all((folder / n).is_file() for n in names)

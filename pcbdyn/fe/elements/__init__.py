@@ -3,7 +3,7 @@ to stiffness and mass matrices (n_cells, 6 * nodes_per_cell, 6 * nodes_per_cell)
 vectorised over cells.
 """
 
-from . import beam, discrete, edge_spring, embedded_beam, shell_quad4, shell_tri3
+from . import beam, discrete, edge_joint, edge_spring, embedded_beam, shell_quad4, shell_tri3
 
 #: element type -> its matrices function
 KERNELS = {
@@ -14,6 +14,7 @@ KERNELS = {
     "beam2": beam.matrices,
     "embedded_beam2": embedded_beam.matrices,
     "edge_spring": edge_spring.matrices,
+    "edge_joint": edge_joint.matrices,
 }
 
 

@@ -38,7 +38,7 @@ class Section:
     @property
     def drilling(self) -> float:
         """The drilling penalty gamma [N/m]: a fraction of the in-plane shear stiffness A66."""
-        return DRILLING_PENALTY * float(self.A[2, 2])
+        return DRILLING_PENALTY * self.A[..., 2, 2]
 
 
 def section(prop) -> Section:
@@ -61,6 +61,32 @@ def section(prop) -> Section:
     if not inertia >= 0.0:
         raise ModelError(f"shell property rotary_inertia_per_area() must be >= 0, got {inertia}")
     return Section(mats["membrane"], mats["bending"], mats["shear"], m, inertia)
+
+
+def oriented(prop, R: np.ndarray) -> Section:
+    """The section of ``prop`` for cells whose frames are ``R`` (n, 3, 3): :func:`section`, or for a
+    property with a material ``axis`` (its matrices given with x along that axis) the matrices rotated
+    into each element's frame, shaped (n, 1, ., .) to broadcast over Gauss points. With c, s the
+    axis' components along e1, e2, the material strains are T eps (T = [[c^2, s^2, cs], [s^2, c^2, -cs],
+    [-2cs, 2cs, c^2 - s^2]], engineering shear) and the transverse shears Q gamma (Q = [[c, s], [-s, c]]),
+    so A_e = T^T A T, D_e = T^T D T, S_e = Q^T S Q."""
+    sec = section(prop)
+    axis = getattr(prop, "axis", None)
+    if axis is None:
+        return sec
+    c, s = R[:, 0] @ np.asarray(axis, float), R[:, 1] @ np.asarray(axis, float)
+    norm = np.hypot(c, s)
+    if np.any(norm < 1e-6 * np.linalg.norm(axis)):
+        raise ModelError("a shell property's material axis is normal to some cells: give an axis in their plane")
+    c, s = c / norm, s / norm
+    T = np.stack([np.stack([c * c, s * s, c * s], -1), np.stack([s * s, c * c, -c * s], -1),
+                  np.stack([-2 * c * s, 2 * c * s, c * c - s * s], -1)], 1)
+    Q = np.stack([np.stack([c, s], -1), np.stack([-s, c], -1)], 1)
+
+    def turn(M, X):
+        return np.matmul(X.transpose(0, 2, 1), np.matmul(M, X))[:, None]
+
+    return Section(turn(sec.A, T), turn(sec.D, T), turn(sec.S, Q), sec.m, sec.I)
 
 
 def local_frame(xyz: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

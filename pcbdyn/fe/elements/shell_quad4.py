@@ -28,7 +28,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..model import ModelError
-from .shell_common import btdb, local_frame, merge, rigid_offsets, rotary_mass, section, to_global
+from .shell_common import btdb, local_frame, merge, oriented, rigid_offsets, rotary_mass, section, to_global
 
 _XI = np.array([-1.0, 1.0, 1.0, -1.0])
 _ETA = np.array([-1.0, -1.0, 1.0, 1.0])
@@ -93,9 +93,10 @@ def _hermite_w_mass(xl, m):
     return np.matmul(T.transpose(0, 2, 1), np.matmul(Mh, T))
 
 
-def local_matrices(xl: np.ndarray, prop):
-    """Stiffness and mass (n, 24, 24) in the element frame from in-plane coordinates (n, 4, 2)."""
-    sec = section(prop)
+def local_matrices(xl: np.ndarray, prop, sec=None):
+    """Stiffness and mass (n, 24, 24) in the element frame from in-plane coordinates (n, 4, 2) (``sec``:
+    the section in the element frames, default :func:`.shell_common.section` of ``prop``)."""
+    sec = section(prop) if sec is None else sec
     n = xl.shape[0]
     # MITC4 tying points: gamma_xi at (0, -1), (0, 1); gamma_eta at (-1, 0), (1, 0)
     gxi_b, gxi_t = (_covariant_shear_row(xl, 0.0, s, 0) for s in (-1.0, 1.0))
@@ -134,10 +135,11 @@ def local_matrices(xl: np.ndarray, prop):
         b[:, 3:5] = np.einsum("nik,nkd->nid", invJ, gcov).reshape(n, 2, 4, 3)  # (gamma_xz, gamma_yz)
         wdet[:, g] = det
         Ns[g] = N
-    Cm = np.zeros((4, 4))
-    Cm[:3, :3], Cm[3, 3] = sec.A, sec.drilling
-    Cb = np.zeros((5, 5))
-    Cb[:3, :3], Cb[3:, 3:] = sec.D, sec.S
+    lead = np.shape(sec.A)[:-2]  # (n, 1) for sections rotated per cell
+    Cm = np.zeros(lead + (4, 4))
+    Cm[..., :3, :3], Cm[..., 3, 3] = sec.A, sec.drilling
+    Cb = np.zeros(lead + (5, 5))
+    Cb[..., :3, :3], Cb[..., 3:, 3:] = sec.D, sec.S
     K = merge(btdb(Bm.reshape(n, 4, 4, 12), Cm, wdet), btdb(Bb.reshape(n, 4, 5, 12), Cb, wdet))
     Mm, Mb = rotary_mass(Ns, wdet, sec)
     return K, merge(Mm, Mb + _hermite_w_mass(xl, sec.m))
@@ -147,5 +149,5 @@ def matrices(xyz: np.ndarray, prop):
     """Global stiffness and mass (n_cells, 24, 24) of quad4 cells with nodes ``xyz`` (n_cells, 4, 3)."""
     xyz = np.asarray(xyz, dtype=float)
     R, xl, h = local_frame(xyz)
-    Kl, Ml = local_matrices(xl, prop)
+    Kl, Ml = local_matrices(xl, prop, oriented(prop, R))
     return to_global(rigid_offsets(Kl, h), R), to_global(rigid_offsets(Ml, h), R)

@@ -24,7 +24,7 @@ from math import factorial
 
 import numpy as np
 
-from .shell_common import btdb, local_frame, merge, rotary_mass, section, to_global
+from .shell_common import btdb, local_frame, merge, oriented, rotary_mass, section, to_global
 
 _GP = np.array([[1 / 6, 1 / 6], [2 / 3, 1 / 6], [1 / 6, 2 / 3]])  # (xi, eta), weights 1/6 each
 _EDGES = ((0, 1), (1, 2), (2, 0))  # midside points 3, 4, 5 of the 6-node interpolation
@@ -123,9 +123,10 @@ def _bciz_w_mass(xl: np.ndarray, area: np.ndarray, m: float) -> np.ndarray:
     return (m * area)[:, None, None] * np.matmul(C.transpose(0, 2, 1), np.matmul(_GRAM, C))
 
 
-def local_matrices(xl: np.ndarray, prop):
-    """Stiffness and mass (n, 18, 18) in the element frame from in-plane coordinates (n, 3, 2)."""
-    sec = section(prop)
+def local_matrices(xl: np.ndarray, prop, sec=None):
+    """Stiffness and mass (n, 18, 18) in the element frame from in-plane coordinates (n, 3, 2) (``sec``:
+    the section in the element frames, default :func:`.shell_common.section` of ``prop``)."""
+    sec = section(prop) if sec is None else sec
     n = xl.shape[0]
     J = np.stack([xl[:, 1] - xl[:, 0], xl[:, 2] - xl[:, 0]], axis=1)  # J[k, i] = d x_i / d xi_k
     area = 0.5 * (J[:, 0, 0] * J[:, 1, 1] - J[:, 0, 1] * J[:, 1, 0])
@@ -141,9 +142,10 @@ def local_matrices(xl: np.ndarray, prop):
     gx, gy = _gradients(np.einsum("nik,kI->niI", invJ, _quadratic(1 / 3, 1 / 3)), U)
     Bm[:, 3, 0] = -0.5 * (gx[:, 1] - gy[:, 0])  # theta_z - (v,x - u,y) / 2 at the centroid
     Bm[:, 3, 0, 2::3] += 1.0 / 3.0
-    Cm = np.zeros((4, 3, 3))  # membrane A at the Gauss points, gamma on the drilling row
-    Cm[:3] = sec.A
-    Cm[3, 0, 0] = sec.drilling
+    lead = np.shape(sec.A)[:-3]  # (n,) for sections rotated per cell
+    Cm = np.zeros(lead + (4, 3, 3))  # membrane A at the Gauss points, gamma on the drilling row
+    Cm[..., :3, :, :] = sec.A
+    Cm[..., 3, 0, 0] = np.reshape(sec.drilling, lead)
     w = np.repeat((area / 3.0)[:, None], 3, axis=1)
     Km = btdb(Bm, Cm, np.column_stack([w, area]))
     Kb = btdb(Bb, sec.D, w)
@@ -157,5 +159,5 @@ def matrices(xyz: np.ndarray, prop):
     """Global stiffness and mass (n_cells, 18, 18) of tri3 cells with nodes ``xyz`` (n_cells, 3, 3)."""
     xyz = np.asarray(xyz, dtype=float)
     R, xl, _ = local_frame(xyz)
-    Kl, Ml = local_matrices(xl, prop)
+    Kl, Ml = local_matrices(xl, prop, oriented(prop, R))
     return to_global(Kl, R), to_global(Ml, R)

@@ -1,0 +1,179 @@
+"""A box (a ribbed shell housing: plates in 3-D with ribs, joints, supports and point masses): its
+validated description and the domain-model interface (:mod:`pcbdyn.domain`) that the bridge to updating
+and diagnosis uses, as a board's: the quantities parameter targets address, the FE model of a
+configuration, measurement points on the plates, the updated box.toml."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .. import targets
+from ..atomic import write_checked
+from ..inputs import Reader, read_toml
+from ..domain import Analysis
+from .entries import RIB_MODELS, BoxError
+from .model import BoxModel, build_model
+from .spec import (check_plates, read_configuration, read_joint, read_mass, read_materials, read_plate, read_rib,
+                   read_support)
+
+#: the collections of box.toml that parameter targets address
+COLLECTIONS = ("plates", "ribs", "joints", "masses")
+#: [m] how far a measurement point may lie from the nearest plate's mid-surface (points on a face, on
+#: a rib's flank); farther ones are an error that names them
+POINT_TOL = 0.005
+
+
+@dataclass
+class Box:
+    name: str
+    path: Path
+    plates: list
+    mesh_size: float
+    rib_model: str  # "beam" (eccentric beams) or "shell" (shell strips: the check model)
+    contacts: list = field(default_factory=list)
+    ribs: list = field(default_factory=list)
+    supports: list = field(default_factory=list)
+    joints: list = field(default_factory=list)
+    masses: list = field(default_factory=list)
+    configurations: list = field(default_factory=list)
+    parameters: list = field(default_factory=list)
+    analysis: Analysis = field(default_factory=Analysis)
+
+    def plate(self, name):
+        return next((p for p in self.plates if p.name == name), None)
+
+    def rib(self, name):
+        return next((r for r in self.ribs if r.name == name), None)
+
+    def configuration(self, name):
+        return next((c for c in self.configurations if c.name == name), None)
+
+    def configuration_names(self) -> list:
+        return [c.name for c in self.configurations]
+
+    def quantity(self, target: str) -> float | None:
+        """The current value [SI] of a parameter target such as ``plates.upper.E``; None when the box has
+        no such quantity (an orthotropic plate's E, a shell-strip rib's height)."""
+        try:
+            t = targets.parse(target, COLLECTIONS)
+        except targets.TargetError:
+            return None
+        if t.collection == "plates" and (p := self.plate(t.name)) is not None:
+            if t.attribute == "E":
+                return None if p.material.orthotropic else p.material.E
+            return {"rho": p.material.rho, "thickness": p.thickness}.get(t.attribute)
+        if t.collection == "ribs" and (r := self.rib(t.name)) is not None and self.rib_model == "beam":
+            return getattr(r, t.attribute, None)
+        if t.collection == "joints" and (j := next((j for j in self.joints if j.name == t.name), None)) is not None:
+            return j.k_rot if t.attribute == "k_rot" else None
+        if t.collection == "masses" and (m := next((m for m in self.masses if m.name == t.name), None)) is not None:
+            return m.mass if t.attribute == "mass" else None
+        return None
+
+    # -------------------------------------------------------------------- domain-model interface
+    def build(self, config: str | None = None, mesh_size: float | None = None, shared_mesh: bool = False) -> BoxModel:
+        """The FE model of configuration ``config`` (None: the base one); see :func:`.model.build_model`."""
+        return build_model(self, config, mesh_size, shared_mesh)
+
+    def nearest_plates(self, xyz) -> tuple:
+        """(index of the nearest plate, distance [m]) of each point (k, 3)."""
+        d = np.array([p.distance(xyz) for p in self.plates])
+        return d.argmin(axis=0), d.min(axis=0)
+
+    def check_points(self, points, source) -> None:
+        """A BoxError naming the points (``points.ids``, ``points.xyz`` [m]) of ``source`` farther than
+        :data:`POINT_TOL` from every plate, with the nearest plate and how far it is."""
+        near, dist = self.nearest_plates(points.xyz)
+        off = dist > POINT_TOL
+        if off.any():
+            listed = "; ".join(f"{int(i)} at {np.round(x * 1e3, 3).tolist()} mm is {d * 1e3:.3g} mm from plate "
+                               f"'{self.plates[k].name}'"
+                               for i, x, d, k in zip(points.ids[off][:10], points.xyz[off][:10], dist[off][:10],
+                                                     near[off][:10]))
+            raise BoxError(f"{Path(source).name}: {int(off.sum())} point(s) lie off every plate of {self.path.name} "
+                           f"(more than {POINT_TOL * 1e3:g} mm away): {listed}{' ...' if off.sum() > 10 else ''}. "
+                           "Give the points in the box frame of the file and state their unit in the header (e.g. "
+                           "'x [mm]')")
+
+    def outlines(self, config: str | None = None) -> list:
+        """What a 3-D mode-shape picture outlines, as plain data: ``{"kind", "label", "xyz": [[x, y, z],
+        ...] in metres, "closed"}`` for the plates, ribs, supported edges, point masses (a single point
+        is a marker)."""
+        def item(kind, label, pts, closed=False):
+            return {"kind": kind, "label": label, "xyz": np.asarray(pts, float).reshape(-1, 3).tolist(),
+                    "closed": closed}
+
+        items = [item("plate", p.name, p.corners(), True) for p in self.plates]
+        items += [item("stiffener", r.name, [self.plate(r.plate).point(*r.start), self.plate(r.plate).point(*r.end)])
+                  for r in self.ribs]
+        items += [item("fixture", f"{s.type} {s.plate}.{s.edge}", self.plate(s.plate).edge(s.edge))
+                  for s in self.supports]
+        added = self.configuration(config).masses if config else []
+        items += [item("mass", m.name + (f" ({config})" if m in added else ""), [self.plate(m.plate).point(*m.at)])
+                  for m in self.masses + added]
+        return items
+
+    def write_enriched(self, effects, dst) -> Path:
+        """``dst``: this box.toml with the effects a diagnosis found declared (:mod:`.enrich`)."""
+        from .enrich import write_enriched
+
+        return write_enriched(self, effects, dst)
+
+    def write_updated(self, values: dict, dst, source: str = "pcbdyn update") -> Path:
+        """``dst``: this box.toml with the parameters' ``values`` {name: SI} written into their targets
+        (comments and layout kept), checked by loading it before it replaces ``dst``."""
+        assignments = {t: float(values[p.name]) for p in self.parameters if p.name in values for t in p.targets}
+        text = targets.updated_text(self.path.read_text(encoding="utf-8"), assignments)
+        return write_checked(dst, f"# {self.path.name} with {', '.join(values)} updated by {source}\n" + text,
+                             load_box, BoxError)
+
+
+def load_box(path) -> Box:
+    """Read and validate a box.toml."""
+    return parse_box(read_toml(path, BoxError)[1], Path(path))
+
+
+def _named(r, data, key, read, *args) -> list:
+    """The entries of array ``key``, each read by ``read(r, entry, where, name, *args)``, names unique."""
+    out = [read(r, e, f"{key}[{i}]", targets.entry_name(key, e, i), *args) for i, e in enumerate(r.list(data, key))]
+    r.unique([e.name for e in out], key, "name")
+    for i, e in enumerate(out):
+        if (why := targets.check_name(e.name)) is not None:
+            r.fail(f"{key}[{i}].name", why)
+    return out
+
+
+def parse_box(data: dict, path: Path) -> Box:
+    """The Box of parsed box.toml ``data`` read from ``path``; a BoxError names the first bad field."""
+    r = Reader(path, BoxError)
+    r.table(data, "top level", ["box", "materials", "plates", "ribs", "supports", "joints", "masses",
+                                "configurations", "parameters", "analysis"], required=["box", "plates"])
+    b = r.table(data["box"], "box", ["name", "mesh_size", "rib_model"])
+    rib_model = b.get("rib_model", "beam")
+    if rib_model not in RIB_MODELS:
+        r.fail("box.rib_model", f"{rib_model!r} is not \"beam\" (eccentric beams) or \"shell\" (shell strips)")
+    materials = read_materials(r, data)
+    plates = _named(r, data, "plates", read_plate, materials)
+    if not plates:
+        r.fail("plates", "is empty; add [[plates]] with origin, u, v, thickness and material")
+    box = Box(name=str(b.get("name", Path(path).parent.name)), path=Path(path), plates=plates,
+              mesh_size=r.q(b.get("mesh_size", "10 mm"), "mm", "box.mesh_size", positive=True), rib_model=rib_model)
+    box.ribs = _named(r, data, "ribs", read_rib, plates, materials)
+    box.supports = [read_support(r, e, f"supports[{i}]", plates) for i, e in enumerate(r.list(data, "supports"))]
+    box.contacts = check_plates(r, plates, box.supports)
+    box.joints = _named(r, data, "joints", read_joint, box.contacts)
+    box.masses = _named(r, data, "masses", read_mass, plates)
+    box.configurations = [read_configuration(r, e, f"configurations[{i}]", plates)
+                          for i, e in enumerate(r.list(data, "configurations"))]
+    r.unique([c.name for c in box.configurations], "configurations", "name")
+    box.analysis = r.analysis(data)
+    for i, p in enumerate(r.list(data, "parameters")):
+        try:
+            box.parameters.append(targets.parameter_spec(p, f"parameters[{i}]", box.quantity, r.file, COLLECTIONS))
+        except targets.TargetError as exc:
+            raise BoxError(str(exc)) from None
+    r.unique([p.name for p in box.parameters], "parameters", "name")
+    return box

@@ -1,0 +1,65 @@
+"""The enriched box.toml: the original file, its comments and layout kept, with the effects a diagnosis
+found declared as box entries (tomlkit), so that ``pcbdyn build`` of the new file gives the diagnosed
+model: a point mass becomes a ``[[masses]]`` entry on its plate (at its lengths along u and v), a plate
+stiffer or softer as a whole that plate's own ``E`` (the declared one times 1 + s). A box has no entry
+for a spring to ground: such effects are written as comments that say where and how stiff.
+
+An effect is a dict as :func:`pcbdyn.report.diagnosis_report.enriched_effects` makes them: type, name,
+value (SI), at (x, y, z) [m] and plate.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+import tomlkit
+
+from .. import targets
+from ..atomic import write_checked
+from .box import load_box
+from .entries import BoxError
+
+
+def _name(doc, base: str) -> str:
+    used = {targets.entry_name("masses", e, i) for i, e in enumerate(doc.get("masses", []))}
+    out, k = re.sub(r"[^A-Za-z0-9_-]+", "_", base).strip("_") or "mass", 2
+    while out in used:
+        out, k = f"{base}_{k}", k + 1
+    return out
+
+
+def enriched_text(box, text: str, effects) -> str:
+    """``text`` (box.toml of ``box``) with ``effects`` declared."""
+    doc = tomlkit.parse(text)
+    for e in effects:
+        plate = box.plate(e.get("plate"))
+        if plate is None:
+            raise BoxError(f"effect {e.get('name')}: names no plate of {box.path.name}")
+        if e["type"] == "point_mass":
+            s, t, _ = plate.coordinates(np.asarray(e["at"], float))[0]
+            a, b = s * plate.lengths[0], t * plate.lengths[1]
+            entry = tomlkit.table()
+            entry.update({"name": _name(doc, str(e["name"])), "plate": plate.name,
+                          "at": [targets.quantity(v, "mm") for v in (a, b)],
+                          "mass": targets.formatted(targets.KINDS["masses", "mass"], float(e["value"]))})
+            entry.comment(f"found by pcbdyn diagnose ({e['name']})")
+            doc.setdefault("masses", tomlkit.aot()).append(entry)
+        elif e["type"] == "region_stiffness":
+            i = next(k for k, p in enumerate(doc["plates"]) if targets.entry_name("plates", p, k) == plate.name)
+            factor = 1.0 + float(e["value"])
+            E = plate.material.E
+            doc["plates"][i]["E"] = ([targets.quantity(v * factor, "GPa") for v in E] if isinstance(E, tuple)
+                                     else targets.quantity(E * factor, "GPa"))
+        else:
+            doc.add(tomlkit.comment(f"pcbdyn diagnose found a {e['type']} of {float(e['value']):.6g} (SI) at "
+                                    f"{np.round(np.asarray(e['at']) * 1e3, 2).tolist()} mm on plate {plate.name}; "
+                                    "a box has no entry for it: model it by hand"))
+    return tomlkit.dumps(doc)
+
+
+def write_enriched(box, effects, dst) -> Path:
+    """``dst``: box.toml of ``box`` with ``effects`` declared, written atomically once it loads."""
+    text = enriched_text(box, Path(box.path).read_text(encoding="utf-8"), effects)
+    return write_checked(dst, text, load_box, BoxError)
