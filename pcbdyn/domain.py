@@ -87,6 +87,17 @@ def check_mesh_size(where: str, span: float, area: float, size: float, error, wh
                     "mm or more), or raise the limit with the PCBDYN_MAX_DOFS variable")
 
 
+class Configured:
+    """The test configurations of a structure (a dataclass with ``configurations``: entries with a
+    ``name``), looked up by name: what board and box share."""
+
+    def configuration(self, name):
+        return next((c for c in self.configurations if c.name == name), None)
+
+    def configuration_names(self) -> list:
+        return [c.name for c in self.configurations]
+
+
 def configuration_of(structure, name, error):
     """The ``[[configurations]]`` entry ``name`` of ``structure`` (None for None, the base one), or
     ``error`` naming the configurations there are."""

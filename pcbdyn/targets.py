@@ -206,6 +206,20 @@ def parameter_spec(entry: dict, where: str, value: Callable, file: str, collecti
                          values[0])
 
 
+def read_parameters(reader, data: dict, value: Callable, collections) -> list:
+    """The ``[[parameters]]`` of a structure's file (``reader``: its :class:`pcbdyn.inputs.Reader`,
+    ``data`` the parsed file) checked by :func:`parameter_spec` against ``value(target)``; a bad one is the
+    reader's error (BoardError, BoxError, ...)."""
+    out = []
+    for i, p in enumerate(reader.list(data, "parameters")):
+        try:
+            out.append(parameter_spec(p, f"parameters[{i}]", value, reader.file, collections))
+        except TargetError as exc:
+            raise reader.error(str(exc)) from None
+    reader.unique([p.name for p in out], "parameters", "name")
+    return out
+
+
 # ------------------------------------------------------------------------------------ TOML slots
 def _entry(doc, target: Target):
     """The TOML table holding ``target``'s entry in the parsed document ``doc`` (tomlkit or dict)."""

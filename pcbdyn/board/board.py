@@ -9,6 +9,7 @@ from pathlib import Path
 
 from .. import targets
 from ..atomic import write_checked
+from ..domain import Configured
 from ..inputs import Reader, read_toml
 from .entries import Analysis, BoardError, Component, Configuration, Outline
 from .laminate import Material
@@ -24,7 +25,7 @@ COLLECTIONS = ("board", "components", "fixtures", "masses", "line_masses", "stif
 
 
 @dataclass
-class Board:
+class Board(Configured):
     """A printed circuit board as board.toml describes it (SI units, the board frame): outline, plate
     (isotropic or stack-up), parts, fixtures, masses, effect entries, test configurations, parameters
     and analysis settings; :func:`load_board` reads and validates it, :meth:`build` makes its FE model."""
@@ -60,12 +61,6 @@ class Board:
 
     def point_mass(self, name):
         return next((m for m in self.masses if m.name == name), None)
-
-    def configuration(self, name):
-        return next((c for c in self.configurations if c.name == name), None)
-
-    def configuration_names(self) -> list:
-        return [c.name for c in self.configurations]
 
     def entry(self, kind, name):
         """The ``line_masses``, ``stiffeners`` or ``regions`` entry called ``name`` (or None)."""
@@ -202,10 +197,5 @@ def parse_board(data: dict, path: Path) -> Board:
             r.fail(f"points[{i}]", f"{p} is not on the board; move it inside the outline")
         board.points.append(pt)
     board.analysis = r.analysis(data)
-    for i, p in enumerate(r.list(data, "parameters")):
-        try:
-            board.parameters.append(targets.parameter_spec(p, f"parameters[{i}]", board.quantity, r.file, COLLECTIONS))
-        except targets.TargetError as exc:
-            raise BoardError(str(exc)) from None
-    r.unique([p.name for p in board.parameters], "parameters", "name")
+    board.parameters = targets.read_parameters(r, data, board.quantity, COLLECTIONS)
     return board

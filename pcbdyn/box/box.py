@@ -13,7 +13,7 @@ import numpy as np
 from .. import targets
 from ..atomic import write_checked
 from ..inputs import Reader, read_toml
-from ..domain import Analysis
+from ..domain import Analysis, Configured
 from .entries import RIB_MODELS, BoxError
 from .model import BoxModel, build_model
 from .spec import (check_plates, read_configuration, read_joint, read_mass, read_materials, read_plate, read_rib,
@@ -27,7 +27,7 @@ POINT_TOL = 0.005
 
 
 @dataclass
-class Box:
+class Box(Configured):
     name: str
     path: Path
     plates: list
@@ -47,12 +47,6 @@ class Box:
 
     def rib(self, name):
         return next((r for r in self.ribs if r.name == name), None)
-
-    def configuration(self, name):
-        return next((c for c in self.configurations if c.name == name), None)
-
-    def configuration_names(self) -> list:
-        return [c.name for c in self.configurations]
 
     def quantity(self, target: str) -> float | None:
         """The current value [SI] of a parameter target such as ``plates.upper.E``; None when the box has
@@ -170,10 +164,5 @@ def parse_box(data: dict, path: Path) -> Box:
                           for i, e in enumerate(r.list(data, "configurations"))]
     r.unique([c.name for c in box.configurations], "configurations", "name")
     box.analysis = r.analysis(data)
-    for i, p in enumerate(r.list(data, "parameters")):
-        try:
-            box.parameters.append(targets.parameter_spec(p, f"parameters[{i}]", box.quantity, r.file, COLLECTIONS))
-        except targets.TargetError as exc:
-            raise BoxError(str(exc)) from None
-    r.unique([p.name for p in box.parameters], "parameters", "name")
+    box.parameters = targets.read_parameters(r, data, box.quantity, COLLECTIONS)
     return box

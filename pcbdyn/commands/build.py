@@ -8,7 +8,7 @@ from pathlib import Path
 
 import click
 
-from .common import done, fail, folder_outputs, library_option, solve_structure, step
+from .common import done, folder_outputs, input_errors, library_option, solve_structure, step
 
 
 def analyse(board, config, out: Path | None, pictures: bool = True, written: list | None = None,
@@ -83,12 +83,10 @@ def uncertainty_note(stds: dict) -> str:
 @library_option()
 def command(board_toml, config, all_configs, out, json_path, no_pictures, html, uncertainty):
     """Predict a board's resonances: frequencies, effective masses in z, mode shapes."""
-    from ..domain import StructureError
-    from ..fe import ModelError
     from ..problems import load_structure
     from ..report.files import write_json
 
-    try:
+    with input_errors():
         board = load_structure(board_toml)
         if config is not None and all_configs:
             raise click.UsageError("give --config NAME or --all-configs, not both")
@@ -100,8 +98,6 @@ def command(board_toml, config, all_configs, out, json_path, no_pictures, html, 
             board, stds = library_uncertainty(board)
             click.echo(uncertainty_note(stds), err=True)
         results = [analyse(board, c, out, pictures=not no_pictures, written=written, stds=stds) for c in configs]
-    except (StructureError, ModelError) as exc:
-        fail(str(exc))
     if json_path is not None:
         data = dict(results[0]) if len(results) == 1 else {**results[0], "configurations": results}
         data["board"] = board.name

@@ -24,7 +24,7 @@ from pathlib import Path
 
 import click
 
-from .common import checked_outputs, done, fail, library_option, parse_extra, parse_noise, step, test_arguments
+from .common import checked_outputs, done, fail, input_errors, library_option, parse_extra, parse_noise, step, test_arguments
 
 
 def names(text) -> list | None:
@@ -58,7 +58,6 @@ def names(text) -> list | None:
 def command(board_toml, test_uff, configs, freq_csv, joint_toml, families, with_, method, solver, noise, max_iter,
             tol_pct, mesh_size, mesh_error, json_path, library):
     """Calibrate part families' equivalent thicknesses from modal tests into a component library."""
-    from ..domain import StructureError
     from ..problems.calibration import calibrate, calibration_problem
     from ..problems.calibration_library import check_library, max_error, write_library
     from ..problems.joint import load_board_tests, read_joint
@@ -66,7 +65,6 @@ def command(board_toml, test_uff, configs, freq_csv, joint_toml, families, with_
     from ..report import calibration_report as rep
     from ..report.files import write_json
     from ..report.update_report import progress_line
-    from ..testdata import TestDataError
     from ..units import to_si
 
     if board_toml is None and joint_toml is None:
@@ -78,7 +76,7 @@ def command(board_toml, test_uff, configs, freq_csv, joint_toml, families, with_
         fail("--frequencies holds no shapes: use --method freq")
     extras = parse_extra(configs)
     f_pct, shape_pct = parse_noise(noise)
-    try:
+    with input_errors(ValueError):
         t0 = step("reading the boards and their tests")
         items = [] if board_toml is None else [load_board_tests(board_toml, test_uff, extras, freq_csv)]
         items += [] if joint_toml is None else read_joint(joint_toml)
@@ -94,8 +92,6 @@ def command(board_toml, test_uff, configs, freq_csv, joint_toml, families, with_
         t0 = step(f"writing the library {library}")
         fams = write_library(cal, library)
         done(t0)
-    except (StructureError, TestDataError, ValueError) as exc:
-        fail(str(exc))
     click.echo(f"\n{rep.headline(cal, what['status'])}")
     for line in what["details"]:
         click.echo(f"  note: {line}")

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import sys
 import time
@@ -29,6 +30,22 @@ def fail(message: str, code: int = 2):
     """Print ``error: message`` on stderr and leave with ``code`` (nothing else is written)."""
     click.echo(f"error: {message}", err=True)
     sys.exit(code)
+
+
+@contextlib.contextmanager
+def input_errors(*more):
+    """Bad input met inside (a structure's, test or library file, a quantity, an FE model that cannot be
+    solved, and the exception classes ``more``) ends the command with its one-line message (exit 2)."""
+    from ..components.library import LibraryError
+    from ..domain import StructureError
+    from ..fe import ModelError
+    from ..testdata import TestDataError
+    from ..units import UnitError
+
+    try:
+        yield
+    except (StructureError, TestDataError, ModelError, UnitError, LibraryError, *more) as exc:
+        fail(str(exc).strip("'\""))
 
 
 def solve_structure(structure, config: str | None, n_modes: int | None = None, f_max: float | None = None):

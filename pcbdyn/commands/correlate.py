@@ -9,7 +9,7 @@ from pathlib import Path
 
 import click
 
-from .common import PROBE_TOL, done, fail, folder_outputs, library_option, solve_structure, step
+from .common import PROBE_TOL, done, fail, folder_outputs, input_errors, library_option, solve_structure, step
 
 @click.command("correlate")
 @click.argument("board_toml", type=click.Path(exists=True, dir_okay=False, path_type=Path))
@@ -23,9 +23,9 @@ from .common import PROBE_TOL, done, fail, folder_outputs, library_option, solve
                 "write pairs, unpaired test modes and COMAC as JSON", html=True)
 @library_option()
 def command(board_toml, test_uff, config, min_mac, n_modes, out, json_path, html):
-    """Correlate a board model with a modal test (UFF): pair table, COMAC, pictures."""
+    """Correlate a structure's model (board.toml or box.toml, one configuration) with a modal test (UFF with
+    mode shapes): pairs by MAC, frequency differences, COMAC, pictures."""
     from ..correlation import correlate
-    from ..domain import StructureError
     from ..fe import ModelError
     from ..problems import load_structure
     from ..report.correlation_report import comac_line, format_pairs, write_outputs
@@ -33,7 +33,7 @@ def command(board_toml, test_uff, config, min_mac, n_modes, out, json_path, html
     from ..testdata import TestDataError
     from ..testdata.measured import read_modes
 
-    try:
+    with input_errors():
         board = load_structure(board_toml)
         test_modes = read_modes(test_uff)
         board.check_points(test_modes.measured_points(), test_uff)
@@ -46,8 +46,6 @@ def command(board_toml, test_uff, config, min_mac, n_modes, out, json_path, html
         except ModelError as exc:
             raise TestDataError(f"{test_uff}: the test points do not lie on the model of {board_toml.name}: {exc}")
         done(t0)
-    except (StructureError, ModelError, TestDataError) as exc:
-        fail(str(exc))
     pairing = corr.pairing
     if not pairing.pairs:
         best = float(pairing.mac.max()) if pairing.mac.size else 0.0

@@ -15,7 +15,7 @@ from pathlib import Path
 import click
 
 from ..diagnosis import KINDS
-from .common import done, fail, folder_outputs, library_option, measured_configurations, parse_noise, result_path, step
+from .common import done, folder_outputs, input_errors, library_option, measured_configurations, parse_noise, result_path, step
 
 
 @click.command("diagnose")
@@ -40,7 +40,6 @@ def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size,
     from ..problems import load_structure
     from ..report import diagnosis_report as rep
     from ..report.files import write_json, write_text
-    from ..testdata import TestDataError
     from ..units import to_si
 
     freq_pct, shape_pct = parse_noise(noise)
@@ -50,7 +49,7 @@ def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size,
         bad = [k for k in chosen if k not in KINDS]
         if bad:
             raise click.BadParameter(f"unknown kind(s) {bad}; use {', '.join(KINDS)}", param_hint="--kinds")
-    try:
+    with input_errors(KeyError, ValueError):
         board = load_structure(board_toml)
         tests = measured_configurations(board, test_uff, configs)
         ms = to_si(mesh_size, "mm", "--mesh-size") if mesh_size else None
@@ -58,8 +57,6 @@ def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size,
         d = diagnose(board, tests, freq_pct, shape_pct, mesh_size=ms, kinds=chosen, max_effects=max_effects,
                      progress=lambda msg: click.echo(f"    {msg}", err=True))
         done(t0)
-    except (StructureError, TestDataError, KeyError, ValueError) as exc:
-        fail(str(exc))
     click.echo(f"\n{board.name}: {d.message}\n")
     click.echo(rep.format_effects(d.effects))
     click.echo("")

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import click
 
-from .common import done, fail, folder_outputs, library_option, measured_configurations, parse_extra, parse_noise, step
+from .common import done, folder_outputs, input_errors, library_option, measured_configurations, parse_extra, parse_noise, step
 
 METHOD_CHOICES = ["tls-qrf", "svd-qr", "qr", "min-norm"]
 
@@ -44,16 +44,14 @@ def command(board_toml, test_uff, config_tests, method, eq_type, params, rank, a
             json_path):
     """Localise model errors among a structure's [[parameters]] from modal tests: TEST_UFF of the base
     configuration and NAME=FILE for each perturbed configuration of board.toml (e.g. c2=test2.uff)."""
-    from ..domain import StructureError
     from ..problems import UpdateProblem, load_structure
     from ..problems.localize import evidence, noise_redraws
     from ..report.files import write_json
-    from ..testdata import TestDataError
     from ..updating.iteration import build_equations
 
     extra = parse_extra(config_tests)
     freq_pct, shape_pct = parse_noise(noise)
-    try:
+    with input_errors(KeyError, ValueError):
         board = load_structure(board_toml)
         names = [n.strip() for n in params.split(",")] if params else None
         t0 = step("building the model and its parameter derivatives")
@@ -68,8 +66,6 @@ def command(board_toml, test_uff, config_tests, method, eq_type, params, rank, a
         redraws = [] if noise is None else noise_redraws(problem, tests, eq_type, matching, A.shape, freq_pct,
                                                           shape_pct)
         done(t0)
-    except (ValueError, KeyError, TestDataError, StructureError) as exc:
-        fail(str(exc).strip("'\""))
     data, tls = evidence(method, A, b, problem.names, rank, alpha, redraws)
     data["configurations"] = ["base"] + [n for n, _ in extra]
     data["equations"] = eq_type

@@ -11,7 +11,7 @@ from pathlib import Path
 import click
 import numpy as np
 
-from .common import PROBE_TOL, checked_outputs, done, fail, library_option, number_pair, solve_structure, step
+from .common import PROBE_TOL, checked_outputs, done, input_errors, library_option, number_pair, solve_structure, step
 
 
 def check_band(f_range, df: float) -> None:
@@ -51,11 +51,9 @@ def check_band(f_range, df: float) -> None:
 def command(board_toml, points_csv, config, excite, excite_dir, noise, seed, f_range, df, damping, kind, n_modes, out,
             json_path):
     """Simulate a modal test on a board model: modes and FRFs at measurement points, with noise."""
-    from ..domain import StructureError
     from ..problems import load_structure
-    from ..fe import ModelError
     from ..report.files import write_json
-    from ..testdata import Noise, Points, TestDataError, read_points_csv, write_uff
+    from ..testdata import Noise, Points, read_points_csv, write_uff
     from ..testdata.simulate import frequency_axis, simulate_on_model
 
     xyz = (number_pair(excite, "--excite", "mm", counts=(2, 3)) + (0.0,))[:3]
@@ -68,7 +66,7 @@ def command(board_toml, points_csv, config, excite, excite_dir, noise, seed, f_r
         raise click.BadParameter(str(exc), param_hint="--noise") from None
     if not 0 <= damping < 1:
         raise click.BadParameter(f"{damping} is not a damping ratio in [0, 1)", param_hint="--damping")
-    try:
+    with input_errors():
         board = load_structure(board_toml)
         points, dofs = read_points_csv(points_csv)
         board.check_points(points, points_csv)
@@ -81,8 +79,6 @@ def command(board_toml, points_csv, config, excite, excite_dir, noise, seed, f_r
                                  zeta=damping, kind=kind, noise=noise_levels, seed=seed, tol=PROBE_TOL)
         done(t0)
         write_uff(out, data)
-    except (StructureError, ModelError, TestDataError) as exc:
-        fail(str(exc))
     ref_id = int(data.frfs.reference.point_ids[0])
     click.echo(f"\n{board.name} [{config or 'base'}]: simulated test, {len(dofs)} response DOFs, "
                f"excitation at point {ref_id} ({', '.join(f'{v * 1e3:g}' for v in xyz)} mm, {excite_dir})")

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import click
 
-from .common import (done, fail, folder_outputs, library_option, measured_configurations, parse_extra, result_path,
+from .common import (done, fail, folder_outputs, input_errors, library_option, measured_configurations, parse_extra, result_path,
                      step, test_arguments)
 
 def parse_frf_freqs(text) -> list:
@@ -66,13 +66,11 @@ def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping,
     """Update a structure's [[parameters]] against modal tests: TEST_UFF for the base configuration and
     NAME=FILE for each perturbed configuration of board.toml (e.g. c2=test2.uff), or measured
     frequencies (--frequencies CSV)."""
-    from ..domain import StructureError
     from ..problems import UpdateProblem, load_structure, run
     from ..problems.frf_tests import frf_configurations
     from ..problems.run import outcome
     from ..report import update_report as rep
     from ..report.files import write_json, write_text
-    from ..testdata import TestDataError
     from ..testdata.measured import read_frequency_table
     from ..units import to_si
 
@@ -80,7 +78,7 @@ def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping,
         fail("give either TEST_UFF (and NAME=FILE for other configurations) or --frequencies FILE.csv")
     if freq_csv is not None and method != "freq":
         fail("--frequencies holds no shapes: use --method freq")
-    try:
+    with input_errors(KeyError, ValueError):
         board = load_structure(board_toml)
         ms = to_si(mesh_size, "mm", "--mesh-size") if mesh_size else None
         t0 = step("building the models")
@@ -109,8 +107,6 @@ def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping,
         what = outcome(problem, res, before, after)
         dst = problem.write_updated(res.p, result_path(out, board_toml, "updated", force), source=(
             f"pcbdyn update ({what['status']})"))
-    except (StructureError, TestDataError, KeyError, ValueError) as exc:
-        fail(str(exc))
     rows = rep.parameter_rows(problem, res.p)
     click.echo(f"\n{board.name}: {what['status']} after {res.iterations} iteration(s) ({res.reason}; best iterate "
                f"{res.best_iteration})")

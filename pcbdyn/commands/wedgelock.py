@@ -16,7 +16,7 @@ from pathlib import Path
 
 import click
 
-from .common import (PROBE_TOL, done, fail, folder_outputs, library_option, parse_extra, parse_noise, result_path, step,
+from .common import (PROBE_TOL, done, fail, folder_outputs, input_errors, library_option, parse_extra, parse_noise, result_path, step,
                      test_arguments)
 
 
@@ -45,19 +45,17 @@ def command(board_toml, test_uff, configs, freq_csv, per_guide, tol_pct, noise, 
     is the base configuration's test, NAME=FILE each perturbed configuration's of board.toml (e.g.
     c2=test2.uff); or measured frequencies (--frequencies CSV)."""
     from ..domain import StructureError
-    from ..fe import ModelError
     from ..problems import load_structure
     from ..problems.wedgelock import fit_wedge_locks
     from ..report import wedgelock_report as rep
     from ..report.files import write_json, write_text
-    from ..testdata import TestDataError
     from ..testdata.measured import read_frequency_table, read_tests
     from ..units import to_si
 
     if (test_uff is None) == (freq_csv is None):
         fail("give either TEST_UFF (and NAME=FILE for other configurations) or --frequencies FILE.csv")
     freq_noise, _ = parse_noise(noise)
-    try:
+    with input_errors(ValueError):
         board = load_structure(board_toml)
         ms = to_si(mesh_size, "mm", "--mesh-size") if mesh_size else None
         if freq_csv is not None:
@@ -72,8 +70,6 @@ def command(board_toml, test_uff, configs, freq_csv, per_guide, tol_pct, noise, 
                                  mesh_size=ms, min_mac=min_mac, probe_tol=PROBE_TOL, max_iter=max_iter,
                                  progress=lambda msg: click.echo(f"    {msg}", err=True))
         done(t0)
-    except (StructureError, ModelError, TestDataError, ValueError) as exc:
-        fail(str(exc))
     d = result.to_dict()
     before, after = result.before_after()
     tables = {"extremes.txt": "\n\n".join(rep.format_extreme(k, d["extremes"][k], d["tolerance_pct"])

@@ -11,8 +11,20 @@ from dataclasses import dataclass, field
 import numpy as np
 
 
+class _HomogeneousMass:
+    """The mass of a shell of one density ``rho`` and thickness ``t`` with non-structural mass ``nsm``."""
+
+    def mass_per_area(self) -> float:
+        """Translational mass per unit area [kg/m^2]."""
+        return self.rho * self.t + self.nsm
+
+    def rotary_inertia_per_area(self) -> float:
+        """Rotary inertia per unit area about the mid-surface [kg]."""
+        return self.rho * self.t**3 / 12.0
+
+
 @dataclass(frozen=True)
-class ShellProperty:
+class ShellProperty(_HomogeneousMass):
     """Homogeneous isotropic shell: Young's modulus E [Pa], Poisson ratio nu, density rho [kg/m^3],
     thickness t [m].
 
@@ -42,17 +54,10 @@ class ShellProperty:
         G = self.E / (2.0 * (1.0 + self.nu))
         return self.shear_factor * G * self.t * np.eye(2)
 
-    def mass_per_area(self) -> float:
-        """Translational mass per unit area [kg/m^2]."""
-        return self.rho * self.t + self.nsm
-
-    def rotary_inertia_per_area(self) -> float:
-        """Rotary inertia per unit area about the mid-surface [kg]."""
-        return self.rho * self.t**3 / 12.0
 
 
 @dataclass(frozen=True)
-class OrthotropicShellProperty:
+class OrthotropicShellProperty(_HomogeneousMass):
     """Orthotropic shell (a plate whose hole pattern or stiffening differs along two directions, smeared):
     Young's moduli ``Eu`` along the in-plane direction ``axis`` (global axes) and ``Ev`` across it, major
     Poisson ratio ``nu`` (nu_uv; nu_vu = nu Ev / Eu), shear modulus ``G`` (default Huber's
@@ -86,11 +91,6 @@ class OrthotropicShellProperty:
     def shear(self) -> np.ndarray:
         return self.shear_factor * self.shear_modulus * self.t * np.eye(2)
 
-    def mass_per_area(self) -> float:
-        return self.rho * self.t + self.nsm
-
-    def rotary_inertia_per_area(self) -> float:
-        return self.rho * self.t**3 / 12.0
 
 
 @dataclass(frozen=True)

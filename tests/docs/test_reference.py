@@ -15,6 +15,8 @@ from pcbdyn.board import parse_board
 from pcbdyn.board.entries import FIXTURE_TYPES
 from pcbdyn.components.library import MODELS
 
+import reference_checks
+
 ROOT = Path(__file__).resolve().parents[2]
 REFERENCE = ROOT / "docs" / "board-toml.md"
 
@@ -28,23 +30,11 @@ TABLES = [(), ("board",), ("board", "outline"), ("board", "outline", "holes", 0)
 
 
 def allowed_fields(path) -> list:
-    """The fields the reader accepts in the table at ``path``: its message for an unknown field lists them."""
-    data = copy.deepcopy(EVERY_TABLE)
-    table = data
-    for key in path:
-        table = table[key]
-    table["qqqqzzzz"] = 1
-    with pytest.raises(BoardError) as err:
-        parse_board(data, Path("board.toml"))
-    message = str(err.value)
-    assert "unknown field; allowed: " in message, message
-    return message.split("allowed: ")[1].split(", ")
+    return reference_checks.allowed_fields(parse_board, BoardError, EVERY_TABLE, path, "board.toml")
 
 
 def documented() -> set:
-    """The names the reference writes as code (outside its examples); `[board]` also counts as `board`."""
-    text = re.sub(r"```.*?```", "", REFERENCE.read_text(), flags=re.S)
-    return {name for code in re.findall(r"`([^`\n]+)`", text) for name in (code, code.strip("[]"))}
+    return reference_checks.documented(REFERENCE)
 
 
 def test_the_example_with_every_table_is_a_valid_board():
