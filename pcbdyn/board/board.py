@@ -13,6 +13,7 @@ from ..domain import Configured
 from ..inputs import Reader, read_toml
 from .entries import Analysis, BoardError, Component, Configuration, Outline
 from .laminate import Material
+from .enrich import enriched_text
 from .model import BoardModel, build_model
 from .outlines import board_outlines
 from .spec import read_outline, read_plate
@@ -121,11 +122,11 @@ class Board(Configured):
         """What a mode-shape picture outlines, as plain data (:func:`.outlines.board_outlines`)."""
         return board_outlines(self, config)
 
-    def write_enriched(self, effects, dst) -> Path:
-        """``dst``: this board.toml with the effects a diagnosis found declared (:mod:`.enrich`)."""
-        from .enrich import write_enriched
-
-        return write_enriched(self.path, effects, dst)
+    def write_enriched(self, effects, dst, date: str | None = None) -> Path:
+        """``dst``: this board.toml with the effects a diagnosis found declared (:mod:`.enrich`), written
+        atomically once it loads."""
+        text = enriched_text(self.path.read_text(encoding="utf-8"), effects, date)
+        return write_checked(dst, text, load_board, BoardError)
 
     def write_updated(self, values: dict, dst, source: str = "pcbdyn update") -> Path:
         """``dst``: this board.toml with the parameters' ``values`` {name: SI} written into their targets

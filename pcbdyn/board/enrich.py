@@ -24,8 +24,6 @@ import numpy as np
 import tomlkit
 
 from .. import targets
-from ..atomic import write_checked
-from .board import load_board
 from .entries import BoardError
 
 TYPES = ("point_mass", "point_inertia", "ground_spring", "edge_stiffness", "line_mass", "stiffener",
@@ -135,13 +133,3 @@ def enriched_text(text: str, effects, date: str | None = None, source: str = "pc
             doc.add(collection, tomlkit.aot())
         doc[collection].append(table)
     return tomlkit.dumps(doc)
-
-
-def write_enriched(original_path, effects, out_path=None, date: str | None = None) -> Path:
-    """Write ``original_path`` with the declarations of ``effects`` to ``out_path`` (default
-    ``<stem>.diagnosed.toml`` beside the original), atomically, after checking that it loads. Returns
-    the path written."""
-    src = Path(original_path)
-    dst = Path(out_path) if out_path is not None else enriched_path(src)
-    text = enriched_text(src.read_text(encoding="utf-8"), effects, date)
-    return write_checked(dst, text, load_board, BoardError)

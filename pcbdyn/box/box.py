@@ -15,6 +15,7 @@ from ..atomic import write_checked
 from ..inputs import Reader, read_toml
 from ..domain import Analysis, Configured
 from .entries import RIB_MODELS, BoxError
+from .enrich import enriched_text
 from .model import BoxModel, build_model
 from .spec import (check_plates, read_configuration, read_joint, read_mass, read_materials, read_plate, read_rib,
                    read_support)
@@ -111,10 +112,10 @@ class Box(Configured):
         return items
 
     def write_enriched(self, effects, dst) -> Path:
-        """``dst``: this box.toml with the effects a diagnosis found declared (:mod:`.enrich`)."""
-        from .enrich import write_enriched
-
-        return write_enriched(self, effects, dst)
+        """``dst``: this box.toml with the effects a diagnosis found declared (:mod:`.enrich`), written
+        atomically once it loads."""
+        text = enriched_text(self, Path(self.path).read_text(encoding="utf-8"), effects)
+        return write_checked(dst, text, load_box, BoxError)
 
     def write_updated(self, values: dict, dst, source: str = "pcbdyn update") -> Path:
         """``dst``: this box.toml with the parameters' ``values`` {name: SI} written into their targets

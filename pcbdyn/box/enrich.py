@@ -11,14 +11,11 @@ value (SI), at (x, y, z) [m] and plate.
 from __future__ import annotations
 
 import re
-from pathlib import Path
 
 import numpy as np
 import tomlkit
 
 from .. import targets
-from ..atomic import write_checked
-from .box import load_box
 from .entries import BoxError
 
 
@@ -57,9 +54,3 @@ def enriched_text(box, text: str, effects) -> str:
                                     f"{np.round(np.asarray(e['at']) * 1e3, 2).tolist()} mm on plate {plate.name}; "
                                     "a box has no entry for it: model it by hand"))
     return tomlkit.dumps(doc)
-
-
-def write_enriched(box, effects, dst) -> Path:
-    """``dst``: box.toml of ``box`` with ``effects`` declared, written atomically once it loads."""
-    text = enriched_text(box, Path(box.path).read_text(encoding="utf-8"), effects)
-    return write_checked(dst, text, load_box, BoxError)

@@ -14,65 +14,14 @@ when that child fails, matplotlib draws the 3-D view too. The page itself is mat
 
 from __future__ import annotations
 
-import json
-import os
-import subprocess
-import sys
 import tempfile
 from pathlib import Path
 
 import numpy as np
 
 from .files import atomic_path
-
-CMAP = "coolwarm"
-QUANTITY = "w (normalised)"
-#: how each kind of outline is drawn in the top view: colour, line width, marker, legend label
-STYLE = {
-    "board": ("black", 1.2, "o", None),
-    "part": ("#1b7837", 1.2, "s", "parts"),
-    "fixture": ("#7b3294", 2.4, "^", "fixtures"),
-    "mass": ("black", 1.0, "X", "masses"),
-    "line mass": ("#555555", 2.0, "o", "line masses"),
-    "stiffener": ("#b35806", 2.4, "o", "stiffeners"),
-    "region": ("#555555", 1.0, "o", "regions"),
-}
-_OTHER = ("#555555", 1.0, "o", None)
-
-
-def picture_names(prefix: str, n_modes: int) -> list:
-    """File names of the pictures of ``n_modes`` modes: ``<prefix>_01.png``, ..."""
-    return [f"{prefix}_{k + 1:02d}.png" for k in range(n_modes)]
-
-
-def render_pyvista(vtu: Path, out_dir: Path, names: list, quantity: str = "w") -> None:
-    """Render the 3-D view of each mode of ``vtu`` (arrays mode_<k>, max |w| = 1), warped and
-    coloured by w on [-1, 1] (``quantity`` "magnitude": a structure in 3-D, max |u| = 1, coloured by
-    |u| on [0, 1]), to ``out_dir/names[k]`` (run in a child process)."""
-    os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
-    import pyvista as pv
-
-    grid = pv.read(str(vtu))
-    grid.points = grid.points * 1e3  # mm, as the top view
-    flat = quantity == "w"
-    span = float(np.ptp(grid.points[:, :2] if flat else grid.points, axis=0).max())
-    for k, name in enumerate(names, start=1):
-        g = grid.copy()
-        u = g.point_data[f"mode_{k}"]
-        g.point_data["w"] = u[:, 2] if flat else np.linalg.norm(u, axis=1)
-        warped = g.warp_by_vector(f"mode_{k}", factor=(0.15 if flat else 0.08) * span)
-        p = pv.Plotter(off_screen=True, window_size=(700, 560))
-        p.set_background("white")
-        p.add_mesh(warped, scalars="w", cmap=CMAP, clim=(-1.0, 1.0) if flat else (0.0, 1.0), show_edges=True,
-                   edge_color="gray", line_width=0.4 if flat else 1.5, show_scalar_bar=False)
-        p.add_mesh(g.extract_feature_edges(boundary_edges=True, feature_edges=False, manifold_edges=False),
-                   color="gray", line_width=1.0)  # the board at rest, for scale
-        p.view_isometric()
-        p.add_axes(color="black", xlabel="x", ylabel="y", zlabel="z")
-        with atomic_path(Path(out_dir) / name) as tmp:
-            p.screenshot(str(tmp))
-        p.close()
-
+from .pictures3d import mode_pictures_3d
+from .rendering import CMAP, OTHER, QUANTITY, STYLE, picture_names, render_child, trim
 
 def _view3d_matplotlib(fig, slot, tri, w):
     ax = fig.add_subplot(slot, projection="3d")
@@ -87,7 +36,7 @@ def _view3d_matplotlib(fig, slot, tri, w):
 
 
 def _outline(ax, item, seen: set) -> None:
-    color, width, marker, legend = STYLE.get(item["kind"], _OTHER)
+    color, width, marker, legend = STYLE.get(item["kind"], OTHER)
     xy = np.asarray(item["xy"], dtype=float).reshape(-1, 2) * 1e3
     label = legend if legend not in seen else None
     seen.add(legend)
@@ -100,17 +49,6 @@ def _outline(ax, item, seen: set) -> None:
         anchor = xy.mean(axis=0) if item.get("closed") else 0.5 * (xy[0] + xy[-1])
     if item.get("label"):
         ax.annotate(item["label"], anchor, xytext=(3, 3), textcoords="offset points", fontsize=7, color=color)
-
-
-def _trim(image, pad: int = 8):
-    """The image without its white margins (kept ``pad`` pixels wide)."""
-    ink = np.any(np.asarray(image)[..., :3] < 0.98, axis=2)
-    rows, cols = np.flatnonzero(ink.any(axis=1)), np.flatnonzero(ink.any(axis=0))
-    if rows.size == 0:
-        return image
-    r0, r1 = max(rows[0] - pad, 0), rows[-1] + pad + 1
-    c0, c1 = max(cols[0] - pad, 0), cols[-1] + pad + 1
-    return image[r0:r1, c0:c1]
 
 
 def mode_figure(tri, w, outlines, title: str, view3d=None):
@@ -126,7 +64,7 @@ def mode_figure(tri, w, outlines, title: str, view3d=None):
         _view3d_matplotlib(fig, grid[0, 0], tri, w)
     else:
         ax3 = fig.add_subplot(grid[0, 0])
-        ax3.imshow(_trim(view3d))
+        ax3.imshow(trim(view3d))
         ax3.set_axis_off()
     ax = fig.add_subplot(grid[0, 1])
     levels = np.linspace(-1.0, 1.0, 21)
@@ -158,8 +96,6 @@ def mode_pictures(vtu: Path, model, frequencies, shapes, out_dir: Path, prefix: 
     and configuration. Returns the 3-D renderer used ("pyvista" or "matplotlib"). A structure in 3-D
     (outlines in ``xyz``, or nodes off one plane z = const) gets :mod:`.pictures3d`'s pictures."""
     if is_3d(model, outlines):
-        from .pictures3d import mode_pictures_3d
-
         return mode_pictures_3d(vtu, model, frequencies, shapes, out_dir, prefix, title, outlines)
     import matplotlib
 
@@ -174,7 +110,7 @@ def mode_pictures(vtu: Path, model, frequencies, shapes, out_dir: Path, prefix: 
     tris += [c[:, [0, 2, 3]] for c in cells if c.shape[1] == 4]
     tri = Triangulation(model.nodes[:, 0] * 1e3, model.nodes[:, 1] * 1e3, np.concatenate(tris))
     with tempfile.TemporaryDirectory(prefix="pcbdyn-views-") as views:
-        renderer = "pyvista" if _render_child(vtu, Path(views), names) else "matplotlib"
+        renderer = "pyvista" if render_child(vtu, Path(views), names) else "matplotlib"
         for k, (name, f) in enumerate(zip(names, frequencies)):
             w = shapes[2::6, k]
             w = w / (np.max(np.abs(w)) or 1.0)
@@ -187,15 +123,3 @@ def mode_pictures(vtu: Path, model, frequencies, shapes, out_dir: Path, prefix: 
     return renderer
 
 
-def _render_child(vtu: Path, folder: Path, names: list, quantity: str = "w") -> bool:
-    """Run :func:`render_pyvista` in a child process; True when every view was written."""
-    code = ("import sys, json; from pathlib import Path; from pcbdyn.report.pictures import render_pyvista; "
-            "a = json.loads(sys.argv[1]); render_pyvista(Path(a[0]), Path(a[1]), a[2], a[3])")
-    env = {**os.environ, "VTK_DEFAULT_OPENGL_WINDOW": os.environ.get("VTK_DEFAULT_OPENGL_WINDOW",
-                                                                       "vtkEGLRenderWindow")}
-    try:
-        res = subprocess.run([sys.executable, "-c", code, json.dumps([str(vtu), str(folder), names, quantity])],
-                             env=env, capture_output=True, timeout=600)
-    except subprocess.TimeoutExpired:
-        return False
-    return res.returncode == 0 and all((folder / n).is_file() for n in names)

@@ -4,7 +4,7 @@ from the opposite side (into an open front), coloured by the magnitude of the di
 max |u| = 1, with one colour bar "|u| (normalised)". Ribs (beams) are drawn as lines; the outlines the
 structure gives (plain data ``{"kind", "label", "xyz": [[x, y, z], ...] in metres, "closed"}``) label
 its plates, ribs, supported edges and masses. The first view is rendered by pyvista from the VTU in a
-child process (:func:`pcbdyn.report.pictures.render_pyvista`), with matplotlib in its place when that
+child process (:func:`pcbdyn.report.rendering.render_pyvista`), with matplotlib in its place when that
 fails; the second is matplotlib's. Formatting only."""
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from .files import atomic_path
-from .pictures import CMAP, STYLE, _OTHER, _render_child, _trim, picture_names
+from .rendering import CMAP, OTHER, STYLE, picture_names, render_child, trim
 
 QUANTITY_3D = "|u| (normalised)"
 #: warp of the pictures: max |u| drawn as this fraction of the structure's largest extent
@@ -48,7 +48,7 @@ def _view(fig, slot, model, shape, mag, outlines, azim: float, title: str):
         elif es.etype == "beam2":
             ax.add_collection3d(Line3DCollection(moved[es.conn], colors="k", linewidths=1.2))
     for item in outlines:
-        color, _, marker, _ = STYLE.get(item["kind"], _OTHER)
+        color, _, marker, _ = STYLE.get(item["kind"], OTHER)
         pts = np.asarray(item.get("xyz", []), float).reshape(-1, 3) * 1e3
         if len(pts) == 1:
             ax.plot(*pts.T, marker=marker, color=color, markersize=6, linestyle="none")
@@ -76,7 +76,7 @@ def mode_figure_3d(model, shape, mag, outlines, title: str, view3d=None):
         _view(fig, grid[0, 0], model, shape, mag, outlines, 45.0, "from the back, right, above")
     else:
         ax = fig.add_subplot(grid[0, 0])
-        ax.imshow(_trim(view3d))
+        ax.imshow(trim(view3d))
         ax.set_axis_off()
         ax.set_title("from the back, right, above", fontsize=9)
     _view(fig, grid[0, 1], model, shape, mag, outlines, -135.0, "from the front, left, above")
@@ -98,7 +98,7 @@ def mode_pictures_3d(vtu: Path, model, frequencies, shapes, out_dir: Path, prefi
     names = picture_names(prefix, len(frequencies))
     mag = magnitudes(model, shapes)
     with tempfile.TemporaryDirectory(prefix="pcbdyn-views-") as views:
-        renderer = "pyvista" if _render_child(vtu, Path(views), names, "magnitude") else "matplotlib"
+        renderer = "pyvista" if render_child(vtu, Path(views), names, "magnitude") else "matplotlib"
         for k, (name, f) in enumerate(zip(names, frequencies)):
             view = plt.imread(Path(views) / name) if renderer == "pyvista" else None
             head = f"{title}: mode {k + 1}, {f:.1f} Hz" if title else f"mode {k + 1}, {f:.1f} Hz"

@@ -71,7 +71,7 @@ def test_a_smaller_rerun_leaves_no_stale_files_and_keeps_the_users(tmp_path, mon
 
     calls = []
     real = pictures.mode_pictures
-    monkeypatch.setattr(pictures, "_render_child", lambda *args: False)  # matplotlib 3-D views: quicker
+    monkeypatch.setattr(pictures, "render_child", lambda *args: False)  # matplotlib 3-D views: quicker
     monkeypatch.setattr(pictures, "mode_pictures", lambda *a, **k: calls.append(k) or real(*a, **k))
     board = write_board(tmp_path, PLATE)
     out = tmp_path / "out"

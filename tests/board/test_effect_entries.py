@@ -20,7 +20,7 @@ import pytest
 from pcbdyn import diagnosis as dg
 from pcbdyn.board import BoardError, build_model, load_board
 from pcbdyn.board.effects import ScaledShell, rib_property
-from pcbdyn.board.enrich import enriched_path, write_enriched
+from pcbdyn.board.enrich import enriched_path
 from pcbdyn.diagnosis.catalogue import Candidate, chain_candidate, copy_model
 from pcbdyn.fe.elements import kernel
 from pcbdyn.fe.modal import solve_modes
@@ -44,6 +44,11 @@ CASES = {
     "stiffener": (5.0, (0.05, 0.04)),
     "region_stiffness": (0.5, (0.05, 0.05)),
 }
+
+
+def write_enriched(path, effects, out_path=None, date=None):
+    """The board at ``path`` with ``effects`` declared, written to ``out_path`` (default beside it)."""
+    return load_board(path).write_enriched(effects, out_path or enriched_path(path), date)
 
 
 def freqs(model):

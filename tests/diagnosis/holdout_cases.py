@@ -28,7 +28,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import bench_cases as bc  # noqa: E402
-from bench_cases import C23, CARD_TRUE, LOOSE, Case, Effect  # noqa: E402
+from bench_cases import C23, LOOSE, Case, Effect  # noqa: E402
 
 HERE = Path(__file__).resolve().parent / "holdout"
 TRUTH_MESH = bc.MODEL_MESH / 4.0
