@@ -30,7 +30,8 @@ from ..fe.assembly import assemble
 from ..fe.modal import solve_modes
 from ..testdata import Modes
 from ..updating.sensitivity import bilinear_forms, eigen_derivatives
-from .catalogue import derivatives, effect_forms
+from .catalogue import effect_forms
+from .combined import Effects
 
 
 @dataclass
@@ -149,15 +150,20 @@ class ModalResidual:
     def of_models(cls, models, observations) -> "ModalResidual":
         """The residual of ``observations`` against a structure's configuration models as functions of
         its declared parameters (:class:`pcbdyn.problems.StructureModels`)."""
-        return cls(observations, models.build, models.derivatives if models.names else None, len(models.names))
+        return cls(observations, models.build, models.derivatives if models.names else None, len(models.names),
+                   models.matrices)
 
-    def __init__(self, observations, build, derivatives=None, n_params: int = 0):
+    def __init__(self, observations, build, derivatives=None, n_params: int = 0, matrices=None):
+        """``matrices(p)``: per observation, its model's (K, M) at ``p`` (default: assembled from
+        ``build(p)``)."""
         self.observations = list(observations)
         self.build = build
         self.derivatives = derivatives
         self.n_params = n_params
+        self.matrices = matrices
         self.n_rows = sum(o.n_rows for o in self.observations)
-        self._at = (None, None, {})  # last p, its [(model, K, M)], {(config, candidate): (dK, dM)}
+        self.effects = Effects()
+        self._at = (None, None)  # last p, its [(model, K, M)]
 
     def row_groups(self) -> tuple:
         """(configuration index, mode index) of every row: the blocks cross-validation leaves out."""
@@ -172,23 +178,20 @@ class ModalResidual:
     # --- states ----------------------------------------------------------------------------
     def _assembled(self, p):
         if self._at[0] is None or not np.array_equal(self._at[0], p):
-            self._at = (p.copy(), [(m, *assemble(m)) for m in self.build(p)], {})
-        return self._at[1], self._at[2]
+            models = self.build(p)
+            mats = self.matrices(p) if self.matrices is not None else [assemble(m) for m in models]
+            self._at = (p.copy(), [(m, *km) for m, km in zip(models, mats)])
+        return self._at[1]
 
     def evaluate(self, p, candidates=(), values=()) -> State:
         """Full re-solve of every configuration at parameters ``p`` with the effects. The effects
         enter K and M linearly, so their exact derivative matrices are added to the model's
-        (assembled once per p); the configuration states keep the model without them."""
+        (made once per p, on one pattern per set of effects: :class:`.combined.Effects`); the
+        configuration states keep the model without them."""
         p = np.asarray(p, float)
         st = State(p, list(candidates), np.asarray(values, float))
-        models, cache = self._assembled(p)
-        for k, (ob, (model, K, M)) in enumerate(zip(self.observations, models)):
-            for c, v in zip(candidates, st.values):
-                if v != 0.0:
-                    if (k, c.name) not in cache:
-                        cache[k, c.name] = derivatives(model, c)
-                    dK, dM = cache[k, c.name]
-                    K, M = K + v * dK, M + v * dM
+        for k, (ob, (model, K, M)) in enumerate(zip(self.observations, self._assembled(p))):
+            K, M = self.effects.combine(k, model, K, M, p, candidates, st.values)
             st.configs.append(self._config(ob, model, K, M))
         return st
 
@@ -255,7 +258,7 @@ class ModalResidual:
         out = []
         for ob, cs in zip(self.observations, st.configs):
             basis, paired = self._basis(cs)
-            BK, BM = effect_forms(cs.model, basis, paired, candidates)
+            BK, BM = effect_forms(cs.model, basis, paired, candidates, self.effects.blocks)
             out.append(self._columns(ob, cs, BK, BM))
         return np.vstack(out)
 
