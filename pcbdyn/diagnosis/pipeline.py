@@ -45,7 +45,9 @@ from .catalogue import KINDS, add_effect, generate, kind, place, weighted_centre
 from .layout import from_structure
 from .model_form import MESH_LEVELS, discretisation, fit_plate_share, kirchhoff_shift
 from .residual import ModalResidual, Observation
-from .select import ALPHA, adopt, estimate, penalty, refine, search, without_vanished
+from .fitting import estimate
+from .scan import Runner
+from .select import ALPHA, adopt, penalty, refine, search, without_vanished
 
 #: kinds whose effects :func:`_with_masses` carries onto the finer meshes
 MASS_KINDS = ("point_mass", "point_inertia", "line_mass")
@@ -190,10 +192,14 @@ def _range_test(res, base, n_params, alpha) -> dict:
 
 
 def diagnose(structure, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_size=None, kinds=None,
-             max_effects: int = 3, alpha: float = ALPHA, progress=None) -> Diagnosis:
+             max_effects: int = 3, alpha: float = ALPHA, progress=None, workers: int | None = 1,
+             scheduler=None) -> Diagnosis:
     """Diagnose ``structure`` (a board, or any structure of :mod:`pcbdyn.domain`) against ``tests`` =
-    [(configuration name or None, :class:`pcbdyn.testdata.Modes`)]."""
+    [(configuration name or None, :class:`pcbdyn.testdata.Modes`)]. ``workers`` local processes (None:
+    the cores) or the Dask cluster at ``scheduler`` run the independent fits of the candidate scans
+    (:mod:`.scan`); the results do not depend on where they ran."""
     say = progress or (lambda msg: None)
+    runner = Runner(workers, scheduler, lambda msg: say(f"  {msg}"))
     h = mesh_size or structure.mesh_size
     say("building the models")
     models = StructureModels(structure, [c for c, _ in tests], mesh_size=h, shared_mesh=True)
@@ -234,10 +240,11 @@ def diagnose(structure, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_s
     layout = from_structure(models.models[0])
     cands = generate(layout, kinds, **options)
     say(f"searching {len(cands)} candidate effects")
-    sel = search(res, cands, p0, models.bounds, max_effects=max_effects, shortlist=2, alpha=alpha, base=base)
+    sel = search(res, cands, p0, models.bounds, max_effects=max_effects, shortlist=2, alpha=alpha, base=base,
+                 runner=runner)
     if any(_movable(cands[i]) for i in sel.chosen):
         say("refining where the effects along the sides begin and end, where stiffeners run and what regions cover")
-        sel = refine(res, cands, sel, LocalMoves(layout, cands, h), models.bounds, alpha=alpha)
+        sel = refine(res, cands, sel, LocalMoves(layout, cands, h), models.bounds, alpha=alpha, runner=runner)
     if {"point_mass", "point_inertia"} <= {cands[i].kind for i in sel.chosen}:
         say("fitting a part found as a mass with an inertia beside it as one body")
         sel = as_bodies(res, cands, sel, _neighbours([cands[i] for i in sel.chosen], MERGE_REACH * h),
