@@ -24,6 +24,9 @@ from .fitting import RANK_STEPS, Fit, estimate
 
 #: the quick fits' best this many are fitted again with full re-solves
 FULL_RANK = 3
+#: a quick fit's chi^2 is trusted to this share of the solved state's (a reanalysis is first order
+#: in the parameters; measured within 0.1 % on the bench's kinds but ribs)
+SCREEN_MARGIN = 0.05
 
 
 @dataclass
@@ -66,6 +69,26 @@ def _followed(state, cands) -> bool:
     return all(getattr(kind(c.kind), "reanalysed", True) for c in changed)
 
 
+def worth_full(res, state, trials: list, p, bounds, limit: float, steps: int = RANK_STEPS) -> list:
+    """For each of ``trials`` = [(candidates, initial magnitudes)] from the solved ``state``: False
+    where its quick fit on the state's reanalysis leaves chi^2 above ``limit`` by more than the
+    reanalysis can be off (:data:`SCREEN_MARGIN` of the state's chi^2), so that no full fit could
+    reach it; True otherwise (and for the trials a reanalysis cannot follow). ``steps``: Gauss-Newton
+    steps of the quick fits (as many as the full fits they stand for, so that only the reanalysis
+    differs)."""
+    rx = P = None
+    out = []
+    for cands, v0 in trials:
+        if not _followed(state, cands):
+            out.append(True)
+            continue
+        if rx is None:  # the parameters' columns are held: a reanalysed state has no full modes
+            rx, P = Reanalysis(res, state), res.param_columns(state)
+        quick = estimate(res, p, cands, v0, steps, bounds, param_columns=P, reduced=rx)
+        out.append(bool(quick.chi2 <= limit + SCREEN_MARGIN * state.chi2))
+    return out
+
+
 def rank(res, state, trials: list, p, bounds, P, runner: Runner | None = None) -> list:
     """Fits of ``trials`` = [(candidates, initial magnitudes)] from the solved ``state`` (declared
     parameters from ``p``, their columns ``P`` held): a :class:`.select.Fit` with full re-solves
@@ -78,6 +101,8 @@ def rank(res, state, trials: list, p, bounds, P, runner: Runner | None = None) -
         chi2 = [estimate(res, p, trials[k][0], trials[k][1], RANK_STEPS, bounds, param_columns=P, reduced=rx).chi2
                 for k in quick]
         quick = [quick[i] for i in np.argsort(chi2, kind="stable")[:FULL_RANK]]
+        if runner.progress is not None:
+            runner.progress(f"{len(chi2)} of {len(trials)} trials screened on the reanalysis")
     chosen = sorted(quick + full)
     done = runner.map(_full_fit, [(trials[k][0], trials[k][1], p) for k in chosen], (res, bounds, P), "trial fits")
     out: list = [None] * len(trials)

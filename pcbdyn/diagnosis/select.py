@@ -30,7 +30,7 @@ import numpy as np
 from scipy.stats import chi2 as chi2_dist
 
 from .fitting import RANK_STEPS, UPPER, Fit, estimate  # noqa: F401  (re-exported)
-from .scan import Runner, rank
+from .scan import Runner, rank, worth_full
 
 #: probability that noise alone makes one of the candidates look like an effect (family-wise)
 ALPHA = 0.01
@@ -235,12 +235,17 @@ def _shortlist(gain, kinds, per_kind: int) -> np.ndarray:
 
 def _prune(res, candidates, idx, fit, steps, bounds, pen, n_params):
     """Backward check after each addition: drop an earlier effect whenever the others, re-estimated
-    without it, reach a lower criterion (greedy choices made before the right effect was in)."""
+    without it, reach a lower criterion (greedy choices made before the right effect was in); the
+    drops a quick fit shows to be far worse are not re-estimated (:func:`.scan.worth_full`)."""
     while len(idx) > 1:
         best = None
-        for drop in range(len(idx) - 1):
-            keep = [i for t, i in enumerate(idx) if t != drop]
-            trial = estimate(res, fit.p, [candidates[i] for i in keep], np.delete(fit.values, drop), steps, bounds)
+        keeps = [[i for t, i in enumerate(idx) if t != drop] for drop in range(len(idx) - 1)]
+        trials = [([candidates[i] for i in keep], np.delete(fit.values, drop)) for drop, keep in enumerate(keeps)]
+        for drop, (keep, full) in enumerate(zip(keeps, worth_full(res, fit.state, trials, fit.p, bounds,
+                                                                   fit.chi2 + pen, steps))):
+            if not full:
+                continue
+            trial = estimate(res, fit.p, trials[drop][0], trials[drop][1], steps, bounds)
             if trial.chi2 + len(keep) * pen < fit.chi2 + len(idx) * pen and (best is None or trial.chi2 < best[1].chi2):
                 best = (keep, trial)
         if best is None:
