@@ -233,7 +233,7 @@ def diagnose(structure, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_s
     before = res.evaluate(p0)
     say(f"fitting the {len(names)} declared parameter(s)" if names else "no declared parameters")
     base = estimate(res, p0, [], [], 10, models.bounds)
-    stats = {"unpaired_test_modes": unmatched, "chi2_before": before.chi2, **_range_test(res, base, len(names), alpha),
+    stats = {"quick": quick, "unpaired_test_modes": unmatched, "chi2_before": before.chi2, **_range_test(res, base, len(names), alpha),
              "mesh_correction_pct": [np.round(100 * (o.f_scale - 1.0), 4).tolist() for o in obs],
              "mesh_resolved": [f.resolved for f in forms],
              "plate_theory_pct": [np.round(100 * f.shift, 4).tolist() for f in forms],
@@ -255,8 +255,8 @@ def diagnose(structure, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_s
     layout = from_structure(models.models[0])
     cands = generate(layout, kinds, **options)
     say(f"searching {len(cands)} candidate effects")
-    sel = search(res, cands, p0, models.bounds, max_effects=max_effects, shortlist=1 if quick else 2, alpha=alpha, base=base,
-                 runner=runner)
+    sel = search(res, cands, p0, models.bounds, max_effects=max_effects, shortlist=1 if quick else 2, alpha=alpha,
+                 base=base, runner=runner)
     if any(_movable(cands[i]) for i in sel.chosen):
         say("refining where the effects along the sides begin and end, where stiffeners run and what regions cover")
         sel = refine(res, cands, sel, LocalMoves(layout, cands, h), models.bounds, alpha=alpha, runner=runner)
