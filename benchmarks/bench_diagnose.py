@@ -15,6 +15,8 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
+import resource
 import sys
 import time
 from pathlib import Path
@@ -45,10 +47,11 @@ def one(case, out: Path) -> dict:
     js.unlink(missing_ok=True)
     args = ["diagnose", str(board), *bc.cli_tests(case, uffs), "--noise", f"f={case.noise[0]:g},shape={case.noise[1]:g}",
             "--out", str(out / case.name / "diagnose"), "--json", str(js)]
-    t0 = time.perf_counter()
+    load0, c0, t0 = os.getloadavg()[0], cpu_seconds(), time.perf_counter()
     r = CliRunner().invoke(main, args)
-    t = time.perf_counter() - t0
-    row = {"case": case.name, "make_s": t_make, "diagnose_s": t, "exit_code": r.exit_code}
+    t, cpu = time.perf_counter() - t0, cpu_seconds() - c0
+    row = {"case": case.name, "make_s": t_make, "diagnose_s": t, "cpu_s": cpu,
+           "load": round(0.5 * (load0 + os.getloadavg()[0]), 2), "exit_code": r.exit_code}
     if r.exit_code != 0 or not js.exists():
         last = (r.output.strip().splitlines() or [repr(r.exception)])[-1]
         return {**row, "outcome": "ERROR", "why": last[:200]}
@@ -66,6 +69,12 @@ def one(case, out: Path) -> dict:
             "after_pct": data.get("after", {}).get("max_freq_error_pct")}
 
 
+def cpu_seconds() -> float:
+    """CPU seconds of this process and of its finished children (worker processes of a scan)."""
+    own, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
+
+
 def fmt(x) -> str:
     return f"{x:.2f}" if isinstance(x, (int, float)) else "-"
 
@@ -81,12 +90,12 @@ def main(argv=None):
     if unknown:
         ap.error(f"unknown case(s) {unknown}; known: {', '.join(CASES)}")
     out = Path(a.out)
-    print(f"{'case':<26} {'diag [s]':>8} {'before%':>8} {'param%':>7} {'after%':>7} {'#eff':>4}  outcome")
+    print(f"{'case':<26} {'diag [s]':>8} {'cpu [s]':>7} {'load':>5} {'before%':>8} {'param%':>7} {'after%':>7} {'#eff':>4}  outcome")
     rows = []
     for n in names:
         r = one(CASES[n], out)
         rows.append(r)
-        print(f"{n:<26} {r['diagnose_s']:>8.1f} {fmt(r.get('before_pct')):>8} {fmt(r.get('params_only_pct')):>7} "
+        print(f"{n:<26} {r['diagnose_s']:>8.1f} {r['cpu_s']:>7.1f} {r['load']:>5.2f} {fmt(r.get('before_pct')):>8} {fmt(r.get('params_only_pct')):>7} "
               f"{fmt(r.get('after_pct')):>7} {r.get('n_effects', '-'):>4}  {r['outcome']}"
               f"{'  ' + ', '.join(r.get('found', [])) if r.get('found') else ''}{'  ' + r['why'] if r['why'] else ''}",
               flush=True)

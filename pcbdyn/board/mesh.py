@@ -11,7 +11,9 @@ split into quads (gmsh's all-quad subdivision), so the result is always all-quad
 
 from __future__ import annotations
 
+import hashlib
 import threading
+from collections import OrderedDict
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 
@@ -148,6 +150,20 @@ def _polyline(occ, v):
     return [occ.addLine(pts[i], pts[i + 1]) for i in range(len(pts) - 1)]
 
 
+#: meshes kept by their inputs (least recently used dropped first): the configurations of one
+#: board meshed alike (``shared_mesh``) are one mesh, made once per size
+MESHES_KEPT = 8
+_meshes: OrderedDict = OrderedDict()
+
+
+def _mesh_key(outline, regions, points, size, strips, lines) -> bytes:
+    h = hashlib.blake2b(digest_size=16)
+    h.update(repr([len(outline.holes), [label for label, _ in regions], len(strips), len(lines)]).encode())
+    for a in [outline.vertices, *outline.holes, *(p for _, p in regions), points, [size], *strips, *lines]:
+        h.update(np.ascontiguousarray(np.asarray(a, dtype=float)).tobytes() + b"|")
+    return h.digest()
+
+
 def mesh_board(outline, regions, points, size: float, strips=(), lines=()) -> BoardMesh:
     """Mesh ``outline`` (vertices + holes) with element size ``size`` [m].
 
@@ -155,9 +171,22 @@ def mesh_board(outline, regions, points, size: float, strips=(), lines=()) -> Bo
     regions overlap); ``strips``: polygons whose outlines element edges follow but whose elements
     stay on the board; ``lines``: open polylines (m, 2) lying on the board that element edges
     follow (edge springs, line masses, stiffeners); ``points``: (k, 2) points that become nodes.
-    Elements outside every region are labelled "board".
+    Elements outside every region are labelled "board". The same inputs give a copy of the mesh
+    made before (:data:`MESHES_KEPT`).
     """
     points = np.asarray(points, dtype=float).reshape(-1, 2)
+    key = _mesh_key(outline, regions, points, size, strips, lines)
+    if key not in _meshes:
+        _meshes[key] = _mesh_board(outline, regions, points, size, strips, lines)
+        while len(_meshes) > MESHES_KEPT:
+            _meshes.popitem(last=False)
+    _meshes.move_to_end(key)
+    m = _meshes[key]
+    return BoardMesh(m.nodes.copy(), {k: {e: c.copy() for e, c in v.items()} for k, v in m.cells.items()},
+                     m.point_nodes.copy())
+
+
+def _mesh_board(outline, regions, points, size: float, strips=(), lines=()) -> BoardMesh:
     with gmsh_session("board") as gmsh:
         occ = gmsh.model.occ
         board = _polygon(occ, outline.vertices)

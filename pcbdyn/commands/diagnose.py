@@ -28,11 +28,19 @@ from .common import done, folder_outputs, input_errors, library_option, measured
 @click.option("--kinds", default=None, help=f"comma-separated catalogue kinds to search (default: all): {', '.join(KINDS)}")
 @click.option("--max-effects", type=click.IntRange(min=1), default=3, show_default=True)
 @click.option("--mesh-size", default=None, help="element size, e.g. '5 mm' (default: the board's)")
+@click.option("--quick", is_flag=True,
+              help="a first look at a fraction of the cost: the mesh correction from one finer mesh (twice as fine) "
+                   "instead of two, candidates on a grid half as fine (still walked to place), one trial fit per kind "
+                   "in each scan instead of two, and the masses found not carried onto the finer meshes")
+@click.option("--scheduler", default=None,
+              help="a Dask scheduler address (tcp://host:8786): the trial fits of the candidate scans run on that "
+                   "cluster (the findings do not depend on where they run)")
 @folder_outputs("folder for the board with the effects declared, the evidence map and tables",
                 "write effects, before/after and statistics as JSON",
                 force="replace an earlier <board>.diagnosed.toml beside the board (default: a numbered name)")
 @library_option()
-def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size, out, force, json_path):
+def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size, quick, scheduler, out, force,
+            json_path):
     """Find the effects a board model lacks from modal tests: TEST_UFF (with mode shapes) of the base
     configuration and NAME=FILE for each perturbed configuration of board.toml (e.g. c2=test2.uff)."""
     from ..diagnosis.pipeline import diagnose
@@ -55,7 +63,7 @@ def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size,
         ms = to_si(mesh_size, "mm", "--mesh-size") if mesh_size else None
         t0 = step("diagnosing")
         d = diagnose(board, tests, freq_pct, shape_pct, mesh_size=ms, kinds=chosen, max_effects=max_effects,
-                     progress=lambda msg: click.echo(f"    {msg}", err=True))
+                     progress=lambda msg: click.echo(f"    {msg}", err=True), quick=quick, scheduler=scheduler)
         done(t0)
     click.echo(f"\n{board.name}: {d.message}\n")
     click.echo(rep.format_effects(d.effects))

@@ -19,7 +19,8 @@ from dataclasses import replace
 import numpy as np
 
 from .catalogue import weighted_centre
-from .select import ALPHA, RANK_STEPS, adopt, estimate, penalty
+from .fitting import RANK_STEPS, estimate
+from .select import ALPHA, adopt, penalty
 
 #: fixed-point iterations on the radius of gyration, and the relative change that ends them
 RADIUS_ITERATIONS, RADIUS_TOL = 5, 0.02

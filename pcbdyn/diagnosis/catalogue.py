@@ -10,7 +10,9 @@ plugin module of this package that registers an object (:func:`register`, into :
   ``options`` (names ``generate`` accepts);
 - ``generate(layout, **options) -> [Candidate]``: candidates on a mesh (:mod:`.layout`);
 - ``blocks(model, candidates) -> [Blocks]``: element matrices of dK/dp and dM/dp of all the
-  candidates at once, vectorised over cells;
+  candidates at once, vectorised over cells; ``uses_properties`` (optional, False by default): True
+  when they depend on the model's element properties, not only on its mesh (a region's own
+  stiffness), so that they cannot be kept from one parameter value to the next (:class:`BlockCache`);
 - ``apply(model, candidate, value) -> Model``: a copy of the model carrying the effect;
 - ``place(layout, candidate) -> Candidate``: the same effect (place and extent) on another
   mesh's layout (a finer mesh, as a test bench's truth model is).
@@ -24,6 +26,7 @@ A new kind of effect is one new module plus its import in :mod:`pcbdyn.diagnosis
 
 from __future__ import annotations
 
+from collections import OrderedDict
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -121,11 +124,39 @@ def _by_kind(candidates):
     return groups
 
 
-def derivatives(model, candidate):
-    """(dK/dp, dM/dp) of one candidate as full-size CSR matrices (before constraints); exact."""
+class BlockCache:
+    """Candidates' element blocks kept by (kind, candidate names) for the kinds that depend on the
+    mesh only (not ``uses_properties``): every fit of a diagnosis asks for the same candidates on
+    the same mesh again (a stiffener's embedded beam pieces, an inertia's footprint). At most
+    ``size`` groups are kept, the least recently used dropped first."""
+
+    def __init__(self, size: int = 64):
+        self.size, self._kept = size, OrderedDict()
+
+    def __call__(self, model, name: str, cands) -> list:
+        spec = kind(name)
+        if getattr(spec, "uses_properties", False):
+            return spec.blocks(model, cands)
+        key = (name, tuple(c.name for c in cands))
+        if key in self._kept:
+            self._kept.move_to_end(key)
+        else:
+            self._kept[key] = spec.blocks(model, cands)
+            while len(self._kept) > self.size:
+                self._kept.popitem(last=False)
+        return self._kept[key]
+
+
+def _blocks(model, name, cands, cache=None) -> list:
+    return cache(model, name, cands) if cache is not None else kind(name).blocks(model, cands)
+
+
+def derivatives(model, candidate, cache: BlockCache | None = None):
+    """(dK/dp, dM/dp) of one candidate as full-size CSR matrices (before constraints); exact.
+    ``cache``: a :class:`BlockCache` to take its element blocks from."""
     n = model.n_dof
     K, M = sp.csr_matrix((n, n)), sp.csr_matrix((n, n))
-    for b in candidate.spec.blocks(model, [candidate]):
+    for b in _blocks(model, candidate.kind, [candidate], cache):
         K = K + scatter(n, b.conn, b.Ke)
         M = M + scatter(n, b.conn, b.Me)
     return K, M
@@ -143,15 +174,16 @@ def place(layout, candidate) -> Candidate:
     return replace(candidate.spec.place(layout, candidate), name=candidate.name, prime=candidate.prime)
 
 
-def effect_forms(model, basis: np.ndarray, shapes: np.ndarray, candidates):
+def effect_forms(model, basis: np.ndarray, shapes: np.ndarray, candidates, cache: BlockCache | None = None):
     """(BK, BM), each (n_candidates, n_basis, n_shapes): phi_k^T dK/dp phi_i and phi_k^T dM/dp phi_i
     for full-length ``basis`` columns k and ``shapes`` columns i, summed over each candidate's
-    cells (the terms of the eigenvalue and eigenvector derivatives, thesis eqs. 3.6 and 3.11)."""
+    cells (the terms of the eigenvalue and eigenvector derivatives, thesis eqs. 3.6 and 3.11).
+    ``cache``: a :class:`BlockCache` to take the element blocks from."""
     BK = np.zeros((len(candidates), basis.shape[1], shapes.shape[1]))
     BM = np.zeros_like(BK)
     for name, idx in _by_kind(candidates).items():
         cands = [candidates[i] for i in idx]
-        for b in kind(name).blocks(model, cands):
+        for b in _blocks(model, name, cands, cache):
             dofs = element_dofs(b.conn)
             pb, ps = basis[dofs], shapes[dofs]  # (n_cells, nd, n_basis), (n_cells, nd, n_shapes)
             S = sp.csr_matrix((np.ones(b.owner.size), (b.owner, np.arange(b.owner.size))),

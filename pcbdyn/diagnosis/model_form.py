@@ -15,7 +15,8 @@ from ..fe.modal import solve_modes
 from ..fe.probe import model_probe
 from ..updating.solvers import covariance
 from .residual import paired_mac
-from .select import ALPHA, adopt, estimate, penalty, worth
+from .fitting import estimate
+from .select import ALPHA, adopt, penalty, worth
 
 #: a mode is resolved by the model's mesh when the twice finer mesh changes its shape at the
 #: points by less than this (sqrt(1 - MAC)): only then is its frequency change an O(h^2) error

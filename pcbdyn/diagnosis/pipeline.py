@@ -45,7 +45,9 @@ from .catalogue import KINDS, add_effect, generate, kind, place, weighted_centre
 from .layout import from_structure
 from .model_form import MESH_LEVELS, discretisation, fit_plate_share, kirchhoff_shift
 from .residual import ModalResidual, Observation
-from .select import ALPHA, adopt, estimate, penalty, refine, search, without_vanished
+from .fitting import estimate
+from .scan import Runner
+from .select import ALPHA, adopt, penalty, refine, search, without_vanished
 
 #: kinds whose effects :func:`_with_masses` carries onto the finer meshes
 MASS_KINDS = ("point_mass", "point_inertia", "line_mass")
@@ -53,6 +55,8 @@ MASS_KINDS = ("point_mass", "point_inertia", "line_mass")
 #: where candidates go: sides cut into 16 pieces (every run of consecutive pieces is a candidate);
 #: stiffener rows and columns every element (``path_spacing`` in element sizes)
 CANDIDATE_OPTIONS = {"segments": 16, "path_spacing": 1.0}
+#: ``quick`` (a first look): candidates on a grid half as fine, the refinement walking them to place
+QUICK_CANDIDATE_OPTIONS = {"segments": 8, "path_spacing": 2.0}
 
 
 def _options(kinds) -> set:
@@ -107,10 +111,15 @@ def _observations(tests, models) -> list:
     return obs
 
 
-def _finer(structure, name, h, p: dict) -> list:
+def _finer(structure, name, h, p: dict, levels: int = MESH_LEVELS, say=None) -> list:
     """Built models of configuration ``name`` at parameters ``p`` on the meshes twice, four
-    times, ... as fine as ``h`` (:data:`.model_form.MESH_LEVELS`)."""
-    return [structure.build(name, h / 2**j, shared_mesh=True).with_parameters(p) for j in range(1, MESH_LEVELS + 1)]
+    times, ... as fine as ``h`` (``levels`` of them, :data:`.model_form.MESH_LEVELS`)."""
+    out = []
+    for j in range(1, levels + 1):
+        if say is not None:
+            say(f"  mesh level {j} of {levels} ({1e3 * h / 2**j:.3g} mm) of {name or 'base'}")
+        out.append(structure.build(name, h / 2**j, shared_mesh=True).with_parameters(p))
+    return out
 
 
 @dataclass
@@ -138,10 +147,11 @@ def _correct(ob, cs, models, form: _Form):
     return ds
 
 
-def _set_noise(structure, models, h, obs, state, freq_pct, shape_pct) -> list:
+def _set_noise(structure, models, h, obs, state, freq_pct, shape_pct, levels: int = MESH_LEVELS, say=None) -> list:
     """Each observation's discretisation correction of the model frequencies, and its sigmas:
     measurement noise, what remains of the discretisation error and the plate theory's gap, in
-    quadrature (:mod:`.model_form`). Returns a :class:`_Form` per observation."""
+    quadrature (:mod:`.model_form`), from ``levels`` finer meshes. Returns a :class:`_Form` per
+    observation."""
     forms = []
     p0 = dict(zip(models.names, models.p0.tolist()))
     for ob, cs in zip(obs, state.configs):
@@ -150,7 +160,7 @@ def _set_noise(structure, models, h, obs, state, freq_pct, shape_pct) -> list:
             wide = solve_modes(cs.model, n_modes=ob.shapes.shape[0] // 2)
             basis = np.asarray(ob.read @ np.column_stack([wide.rigid_shapes, wide.shapes]))
         sf, ss = _noise_sigmas(ob, freq_pct, shape_pct, basis)
-        finer = _finer(structure, ob.name, h, p0)
+        finer = _finer(structure, ob.name, h, p0, levels, say)
         forms.append(_Form(finer, kirchhoff_shift(finer[-1], ob, cs), sf))
         ds = _correct(ob, cs, (bm.model for bm in finer), forms[-1])
         ob.sigma_s = None if ss is None else np.sqrt(ss**2 + ds**2)
@@ -190,10 +200,19 @@ def _range_test(res, base, n_params, alpha) -> dict:
 
 
 def diagnose(structure, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_size=None, kinds=None,
-             max_effects: int = 3, alpha: float = ALPHA, progress=None) -> Diagnosis:
+             max_effects: int = 3, alpha: float = ALPHA, progress=None, workers: int | None = 1,
+             scheduler=None, quick: bool = False) -> Diagnosis:
     """Diagnose ``structure`` (a board, or any structure of :mod:`pcbdyn.domain`) against ``tests`` =
-    [(configuration name or None, :class:`pcbdyn.testdata.Modes`)]."""
+    [(configuration name or None, :class:`pcbdyn.testdata.Modes`)]. ``workers`` local processes (None:
+    the cores) or the Dask cluster at ``scheduler`` run the independent fits of the candidate scans
+    (:mod:`.scan`); the results do not depend on where they ran. ``quick``: a first look that
+    costs a fraction of the run: the mesh correction from one finer mesh (twice as fine) instead of
+    :data:`.model_form.MESH_LEVELS`, the candidates on a grid half as fine
+    (:data:`QUICK_CANDIDATE_OPTIONS`, the local search still walks them to place), one trial per
+    kind in each scan instead of two, and the masses found not carried onto the finer meshes to
+    measure the correction again."""
     say = progress or (lambda msg: None)
+    runner = Runner(workers, scheduler, lambda msg: say(f"  {msg}"))
     h = mesh_size or structure.mesh_size
     say("building the models")
     models = StructureModels(structure, [c for c, _ in tests], mesh_size=h, shared_mesh=True)
@@ -209,11 +228,12 @@ def diagnose(structure, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_s
         res = ModalResidual.of_models(models, obs)
         before = res.evaluate(p0)
     say("estimating the noise and the model's discretisation error")
-    forms = _set_noise(structure, models, h, obs, before, freq_noise_pct, shape_noise_pct)
+    forms = _set_noise(structure, models, h, obs, before, freq_noise_pct, shape_noise_pct, 1 if quick else MESH_LEVELS,
+                       say)
     before = res.evaluate(p0)
     say(f"fitting the {len(names)} declared parameter(s)" if names else "no declared parameters")
     base = estimate(res, p0, [], [], 10, models.bounds)
-    stats = {"unpaired_test_modes": unmatched, "chi2_before": before.chi2, **_range_test(res, base, len(names), alpha),
+    stats = {"quick": quick, "unpaired_test_modes": unmatched, "chi2_before": before.chi2, **_range_test(res, base, len(names), alpha),
              "mesh_correction_pct": [np.round(100 * (o.f_scale - 1.0), 4).tolist() for o in obs],
              "mesh_resolved": [f.resolved for f in forms],
              "plate_theory_pct": [np.round(100 * f.shift, 4).tolist() for f in forms],
@@ -230,21 +250,23 @@ def diagnose(structure, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_s
                          f"{stats['p_value_noise']:.2f}): no effect is missing that the data can show",
                          after=out["parameters_only"], **out)
     say("generating the candidate effects")
-    options = {k: v * h if k == "path_spacing" else v for k, v in CANDIDATE_OPTIONS.items() if k in _options(kinds)}
+    grid = QUICK_CANDIDATE_OPTIONS if quick else CANDIDATE_OPTIONS
+    options = {k: v * h if k == "path_spacing" else v for k, v in grid.items() if k in _options(kinds)}
     layout = from_structure(models.models[0])
     cands = generate(layout, kinds, **options)
     say(f"searching {len(cands)} candidate effects")
-    sel = search(res, cands, p0, models.bounds, max_effects=max_effects, shortlist=2, alpha=alpha, base=base)
+    sel = search(res, cands, p0, models.bounds, max_effects=max_effects, shortlist=1 if quick else 2, alpha=alpha,
+                 base=base, runner=runner)
     if any(_movable(cands[i]) for i in sel.chosen):
         say("refining where the effects along the sides begin and end, where stiffeners run and what regions cover")
-        sel = refine(res, cands, sel, LocalMoves(layout, cands, h), models.bounds, alpha=alpha)
+        sel = refine(res, cands, sel, LocalMoves(layout, cands, h), models.bounds, alpha=alpha, runner=runner)
     if {"point_mass", "point_inertia"} <= {cands[i].kind for i in sel.chosen}:
         say("fitting a part found as a mass with an inertia beside it as one body")
         sel = as_bodies(res, cands, sel, _neighbours([cands[i] for i in sel.chosen], MERGE_REACH * h),
                         MERGE_REACH * h, models.bounds, alpha=alpha)
     sel = without_vanished(res, cands, sel, models.bounds, alpha=alpha)
     masses = [(cands[i], v) for i, v in zip(sel.chosen, sel.values) if cands[i].kind in MASS_KINDS]
-    if masses:
+    if masses and not quick:
         say("measuring the mesh correction again with the masses found on the finer meshes")
         _with_masses(models, res, sel.p, masses, forms)
         stats["mesh_resolved"] = [f.resolved for f in forms]

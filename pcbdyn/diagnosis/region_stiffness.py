@@ -94,6 +94,7 @@ def _locate(model, etype: str, conn: np.ndarray):
 
 class _RegionStiffness:
     name = report_as = "region_stiffness"
+    uses_properties = True  # dK/ds is the region's own stiffness, which the declared parameters move
     param = "stiffness_change"
     unit = "1"
     scale = 0.3

@@ -30,7 +30,8 @@ from ..fe.assembly import assemble
 from ..fe.modal import solve_modes
 from ..testdata import Modes
 from ..updating.sensitivity import bilinear_forms, eigen_derivatives
-from .catalogue import derivatives, effect_forms
+from .catalogue import effect_forms
+from .combined import Effects
 
 
 @dataclass
@@ -83,7 +84,9 @@ class ConfigState:
     ``modes``, ``pairs`` (elastic mode index per measured mode; ``matched`` False where no model
     mode resembles it and the nearest free one stands in), paired frequencies ``f_a`` (with the
     observation's discretisation correction), ``mac``, the
-    model shapes at the points ``u`` and scale factors ``s``, its rows ``r``."""
+    model shapes at the points ``u`` and scale factors ``s``, its rows ``r``; ``points``: the modes
+    [rigid, elastic] at the measured points when they are not read from full-length shapes (a
+    state found by :mod:`.reanalysis`)."""
 
     model: object
     K: object
@@ -96,6 +99,14 @@ class ConfigState:
     u: np.ndarray | None
     s: np.ndarray | None
     r: np.ndarray
+    points: np.ndarray | None = None
+    static: tuple | None = None  # (reduction, shift, factorisation) of :func:`beyond_basis`, made when first needed
+
+    def at_points(self, read) -> np.ndarray:
+        """The modes [rigid, elastic] at the measured points (``read``: the observation's reading)."""
+        if self.points is not None:
+            return self.points
+        return np.asarray(read @ np.column_stack([self.modes.rigid_shapes, self.modes.shapes]))
 
 
 @dataclass
@@ -134,6 +145,39 @@ class State:
                 "mean_mac": float(np.mean(macs)) if macs else None, "configurations": per}
 
 
+def paired_state(ob: Observation, model, K, M, modes, U, points=None) -> ConfigState:
+    """The state of observation ``ob`` against model ``modes`` (frequencies, and ``U`` their shapes at
+    the points, None without measured shapes): test modes paired by MAC (the nearest free frequency
+    standing in where none resembles), modal scale factors and residual rows. ``points``: the
+    points' basis of the modes' derivatives when it is not ``ob.read`` on full-length shapes."""
+    m = ob.f.size
+    f_all = modes.frequencies
+    if U is None:
+        pairs = np.arange(m)
+        matched = np.ones(m, bool)
+        u = s = None
+        macs = np.ones(m)
+    else:
+        pairs = -np.ones(m, int)
+        for pr in pair_modes(ob.shapes, U, ob.f, f_all, min_mac=0.3).pairs:
+            pairs[pr.test] = pr.model
+        matched = pairs >= 0
+        free = [k for k in range(f_all.size) if k not in set(pairs.tolist())]
+        for i in np.flatnonzero(pairs < 0):  # unpaired: nearest unused frequency keeps the rows defined
+            k = min(free, key=lambda k: abs(f_all[k] / ob.f[i] - 1))
+            pairs[i] = k
+            free.remove(k)
+        u = U[:, pairs]
+        s = np.sum(u * ob.shapes, axis=0) / np.sum(u * u, axis=0)
+        macs = paired_mac(u, ob.shapes)
+    f_a = f_all[pairs] * ob.f_scale
+    rows = [(ob.f - f_a) / (ob.sigma_f * ob.f)]
+    if u is not None:
+        rms = np.sqrt(np.mean(ob.shapes**2, axis=0))
+        rows.append(((ob.shapes - s * u) / (ob.sigma_s * rms)).T.ravel())
+    return ConfigState(model, K, M, modes, pairs, matched, f_a, macs, u, s, np.concatenate(rows), points)
+
+
 def paired_mac(a, b) -> np.ndarray:
     """MAC of column i of ``a`` with column i of ``b`` (thesis eq. 2.3)."""
     return np.diagonal(mac(a, b)).copy()
@@ -149,15 +193,20 @@ class ModalResidual:
     def of_models(cls, models, observations) -> "ModalResidual":
         """The residual of ``observations`` against a structure's configuration models as functions of
         its declared parameters (:class:`pcbdyn.problems.StructureModels`)."""
-        return cls(observations, models.build, models.derivatives if models.names else None, len(models.names))
+        return cls(observations, models.build, models.derivatives if models.names else None, len(models.names),
+                   models.matrices)
 
-    def __init__(self, observations, build, derivatives=None, n_params: int = 0):
+    def __init__(self, observations, build, derivatives=None, n_params: int = 0, matrices=None):
+        """``matrices(p)``: per observation, its model's (K, M) at ``p`` (default: assembled from
+        ``build(p)``)."""
         self.observations = list(observations)
         self.build = build
         self.derivatives = derivatives
         self.n_params = n_params
+        self.matrices = matrices
         self.n_rows = sum(o.n_rows for o in self.observations)
-        self._at = (None, None, {})  # last p, its [(model, K, M)], {(config, candidate): (dK, dM)}
+        self.effects = Effects()
+        self._at = (None, None)  # last p, its [(model, K, M)]
 
     def row_groups(self) -> tuple:
         """(configuration index, mode index) of every row: the blocks cross-validation leaves out."""
@@ -172,55 +221,33 @@ class ModalResidual:
     # --- states ----------------------------------------------------------------------------
     def _assembled(self, p):
         if self._at[0] is None or not np.array_equal(self._at[0], p):
-            self._at = (p.copy(), [(m, *assemble(m)) for m in self.build(p)], {})
-        return self._at[1], self._at[2]
+            models = self.build(p)
+            mats = self.matrices(p) if self.matrices is not None else [assemble(m) for m in models]
+            self._at = (p.copy(), [(m, *km) for m, km in zip(models, mats)])
+        return self._at[1]
 
     def evaluate(self, p, candidates=(), values=()) -> State:
         """Full re-solve of every configuration at parameters ``p`` with the effects. The effects
         enter K and M linearly, so their exact derivative matrices are added to the model's
-        (assembled once per p); the configuration states keep the model without them."""
+        (made once per p, on one pattern per set of effects: :class:`.combined.Effects`); the
+        configuration states keep the model without them."""
         p = np.asarray(p, float)
         st = State(p, list(candidates), np.asarray(values, float))
-        models, cache = self._assembled(p)
-        for k, (ob, (model, K, M)) in enumerate(zip(self.observations, models)):
-            for c, v in zip(candidates, st.values):
-                if v != 0.0:
-                    if (k, c.name) not in cache:
-                        cache[k, c.name] = derivatives(model, c)
-                    dK, dM = cache[k, c.name]
-                    K, M = K + v * dK, M + v * dM
+        for k, (ob, (model, K, M)) in enumerate(zip(self.observations, self._assembled(p))):
+            K, M = self.effects.combine(k, model, K, M, p, candidates, st.values)
             st.configs.append(self._config(ob, model, K, M))
         return st
 
     def _config(self, ob: Observation, model, K, M) -> ConfigState:
-        m = ob.f.size
-        modes = solve_modes(model, n_modes=max(2 * m, m + 6), K=K, M=M)
-        f_all = modes.frequencies
-        if ob.shapes is None:
-            pairs = np.arange(m)
-            matched = np.ones(m, bool)
-            u = s = None
-            macs = np.ones(m)
-        else:
-            U = np.asarray(ob.read @ modes.shapes)
-            pairs = -np.ones(m, int)
-            for pr in pair_modes(ob.shapes, U, ob.f, f_all, min_mac=0.3).pairs:
-                pairs[pr.test] = pr.model
-            matched = pairs >= 0
-            free = [k for k in range(f_all.size) if k not in set(pairs.tolist())]
-            for i in np.flatnonzero(pairs < 0):  # unpaired: nearest unused frequency keeps the rows defined
-                k = min(free, key=lambda k: abs(f_all[k] / ob.f[i] - 1))
-                pairs[i] = k
-                free.remove(k)
-            u = U[:, pairs]
-            s = np.sum(u * ob.shapes, axis=0) / np.sum(u * u, axis=0)
-            macs = paired_mac(u, ob.shapes)
-        f_a = f_all[pairs] * ob.f_scale
-        rows = [(ob.f - f_a) / (ob.sigma_f * ob.f)]
-        if u is not None:
-            rms = np.sqrt(np.mean(ob.shapes**2, axis=0))
-            rows.append(((ob.shapes - s * u) / (ob.sigma_s * rms)).T.ravel())
-        return ConfigState(model, K, M, modes, pairs, matched, f_a, macs, u, s, np.concatenate(rows))
+        modes = solve_modes(model, n_modes=self.n_modes(ob), K=K, M=M)
+        U = None if ob.shapes is None else np.asarray(ob.read @ modes.shapes)
+        return paired_state(ob, model, K, M, modes, U)
+
+    @staticmethod
+    def n_modes(ob: Observation) -> int:
+        """How many elastic modes a configuration's state holds: twice the measured ones (pairing
+        and the modal expansion of the shape derivatives)."""
+        return max(2 * ob.f.size, ob.f.size + 6)
 
     # --- sensitivities ---------------------------------------------------------------------
     def _columns(self, ob: Observation, cs: ConfigState, BK, BM, dU_static=None) -> np.ndarray:
@@ -233,7 +260,7 @@ class ModalResidual:
         df = dlam * ob.f_scale**2 / (8.0 * np.pi**2 * cs.f_a)  # d(c f)/dp, f = f_a / c
         out = [(df / (ob.sigma_f * ob.f)).T]
         if cs.u is not None:
-            Ub = np.asarray(ob.read @ np.column_stack([modes.rigid_shapes, modes.shapes]))
+            Ub = cs.at_points(ob.read)
             dU = np.einsum("pk,cki->pic", Ub, C, optimize=True)  # (n_pts, m, n_col)
             if dU_static is not None:
                 dU = dU + dU_static
@@ -255,7 +282,7 @@ class ModalResidual:
         out = []
         for ob, cs in zip(self.observations, st.configs):
             basis, paired = self._basis(cs)
-            BK, BM = effect_forms(cs.model, basis, paired, candidates)
+            BK, BM = effect_forms(cs.model, basis, paired, candidates, self.effects.blocks)
             out.append(self._columns(ob, cs, BK, BM))
         return np.vstack(out)
 
@@ -271,22 +298,26 @@ class ModalResidual:
             if cs.u is not None:
                 lam = cs.modes.omega2[cs.pairs]
                 F = np.stack([dK @ paired - (dM @ paired) * lam[None, :] for dK, dM in pairs], axis=2)
-                static = np.asarray(ob.read @ _beyond_basis(cs, basis, F.reshape(F.shape[0], -1))).reshape(
+                static = np.asarray(ob.read @ beyond_basis(cs, basis, F.reshape(F.shape[0], -1))).reshape(
                     -1, lam.size, len(pairs))
             out.append(self._columns(ob, cs, BK, BM, static) * st.p[None, :])
         return np.vstack(out)
 
 
-def _beyond_basis(cs: ConfigState, basis, F) -> np.ndarray:
+def beyond_basis(cs: ConfigState, basis, F) -> np.ndarray:
     """-(G - sum_basis phi_k phi_k^T / (lambda_k + mu)) F: the modes above the computed ones answer a
     force F quasi-statically (modal acceleration), G = (K + mu M)^-1 on the constrained DOFs, mu a
     small shift that keeps a free board's G finite. It completes the modal expansion of the
-    eigenvector derivative (eqs. 3.8-3.14) for parameters that act over the whole board."""
+    eigenvector derivative (eqs. 3.8-3.14) for parameters that act over the whole board, and gives
+    the static corrections of :mod:`.reanalysis`. The factorisation is kept with the state."""
     from ..fe.linsolve import factorize
     from ..fe.modal import reduced_system
 
-    red, Kr, Mr = reduced_system(cs.model, cs.K, cs.M)
     lam_b = np.r_[np.zeros(cs.modes.n_rigid), cs.modes.omega2]
-    mu = 1e-3 * lam_b[lam_b > 0].min()
-    G = red.expand(factorize((Kr + mu * Mr).tocsc()).solve(red.T.T @ F))
+    if cs.static is None:
+        red, Kr, Mr = reduced_system(cs.model, cs.K, cs.M)
+        mu = 1e-3 * lam_b[lam_b > 0].min()
+        cs.static = (red, mu, factorize((Kr + mu * Mr).tocsc()))
+    red, mu, f = cs.static
+    G = red.expand(f.solve(red.T.T @ F))
     return -(G - basis @ ((basis.T @ F) / (lam_b + mu)[:, None]))

@@ -7,9 +7,9 @@ The residual (:class:`.residual.ModalResidual`) is in units of noise, so chi^2 =
 projects out the columns of the declared parameters and of the effects already chosen and scores
 every candidate by the chi^2 its column removes (the cos^2 criterion of thesis eqs. 5.51-5.54
 applied to the residual), among those whose estimated value is physical (``lower`` of its kind).
-The best ``shortlist`` of every kind are re-estimated with full re-solves (a spring's effect on
-the frequencies saturates, so the linear score alone under-rates large ones) and the least chi^2
-wins. Magnitudes stay within [lower, UPPER * scale], declared parameters within their bounds.
+The best ``shortlist`` of every kind are re-estimated nonlinearly (a spring's effect on the
+frequencies saturates, so the linear score alone under-rates large ones; :func:`.scan.rank`: quick
+fits on a reanalysis of the state, the best of them with full re-solves) and the least chi^2 wins. Magnitudes stay within [lower, UPPER * scale], declared parameters within their bounds.
 
 A new effect is kept only if its chi^2 drop exceeds the penalty
     q = max(ln n, chi^2_1 quantile exceeded with probability ALPHA / P)
@@ -29,15 +29,11 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.stats import chi2 as chi2_dist
 
-from ..updating.gauss_newton import gauss_newton
+from .fitting import RANK_STEPS, UPPER, Fit, estimate  # noqa: F401  (re-exported)
+from .scan import Runner, rank, worth_full
 
-#: magnitudes are bounded by this many times their kind's typical ``scale`` (a 1 kg mass or a
-#: 1e7 N/m spring is no longer an effect a test setup hides; unbounded, a huge mass pins a node)
-UPPER = 100.0
 #: probability that noise alone makes one of the candidates look like an effect (family-wise)
 ALPHA = 0.01
-#: Gauss-Newton steps used to rank the shortlist (the winner is then fitted to convergence)
-RANK_STEPS = 2
 
 
 @dataclass
@@ -67,61 +63,12 @@ def penalty(n_obs: int, n_candidates: int, alpha: float = ALPHA) -> float:
     return max(np.log(n_obs), float(chi2_dist.isf(alpha / max(n_candidates, 1), 1)))
 
 
-@dataclass
-class Fit:
-    p: np.ndarray
-    values: np.ndarray
-    state: object
-    cov: np.ndarray
-
-    @property
-    def chi2(self) -> float:
-        return np.inf if self.state is None else self.state.chi2
-
-
-def estimate(res, p0, cands, v0, steps: int, bounds=None, tol: float = 1e-5, param_columns=None) -> Fit:
-    """The declared parameters (on a log scale, within ``bounds`` = (lower, upper) of p) and the
-    magnitudes of ``cands`` fitted to the residual ``res`` by the updating engine's bounded Gauss-Newton
-    (:func:`pcbdyn.updating.gauss_newton.gauss_newton`); ``cov`` is the covariance of (ln p,
-    magnitudes). ``param_columns``: the parameters' columns held from an earlier state (a quick fit
-    that ranks candidates need not re-derive the board's matrices at every step)."""
-    p = np.asarray(p0, float)
-    npar = p.size
-    lo_v = np.array([c.spec.lower for c in cands], float)
-    hi_v = UPPER * np.array([c.spec.scale for c in cands], float)
-    scale = np.r_[np.ones(npar), [c.spec.scale for c in cands]]
-    lo_p, hi_p = (np.full(npar, 0.0), np.full(npar, np.inf)) if bounds is None else bounds
-    lo_p = np.maximum(lo_p, 1e-6 * np.abs(p))  # ln p: a parameter may shrink a millionfold, not vanish
-    with np.errstate(divide="ignore"):
-        lower, upper = np.r_[np.log(lo_p), lo_v], np.r_[np.log(hi_p), hi_v]
-
-    def evaluate(y):
-        try:
-            return res.evaluate(np.exp(y[:npar]), cands, y[npar:])
-        except (ValueError, ArithmeticError, np.linalg.LinAlgError):  # e.g. overlapping regions softened below zero
-            return None
-
-    def step_tol(y):
-        return tol * np.r_[np.ones(npar), np.maximum(np.abs(y[npar:]), scale[npar:])]
-
-    y0 = np.r_[np.log(p), np.clip(np.asarray(v0, float), lo_v, hi_v)]
-    gn = gauss_newton(evaluate, lambda st: _jacobian(res, st, cands, npar, param_columns), y0, lower, upper,
-                      scale, steps, step_tol)
-    return Fit(np.exp(gn.y[:npar]), gn.y[npar:], gn.state, gn.cov)
-
-
-def _jacobian(res, st, cands, npar, param_columns=None):
-    cols = [res.param_columns(st) if param_columns is None else param_columns] if npar else []
-    if cands:
-        cols.append(res.effect_columns(st, cands))
-    return np.hstack(cols) if cols else np.zeros((res.n_rows, 0))
-
-
 def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_steps: int = 8, shortlist: int = 3,
-           alpha: float = ALPHA, base: Fit | None = None) -> Selection:
+           alpha: float = ALPHA, base: Fit | None = None, runner: Runner | None = None) -> Selection:
     """Effects among ``candidates`` that explain the residual ``res`` (:class:`.residual.ModalResidual`)
     beyond the declared parameters (initial values ``p0``, ``bounds``); ``base``: the fit of the
-    declared parameters alone when already made."""
+    declared parameters alone when already made; ``runner``: where the shortlist's trial fits run
+    (:mod:`.scan`)."""
     p0 = np.asarray(p0, float)
     n = res.n_rows
     pen = penalty(n, len(candidates), alpha)
@@ -148,9 +95,9 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
         order = np.union1d(_shortlist(gain, kinds, shortlist), _companions(candidates, sel.chosen))
         if not order.size:
             break
-        fits = [estimate(res, fit.p, [candidates[i] for i in sel.chosen + [j]], np.r_[sel.values, max(value[j], 0.0)],
-                         RANK_STEPS, bounds, param_columns=P) for j in order]
-        best = int(np.argmin([f.chi2 for f in fits]))
+        trials = [([candidates[i] for i in sel.chosen + [j]], np.r_[sel.values, max(value[j], 0.0)]) for j in order]
+        fits = rank(res, st, trials, fit.p, bounds, P, runner)
+        best = int(np.argmin([np.inf if f is None else f.chi2 for f in fits]))
         if not np.isfinite(fits[best].chi2):
             break
         idx = sel.chosen + [int(order[best])]
@@ -188,13 +135,14 @@ def without_vanished(res, candidates, sel: Selection, bounds=None, newton_steps:
 
 
 def refine(res, candidates, sel: Selection, neighbours, bounds=None, newton_steps: int = 8,
-           alpha: float = ALPHA) -> Selection:
+           alpha: float = ALPHA, runner: Runner | None = None) -> Selection:
     """Local search on the geometry of the effects found: each chosen candidate is swapped in turn
     for each of ``neighbours(i)`` (candidate indices of the same kind next to it, e.g. a segment
     one piece longer or shorter), all magnitudes and the declared parameters re-estimated; the
     best swap is kept while it lowers chi^2, then effects the others now explain are pruned.
     Forward selection adds effects greedily on a coarse set of places; this lets a place found
-    early move to where the effects found later leave it best."""
+    early move to where the effects found later leave it best. The swaps are ranked by
+    :func:`.scan.rank` (``runner``: where their full fits run)."""
     pen = penalty(res.n_rows, len(candidates), alpha)
     n_par = np.size(sel.p)
     idx = list(sel.chosen)
@@ -204,15 +152,12 @@ def refine(res, candidates, sel: Selection, neighbours, bounds=None, newton_step
         improved = False
         best = None
         P = res.param_columns(fit.state)  # held while ranking the swaps, as in :func:`search`
-        for k, i in enumerate(idx):
-            for j in neighbours(i):
-                if j in idx:
-                    continue
-                trial_idx = idx[:k] + [j] + idx[k + 1:]
-                trial = estimate(res, fit.p, [candidates[t] for t in trial_idx], fit.values, RANK_STEPS, bounds,
-                                 param_columns=P)
-                if trial.chi2 < (fit.chi2 if best is None else best[1].chi2) * (1 - 1e-6):
-                    best = (trial_idx, trial)
+        swaps = [idx[:k] + [j] + idx[k + 1:] for k, i in enumerate(idx) for j in neighbours(i) if j not in idx]
+        trials = rank(res, fit.state, [([candidates[t] for t in sw], fit.values) for sw in swaps], fit.p, bounds, P,
+                      runner)
+        for trial_idx, trial in zip(swaps, trials):
+            if trial is not None and trial.chi2 < (fit.chi2 if best is None else best[1].chi2) * (1 - 1e-6):
+                best = (trial_idx, trial)
         if best is not None:
             new = estimate(res, best[1].p, [candidates[t] for t in best[0]], best[1].values, newton_steps, bounds)
             if new.chi2 < fit.chi2 * (1 - 1e-6):
@@ -290,12 +235,17 @@ def _shortlist(gain, kinds, per_kind: int) -> np.ndarray:
 
 def _prune(res, candidates, idx, fit, steps, bounds, pen, n_params):
     """Backward check after each addition: drop an earlier effect whenever the others, re-estimated
-    without it, reach a lower criterion (greedy choices made before the right effect was in)."""
+    without it, reach a lower criterion (greedy choices made before the right effect was in); the
+    drops a quick fit shows to be far worse are not re-estimated (:func:`.scan.worth_full`)."""
     while len(idx) > 1:
         best = None
-        for drop in range(len(idx) - 1):
-            keep = [i for t, i in enumerate(idx) if t != drop]
-            trial = estimate(res, fit.p, [candidates[i] for i in keep], np.delete(fit.values, drop), steps, bounds)
+        keeps = [[i for t, i in enumerate(idx) if t != drop] for drop in range(len(idx) - 1)]
+        trials = [([candidates[i] for i in keep], np.delete(fit.values, drop)) for drop, keep in enumerate(keeps)]
+        for drop, (keep, full) in enumerate(zip(keeps, worth_full(res, fit.state, trials, fit.p, bounds,
+                                                                   fit.chi2 + pen, steps))):
+            if not full:
+                continue
+            trial = estimate(res, fit.p, trials[drop][0], trials[drop][1], steps, bounds)
             if trial.chi2 + len(keep) * pen < fit.chi2 + len(idx) * pen and (best is None or trial.chi2 < best[1].chi2):
                 best = (keep, trial)
         if best is None:

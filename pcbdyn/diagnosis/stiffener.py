@@ -30,6 +30,7 @@ class _Stiffener:
     scale = 1.0
     lower = 0.0
     options = ("path_spacing",)
+    reanalysed = False  # a rib changes the modes beyond a first-order basis (:mod:`.scan`)
 
     def __init__(self, section: RibSection = RibSection()):
         self.section = section

@@ -95,15 +95,21 @@ class _Pattern:
         return sp.csr_matrix((data, indices, indptr), shape=(n, n), copy=False)
 
 
-def _accumulate(pattern: _Pattern, targets, slot: np.ndarray, blocks) -> None:
-    """Add node blocks ``blocks[t]`` (m, 36) into CSR values ``targets[t]`` at pattern slots ``slot``
-    (duplicates summed): one sort of the slots, shared by all targets, gives the runs of equal
-    slots as a 0/1 sparse matrix whose product with the blocks sums each run."""
+def _summing(pattern: _Pattern, slot: np.ndarray):
+    """(CSR value positions, S): the runs of equal pattern slots ``slot`` (one per node block) as a
+    0/1 sparse matrix S whose product with the blocks (m, 36) sums each run, and the CSR value
+    positions of those sums (one sort of the slots, shared by all blocks summed there)."""
     order = np.argsort(slot, kind="stable")
     s = slot[order]
     starts = np.flatnonzero(np.r_[True, s[1:] != s[:-1]])
     S = sp.csr_matrix((np.ones(s.size), order, np.r_[starts, s.size]), shape=(starts.size, s.size))
-    pos = pattern.positions(s[starts]).ravel()
+    return pattern.positions(s[starts]).ravel(), S
+
+
+def _accumulate(pattern: _Pattern, targets, slot: np.ndarray, blocks) -> None:
+    """Add node blocks ``blocks[t]`` (m, 36) into CSR values ``targets[t]`` at pattern slots ``slot``
+    (duplicates summed, :func:`_summing`)."""
+    pos, S = _summing(pattern, slot)
     for data, b in zip(targets, blocks):
         data[pos] += (S @ b).ravel()
 
@@ -158,3 +164,35 @@ def assemble(model, sets=None, props=None):
         flush()
     index = pattern.csr_index()
     return pattern.to_csr(K, index), pattern.to_csr(M, index)
+
+
+class SetAssembly:
+    """The assembled pattern of ``model`` (all its non-empty element sets) and each set's share of
+    it: ``positions(name)`` are the CSR value positions a set touches, ``values(name, prop)`` its
+    summed K and M entries there with property ``prop``. Sets then combine by adding their values
+    at their positions: a model whose sets change one at a time is re-assembled set by set, on one
+    pattern whose index arrays (``index``) stay the same objects."""
+
+    def __init__(self, model):
+        self.model = model
+        self.names = [nm for nm in model.sets if len(model.sets[nm].conn) > 0]
+        self.pattern = _Pattern(model.n_dof // NDOF, [model.sets[nm].conn for nm in self.names])
+        self.index = self.pattern.csr_index()
+        self._sums = {nm: _summing(self.pattern, slot) for nm, slot in zip(self.names, self.pattern.slot)}
+
+    @property
+    def nnz(self) -> int:
+        return self.pattern.nnz
+
+    def positions(self, name: str) -> np.ndarray:
+        return self._sums[name][0]
+
+    def values(self, name: str, prop=None) -> tuple[np.ndarray, np.ndarray]:
+        """(K values, M values) of set ``name`` at its :meth:`positions` (its own property by default)."""
+        Ke, Me = element_matrices(self.model, name, prop)
+        S = self._sums[name][1]
+        return (S @ _node_blocks(Ke)).ravel(), (S @ _node_blocks(Me)).ravel()
+
+    def matrix(self, data: np.ndarray) -> sp.csr_matrix:
+        """The CSR matrix with values ``data`` (length :attr:`nnz`) on the pattern (shared index)."""
+        return self.pattern.to_csr(data, self.index)

@@ -26,7 +26,9 @@ class StructureModels:
     domain-model interface, :mod:`pcbdyn.domain`) as functions of its parameters ``names`` (default: all
     of them). ``shared_mesh``: all configurations on one mesh, node for node. Attributes: ``models``
     (the built :class:`pcbdyn.fe.parametric.ParametricModel` of each configuration), ``p0`` and
-    ``bounds`` [SI] of the parameters."""
+    ``bounds`` [SI] of the parameters. Matrices and derivatives at other values come from each
+    configuration's :class:`pcbdyn.fe.parametric_matrices.ParametricMatrices` (made when first asked
+    for): no element matrix is recomputed as the parameters move."""
 
     def __init__(self, structure, configs, names=None, mesh_size=None, shared_mesh: bool = False):
         self.structure = structure
@@ -36,6 +38,16 @@ class StructureModels:
         params = [self.models[0].parameters[n] for n in self.names]
         self.p0 = np.array([p.value for p in params], float)
         self.bounds = (np.array([p.bounds[0] for p in params], float), np.array([p.bounds[1] for p in params], float))
+        self._matrices = None
+
+    @property
+    def parametric(self) -> list:
+        """The :class:`pcbdyn.fe.parametric_matrices.ParametricMatrices` of each configuration."""
+        if self._matrices is None:
+            from ..fe.parametric_matrices import ParametricMatrices
+
+            self._matrices = [ParametricMatrices(pm, self.names) for pm in self.models]
+        return self._matrices
 
     def at(self, p) -> list:
         """The models with the parameters at ``p`` [SI]."""
@@ -45,7 +57,12 @@ class StructureModels:
         """The FE models (fe.Model) at ``p``."""
         return [pm.model for pm in self.at(p)]
 
+    def matrices(self, p) -> list:
+        """Per configuration, (K, M) at ``p`` [SI] (full size, before constraints; the index arrays
+        of one configuration's matrices are the same at every ``p``)."""
+        return [pmx.matrices(p) for pmx in self.parametric]
+
     def derivatives(self, p, models=None) -> list:
         """Per configuration, [(dK, dM)] of every parameter at ``p`` (``models``: unused, the
         signature of a residual's ``derivatives(p, models)``)."""
-        return [parameter_derivatives(pm, self.names) for pm in self.at(p)]
+        return [pmx.derivatives(p) for pmx in self.parametric]

@@ -90,3 +90,21 @@ def test_a_board_meshes_the_same_run_after_run():
     first = board.build().model.nodes
     for _ in range(4):
         assert np.array_equal(board.build().model.nodes, first)
+
+
+def test_a_kept_mesh_is_handed_out_as_a_copy():
+    """Meshes are kept by their inputs (board/mesh.py): a caller that changes the mesh it got does not
+    change the next one, and other inputs (a finer size, a region) give another mesh."""
+    from pcbdyn.board.entries import Outline
+    from pcbdyn.board.mesh import mesh_board
+
+    outline = Outline(np.array([[0.0, 0.0], [0.1, 0.0], [0.1, 0.08], [0.0, 0.08]]))
+    first = mesh_board(outline, [], [[0.05, 0.04]], 0.01)
+    nodes = first.nodes.copy()
+    first.nodes[:] = 0.0
+    first.cells["board"]["quad4"][:] = 0
+    again = mesh_board(outline, [], [[0.05, 0.04]], 0.01)
+    assert np.array_equal(again.nodes, nodes) and _area(again.nodes, again.cells["board"]["quad4"]).min() > 0
+    assert len(mesh_board(outline, [], [[0.05, 0.04]], 0.005).nodes) > len(nodes)
+    square = np.array([[0.02, 0.02], [0.04, 0.02], [0.04, 0.04], [0.02, 0.04]])
+    assert "U1" in mesh_board(outline, [("U1", square)], [[0.05, 0.04]], 0.01).cells

@@ -25,4 +25,5 @@ def matrices(xyz: np.ndarray, prop):
     ends = np.einsum("cen,cnk->cek", W, xyz)
     Kb, Mb = beam.matrices(ends, prop.beam)
     T = np.einsum("cen,ab->ceanb", W, np.eye(6)).reshape(n_cells, 12, 6 * nn)
-    return np.einsum("cai,cab,cbj->cij", T, Kb, T), np.einsum("cai,cab,cbj->cij", T, Mb, T)
+    Tt = T.transpose(0, 2, 1)
+    return Tt @ (Kb @ T), Tt @ (Mb @ T)

@@ -1,0 +1,88 @@
+"""Coverage of the uncertainties ``pcbdyn diagnose`` reports (issue 26): over noisy repeats of bench
+cases (tests/diagnosis/bench_cases.py; each repeat the same truth with its own noise seed), how often
+the 2-sigma interval of each found magnitude, magnitude +- 2 * uncertainty, holds the true value.
+Acceptance: >= 90 % over 20 repeats of three cases.
+
+    python benchmarks/bench_coverage.py [--cases pm_transducer,gs_standoff,line_mass_free_edge]
+                                        [--repeats 20] [--out out/coverage] [--json coverage.json]
+
+Per case: repeats run, the effect found (type within 15 mm), covered by 2 sigma, the coverage, the
+median |error| / sigma and the median time; a miss (not found) counts as not covered. Each
+diagnose runs through :func:`bench_diagnose.one` (its JSON kept under --out).
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from bench_diagnose import CASES, bc, match, one  # noqa: E402
+
+DEFAULT = "pm_transducer,gs_standoff,line_mass_free_edge"
+#: repeat r of a case uses the noise seed SEED_BASE + 100 * case seed + r (apart from the bench's own)
+SEED_BASE = 7000
+
+
+def repeat(case, r: int, out: Path) -> dict:
+    """One noisy repeat: the bench row and, per required effect of the truth, (found, |error| / sigma)."""
+    rc = dataclasses.replace(case, name=f"{case.name}_r{r:02d}", seed=SEED_BASE + 100 * case.seed + r)
+    row = one(rc, out)
+    truth = json.loads((out / rc.name / "truth" / "truth.json").read_text())
+    js = out / rc.name / "diagnose.json"
+    data = json.loads(js.read_text()) if js.exists() else {}
+    z = []
+    for t in truth["effects"]:
+        if not t["required"]:
+            continue
+        e, d = match(data.get("effects", []), t)
+        if e is None or d > max(15.0, 1e3 * bc.MODEL_MESH):
+            z.append(np.inf)
+        else:
+            z.append(abs(e["magnitude"] - t["magnitude"]) / max(e["uncertainty"], 1e-300))
+    return {**row, "z": z}
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--cases", default=DEFAULT, help="comma-separated bench cases with effects")
+    ap.add_argument("--repeats", type=int, default=20)
+    ap.add_argument("--out", default=str(ROOT / "out" / "coverage"))
+    ap.add_argument("--json", default=None, help="write the rows as JSON")
+    a = ap.parse_args(argv)
+    names = a.cases.split(",")
+    bad = [n for n in names if n not in bc.BY_NAME or bc.BY_NAME[n].noise_only]
+    if bad:
+        ap.error(f"not bench cases with effects: {bad}; use some of "
+                 f"{', '.join(n for n, c in bc.BY_NAME.items() if not c.noise_only)}")
+    out = Path(a.out)
+    print(f"{'case':<22} {'runs':>4} {'found':>5} {'in 2 sigma':>10} {'coverage':>8} {'med |e|/sigma':>13} {'med time [s]':>12}")
+    rows, total = [], [0, 0]
+    for n in names:
+        runs = []
+        for r in range(a.repeats):
+            runs.append(repeat(CASES[n], r, out))
+            print(f"  {n} repeat {r + 1} of {a.repeats}: |error|/sigma {np.round(runs[-1]['z'], 2).tolist()} "
+                  f"({runs[-1]['diagnose_s']:.0f} s, load {runs[-1]['load']:.1f})", file=sys.stderr, flush=True)
+        z = np.concatenate([np.asarray(x["z"], float) for x in runs])
+        found, covered = int(np.isfinite(z).sum()), int((z <= 2.0).sum())
+        total[0] += covered
+        total[1] += z.size
+        rows.append({"case": n, "runs": runs, "found": found, "covered": covered, "coverage": covered / max(z.size, 1)})
+        print(f"{n:<22} {len(runs):>4} {found:>5} {covered:>10} {100 * covered / max(z.size, 1):>7.0f}% "
+              f"{np.median(z):>13.2f} {np.median([x['diagnose_s'] for x in runs]):>12.1f}", flush=True)
+    print(f"\nall: {total[0]} of {total[1]} found magnitudes within 2 sigma of the truth "
+          f"({100 * total[0] / max(total[1], 1):.0f} %; acceptance >= 90 %)")
+    if a.json:
+        Path(a.json).write_text(json.dumps(rows, indent=1, default=float))
+
+
+if __name__ == "__main__":
+    main()

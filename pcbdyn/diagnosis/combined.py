@@ -1,0 +1,101 @@
+"""A configuration's K and M with candidate effects added, on one sparsity pattern per set of effects.
+
+Every fit of a diagnosis re-solves the same configurations with other parameter values and effect
+magnitudes. The parameters move values only (:class:`pcbdyn.fe.parametric_matrices.ParametricMatrices`
+keeps one pattern), and so do the magnitudes: each effect enters K and M linearly through its exact
+derivative matrices (:func:`.catalogue.derivatives`). Here the union of the model's pattern and its
+effects' is found once per set of effects and kept (:class:`EffectPlan`), so that K and M of every
+evaluation share one index: the FE engine's caches keyed by pattern (symbolic factorisation, DOF
+groups and the order of their spectra) then hit, and no pattern union is searched per solve.
+"""
+
+from __future__ import annotations
+
+from collections import OrderedDict
+
+import numpy as np
+import scipy.sparse as sp
+
+from .catalogue import BlockCache, derivatives, kind
+
+#: patterns of effect sets kept (least recently used dropped first)
+PLANS_KEPT = 64
+
+
+def _keys(A: sp.csr_matrix) -> np.ndarray:
+    n = A.shape[1]
+    return np.repeat(np.arange(A.shape[0], dtype=np.int64), np.diff(A.indptr)) * n + A.indices
+
+
+class EffectPlan:
+    """The union pattern of a base CSR pattern and the effects' derivative matrices, and where each
+    of them sits in it (``base``: positions of the base entries, ``at[k]``: of effect k's)."""
+
+    def __init__(self, base: sp.csr_matrix, parts: list):
+        union = sp.csr_matrix((np.ones(base.nnz), base.indices, base.indptr), shape=base.shape)
+        for dK, dM in parts:
+            union = union + abs(dK) + abs(dM)
+        union.sum_duplicates()
+        self.of = base.indices  # held: the plan is found again by the identity of the base's index
+        self.indptr, self.indices, self.shape = union.indptr, union.indices, union.shape
+        where = _keys(union)
+        self.base = np.searchsorted(where, _keys(base))
+        self.at = [(np.searchsorted(where, _keys(dK)), np.searchsorted(where, _keys(dM))) for dK, dM in parts]
+
+    def combine(self, K, M, parts, values) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+        """K + sum v_k dK_k and M + sum v_k dM_k on the union pattern (shared index arrays)."""
+        data = np.zeros((2, self.indices.size))
+        data[0, self.base] = K.data
+        data[1, self.base] = M.data
+        for (pk, pm), (dK, dM), v in zip(self.at, parts, values):  # positions are unique within each
+            data[0, pk] += v * dK.data
+            data[1, pm] += v * dM.data
+        return (sp.csr_matrix((data[0], self.indices, self.indptr), shape=self.shape, copy=False),
+                sp.csr_matrix((data[1], self.indices, self.indptr), shape=self.shape, copy=False))
+
+
+class Effects:
+    """Candidates' derivative matrices per configuration (kept: by name for the kinds that depend on
+    the mesh only, by name and parameter values for the others) and the :class:`EffectPlan` of each
+    set of effects; ``blocks``: the :class:`.catalogue.BlockCache` the residual's sensitivities share."""
+
+    def __init__(self):
+        self.blocks = BlockCache()
+        self._fixed: dict = {}
+        self._moving: dict = {}
+        self._plans: OrderedDict = OrderedDict()
+
+    def derivative(self, k: int, model, cand, p) -> tuple:
+        """(dK, dM) of ``cand`` on configuration ``k``'s ``model`` at parameters ``p``, canonical CSR."""
+        if getattr(kind(cand.kind), "uses_properties", False):
+            key = (k, cand.name, np.asarray(p, float).tobytes())
+            if key not in self._moving:
+                if len(self._moving) > 4 * PLANS_KEPT:
+                    self._moving.clear()
+                self._moving[key] = tuple(_canonical(A) for A in derivatives(model, cand, self.blocks))
+            return self._moving[key]
+        if (k, cand.name) not in self._fixed:
+            self._fixed[k, cand.name] = tuple(_canonical(A) for A in derivatives(model, cand, self.blocks))
+        return self._fixed[k, cand.name]
+
+    def combine(self, k: int, model, K, M, p, candidates, values) -> tuple:
+        """(K, M) of configuration ``k`` at ``p`` with the ``candidates`` at ``values`` (those at 0 left out)."""
+        on = [(c, float(v)) for c, v in zip(candidates, values) if v != 0.0]
+        if not on:
+            return K, M
+        parts = [self.derivative(k, model, c, p) for c, _ in on]
+        key = (k, K.shape, id(K.indices), tuple(c.name for c, _ in on))
+        plan = self._plans.get(key)
+        if plan is None or plan.of is not K.indices:
+            plan = self._plans[key] = EffectPlan(K, parts)
+            while len(self._plans) > PLANS_KEPT:
+                self._plans.popitem(last=False)
+        else:
+            self._plans.move_to_end(key)
+        return plan.combine(K, M, parts, [v for _, v in on])
+
+
+def _canonical(A) -> sp.csr_matrix:
+    A = sp.csr_matrix(A)
+    A.sum_duplicates()
+    return A

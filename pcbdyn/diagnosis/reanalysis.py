@@ -1,0 +1,169 @@
+"""Eigen-solutions near a solved state without re-solving: Rayleigh-Ritz on the state's modes and
+their static corrections (the combined approximations of structural reanalysis).
+
+Ranking a shortlist of candidate effects fits each with the declared parameters and the effects
+already chosen, a few Gauss-Newton steps apiece: a hundred full re-solves per search step. Every
+one of those fits starts from the same solved state (K, M, its modes Phi with eigenvalues Lambda)
+and moves a handful of directions d (each candidate's magnitude, the parameters), along which K and
+M change by dK_d, dM_d. The modes of K + sum a_d dK_d, M + sum a_d dM_d lie close to the span of
+
+    Phi  and  X_d = (K + mu M)^-1 (dK_d - dM_d Lambda) Phi   less its part along Phi
+
+(the first term of their change, thesis eqs. 3.8-3.14, with every mode above the computed ones
+answering quasi-statically: :func:`.residual.beyond_basis`). A point mass or a spring acts on a few
+DOFs, so its X_d has a rank of 1-3; the columns are compressed to their numerical rank. On that
+basis B the pencil is (B^T K B + sum a_d B^T dK_d B, ...), a few tens of rows: one small dense
+eigen-problem per trial instead of a sparse solve, the shapes at the points read as (read B) y and
+the sensitivities taken in B (phi_k^T dK phi_i = y_k^T B^T dK B y_i). A ranking fit needs its
+chi^2 to a fraction of the noise, not exactly: the fits that win are then re-fitted with full
+re-solves (:func:`.select.search`), which decide.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg as sla
+
+from .residual import ConfigState, State, beyond_basis, paired_state
+
+#: static-correction directions are compressed to the columns whose M-norm share exceeds this
+RANK_TOL = 1e-8
+#: eigenvalues below this share of the state's first elastic one are rigid-body modes
+RIGID_SHARE = 1e-6
+
+
+class _Modes:
+    """The part of :class:`pcbdyn.fe.modal.Modes` a paired state and its sensitivities read, in
+    the coefficients of a reduced basis: ``frequencies`` [Hz], ``n_rigid``, ``omega2``, ``coef``
+    (n_basis, n_rigid + n_elastic) of [rigid, elastic]."""
+
+    def __init__(self, lam, coef, n_rigid):
+        self.n_rigid, self.coef = n_rigid, coef
+        self.omega2 = lam[n_rigid:]
+        self.frequencies = np.sqrt(np.maximum(self.omega2, 0.0)) / (2.0 * np.pi)
+
+
+class _Config:
+    """One configuration's reanalysis: the state's modes, directions' static corrections (compressed)
+    and the products a basis of them needs, each made once."""
+
+    def __init__(self, ob, cs: ConfigState, n_modes: int):
+        self.ob, self.cs, self.n_modes = ob, cs, n_modes
+        self.phi = np.column_stack([cs.modes.rigid_shapes, cs.modes.shapes])
+        self.lam = np.r_[np.zeros(cs.modes.n_rigid), cs.modes.omega2]
+        self.paired = cs.modes.shapes[:, cs.pairs]
+        self.lam_p = cs.modes.omega2[cs.pairs]
+        self.read_phi = None if ob.shapes is None else np.asarray(ob.read @ self.phi)
+        self.K_phi, self.M_phi = cs.K @ self.phi, cs.M @ self.phi
+        self.X, self.KX, self.MX, self.read_X = {}, {}, {}, {}
+        self._moved: dict = {}
+
+    def correction(self, key, dK, dM) -> None:
+        """The compressed static correction of direction ``key`` (dK, dM), kept."""
+        if key in self.X:
+            return
+        F = dK @ self.paired - (dM @ self.paired) * self.lam_p[None, :]
+        X = beyond_basis(self.cs, self.phi, F)
+        X -= self.phi @ (self.phi.T @ (self.cs.M @ X))  # M-orthogonal to the modes (to round-off already)
+        d, U = np.linalg.eigh(X.T @ (self.cs.M @ X))
+        keep = d > RANK_TOL * max(d.max(initial=0.0), 1e-300)
+        X = X @ (U[:, keep] / np.sqrt(d[keep]))
+        self.X[key], self.KX[key], self.MX[key] = X, self.cs.K @ X, self.cs.M @ X
+        self.read_X[key] = None if self.read_phi is None else np.asarray(self.ob.read @ X)
+
+    def moved(self, key, dK, dM, keys) -> tuple:
+        """(B^T dK B, B^T dM B) of direction ``key`` on the basis [phi, X_k for k in ``keys``]."""
+        full = (key, tuple(keys))
+        if full not in self._moved:
+            B = np.column_stack([self.phi] + [self.X[k] for k in keys])
+            self._moved[full] = (B.T @ (dK @ B), B.T @ (dM @ B))
+        return self._moved[full]
+
+    def basis(self, keys) -> tuple:
+        """(K_B, M_B, T, points): the state's pencil on [phi, X_k], the M-orthonormal change of
+        basis T that drops dependent columns, and the basis at the points (None without shapes)."""
+        B = np.column_stack([self.phi] + [self.X[k] for k in keys])
+        KB = B.T @ np.column_stack([self.K_phi] + [self.KX[k] for k in keys])
+        MB = B.T @ np.column_stack([self.M_phi] + [self.MX[k] for k in keys])
+        KB, MB = 0.5 * (KB + KB.T), 0.5 * (MB + MB.T)
+        d, U = np.linalg.eigh(MB)
+        keep = d > 1e-10 * d.max()
+        T = U[:, keep] / np.sqrt(d[keep])
+        points = None if self.read_phi is None else np.column_stack([self.read_phi] + [self.read_X[k] for k in keys])
+        return KB, MB, T, points
+
+
+class Reanalysis:
+    """Reduced evaluations of the residual ``res`` near its solved state ``st`` (module doc).
+    ``evaluate(p, candidates, values)`` and ``effect_columns(state, candidates)`` stand in for the
+    residual's own, for states reached from ``st`` by moving the declared parameters and the
+    candidates' magnitudes."""
+
+    def __init__(self, res, st: State):
+        self.res, self.st = res, st
+        self.base = {c.name: v for c, v in zip(st.candidates, st.values)}
+        self.configs = [_Config(ob, cs, res.n_modes(ob)) for ob, cs in zip(res.observations, st.configs)]
+        models = [cs.model for cs in st.configs]
+        self.param_derivs = res.derivatives(st.p, models) if res.n_params else [[] for _ in models]
+        self._bases: dict = {}
+
+    def _derivative(self, k: int, c):
+        return self.res.effects.derivative(k, self.st.configs[k].model, c, self.st.p)
+
+    def _directions(self, candidates) -> list:
+        """The candidates a fit moves: its own, then the solved state's effects it leaves out
+        (they go back to zero)."""
+        names = {c.name for c in candidates}
+        return list(candidates) + [c for c in self.st.candidates if c.name not in names]
+
+    def _basis(self, k: int, candidates) -> tuple:
+        """Configuration k's reduced pencil for a fit of ``candidates`` (with every parameter)."""
+        dirs = self._directions(candidates)
+        key = (k, tuple(c.name for c in dirs))
+        if key not in self._bases:
+            cfg = self.configs[k]
+            for c in dirs:
+                cfg.correction(c.name, *self._derivative(k, c))
+            names = [c.name for c in dirs]
+            KB, MB, T, points = cfg.basis(names)
+            moves = [cfg.moved(("p", j), dK, dM, names) for j, (dK, dM) in enumerate(self.param_derivs[k])]
+            moves += [cfg.moved(c.name, *self._derivative(k, c), names) for c in dirs]
+            self._bases[key] = (KB, MB, T, points, moves)
+        return self._bases[key]
+
+    def evaluate(self, p, candidates=(), values=()) -> State:
+        """The state at parameters ``p`` [SI] with ``candidates`` at ``values`` (the solved state's
+        effects not among them at zero), from the reduced pencils; first order in the parameters."""
+        p = np.asarray(p, float)
+        st = State(p, list(candidates), np.asarray(values, float))
+        dirs = self._directions(candidates)
+        to = dict(zip((c.name for c in candidates), st.values))
+        steps = np.r_[p - self.st.p, [to.get(c.name, 0.0) - self.base.get(c.name, 0.0) for c in dirs]]
+        for k, cfg in enumerate(self.configs):
+            KB, MB, T, points, moves = self._basis(k, candidates)
+            K = KB + sum(a * GK for a, (GK, _) in zip(steps, moves) if a != 0.0)
+            M = MB + sum(a * GM for a, (_, GM) in zip(steps, moves) if a != 0.0)
+            lam, Z = sla.eigh(T.T @ K @ T, T.T @ M @ T)
+            coef = T @ Z
+            first = cfg.lam[cfg.cs.modes.n_rigid] if cfg.lam.size > cfg.cs.modes.n_rigid else 1.0
+            nr = int(np.count_nonzero(lam < RIGID_SHARE * first))
+            keep = np.r_[np.arange(nr), nr + np.arange(min(cfg.n_modes, lam.size - nr))]
+            modes = _Modes(lam[keep], coef[:, keep], nr)
+            at_points = None if points is None else points @ modes.coef
+            U = None if at_points is None else at_points[:, nr:]
+            st.configs.append(paired_state(cfg.ob, cfg.cs.model, None, None, modes, U, at_points))
+        return st
+
+    def effect_columns(self, st: State, candidates) -> np.ndarray:
+        """(n_rows, n_candidates) of a reduced state (the candidates among its fit's)."""
+        names = [c.name for c in self._directions(st.candidates)]
+        out = []
+        for k, (ob, cs) in enumerate(zip(self.res.observations, st.configs)):
+            moves = self._basis(k, st.candidates)[4]
+            n_par = len(self.param_derivs[k])
+            C = cs.modes.coef
+            paired = C[:, cs.modes.n_rigid + cs.pairs]
+            BK = np.stack([C.T @ moves[n_par + names.index(c.name)][0] @ paired for c in candidates])
+            BM = np.stack([C.T @ moves[n_par + names.index(c.name)][1] @ paired for c in candidates])
+            out.append(self.res._columns(ob, cs, BK, BM))
+        return np.vstack(out)

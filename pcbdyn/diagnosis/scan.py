@@ -1,0 +1,111 @@
+"""Ranking trial fits: which of several sets of effects fits the data best, at the least cost.
+
+Forward selection (:func:`.select.search`) ranks a shortlist of candidates, each fitted with the
+effects already chosen and the declared parameters for a few Gauss-Newton steps; the local search
+(:func:`.select.refine`) ranks the moves of each effect found. Every trial starts from one solved
+state, so each is first fitted on that state's reanalysis (:mod:`.reanalysis`: no sparse solve),
+and only the :data:`FULL_RANK` best of those, with the trials a reanalysis cannot follow (adding or
+removing a rib changes the modes beyond a first-order basis: kinds with ``reanalysed = False``),
+are fitted again with full re-solves, which decide. Those full fits are independent jobs: they run
+in local worker processes or on a Dask cluster (:func:`pcbdyn.parallel.run_jobs`) when a
+:class:`Runner` says so, with the same results as in this process.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..parallel import run_jobs
+from .catalogue import kind
+from .reanalysis import Reanalysis
+from .fitting import RANK_STEPS, Fit, estimate
+
+#: the quick fits' best this many are fitted again with full re-solves
+FULL_RANK = 3
+#: a quick fit's chi^2 is trusted to this share of the solved state's (a reanalysis is first order
+#: in the parameters; measured within 0.1 % on the bench's kinds but ribs)
+SCREEN_MARGIN = 0.05
+
+
+@dataclass
+class Runner:
+    """Where full trial fits run: ``workers`` local processes (1: this process; None: the cores) or
+    the Dask cluster at ``scheduler``; ``progress(msg)`` is told how many of a scan are done."""
+
+    workers: int | None = 1
+    scheduler: object = None
+    progress: object = None
+
+    def map(self, fn, jobs: list, shared, what: str = "fits") -> list:
+        """``fn(*job, shared)`` for every job, results in the jobs' order."""
+        if not jobs:
+            return []
+        count = [0]
+
+        def done(_):
+            count[0] += 1
+            if self.progress is not None:
+                self.progress(f"{count[0]} of {len(jobs)} {what}")
+
+        out = sorted(run_jobs(fn, [(k, *job) for k, job in enumerate(jobs)], shared, self.workers, self.scheduler, done),
+                     key=lambda item: item[0][0])
+        return [result for _, result in out]
+
+
+def _full_fit(k, cands, v0, p, shared):
+    """One full trial fit (a job): (chi^2, magnitudes, parameters)."""
+    res, bounds, P = shared
+    fit = estimate(res, p, cands, v0, RANK_STEPS, bounds, param_columns=P)
+    return fit.chi2, fit.values, fit.p
+
+
+def _followed(state, cands) -> bool:
+    """True when a reanalysis of ``state`` can follow the trial ``cands``: every effect it adds or
+    drops is of a kind a first-order basis follows."""
+    here, there = {c.name for c in state.candidates}, {c.name for c in cands}
+    changed = [c for c in list(cands) + list(state.candidates) if (c.name in here) != (c.name in there)]
+    return all(getattr(kind(c.kind), "reanalysed", True) for c in changed)
+
+
+def worth_full(res, state, trials: list, p, bounds, limit: float, steps: int = RANK_STEPS) -> list:
+    """For each of ``trials`` = [(candidates, initial magnitudes)] from the solved ``state``: False
+    where its quick fit on the state's reanalysis leaves chi^2 above ``limit`` by more than the
+    reanalysis can be off (:data:`SCREEN_MARGIN` of the state's chi^2), so that no full fit could
+    reach it; True otherwise (and for the trials a reanalysis cannot follow). ``steps``: Gauss-Newton
+    steps of the quick fits (as many as the full fits they stand for, so that only the reanalysis
+    differs)."""
+    rx = P = None
+    out = []
+    for cands, v0 in trials:
+        if not _followed(state, cands):
+            out.append(True)
+            continue
+        if rx is None:  # the parameters' columns are held: a reanalysed state has no full modes
+            rx, P = Reanalysis(res, state), res.param_columns(state)
+        quick = estimate(res, p, cands, v0, steps, bounds, param_columns=P, reduced=rx)
+        out.append(bool(quick.chi2 <= limit + SCREEN_MARGIN * state.chi2))
+    return out
+
+
+def rank(res, state, trials: list, p, bounds, P, runner: Runner | None = None) -> list:
+    """Fits of ``trials`` = [(candidates, initial magnitudes)] from the solved ``state`` (declared
+    parameters from ``p``, their columns ``P`` held): a :class:`.select.Fit` with full re-solves
+    for the trials that decide (module doc), None for the others."""
+    runner = runner or Runner()
+    quick = [k for k, (cands, _) in enumerate(trials) if _followed(state, cands)]
+    full = [k for k in range(len(trials)) if k not in quick]
+    if len(quick) > FULL_RANK:
+        rx = Reanalysis(res, state)
+        chi2 = [estimate(res, p, trials[k][0], trials[k][1], RANK_STEPS, bounds, param_columns=P, reduced=rx).chi2
+                for k in quick]
+        quick = [quick[i] for i in np.argsort(chi2, kind="stable")[:FULL_RANK]]
+        if runner.progress is not None:
+            runner.progress(f"{len(chi2)} of {len(trials)} trials screened on the reanalysis")
+    chosen = sorted(quick + full)
+    done = runner.map(_full_fit, [(trials[k][0], trials[k][1], p) for k in chosen], (res, bounds, P), "trial fits")
+    out: list = [None] * len(trials)
+    for k, (chi2, values, fp) in zip(chosen, done):
+        out[k] = Fit(fp, values, None, np.zeros((0, 0)), chi2_value=chi2)
+    return out

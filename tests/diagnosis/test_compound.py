@@ -1,0 +1,85 @@
+"""Additions that bring stiffness and mass together (issue 26): ``pcbdyn diagnose`` on simulated tests
+(:mod:`bench_cases`: the truth meshed four times finer than the model, 0.2 % / 2 % noise) of the
+free six-part card carrying
+
+- an aluminium flat bar 10 x 4 mm glued across the card: a beam with its own mass (17.5 g over the
+  162 mm), found as a ``stiffener`` whose section (aluminium, 4 mm high, :class:`RibSection`) makes
+  its mass follow from its bending stiffness;
+- a bracket: a 15 g mass on a 1e5 N/m spring to the frame at one point, found as a mass and the
+  spring under it (the selection tries a spring on the nodes of a mass found).
+
+Each: every part of the addition within 30 % and the max frequency error after <= 0.5 %.
+
+Not met yet (strict xfails, so that a fix shows): measured on branch ``diag`` at 80bac8f, the
+diagnosis reports nothing on either (see the reasons).
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import bench_cases as bc  # noqa: E402
+from test_diagnose_bench import match  # noqa: E402
+
+from pcbdyn.board.entries import RibSection  # noqa: E402
+from pcbdyn.cli import main  # noqa: E402
+
+BAR_B, SECTION = 10e-3, RibSection()
+BAR_EI = SECTION.E * BAR_B * SECTION.h**3 / 12.0  # 3.73 N m^2
+BAR_Y = 0.112
+BRACKET_AT = (0.081, 0.113)
+BAR = bc.Case("compound_al_bar", "card", (bc.Effect("stiffener", BAR_EI, path=((0.0, BAR_Y), (0.162, BAR_Y))),),
+              true_values=bc.CARD_TRUE, seed=21, note="an aluminium flat bar 10 x 4 mm glued across the card")
+BRACKET = bc.Case("compound_bracket", "card", (bc.Effect("point_mass", 15e-3, at=BRACKET_AT),
+                                               bc.Effect("ground_spring", 1e5, at=BRACKET_AT)),
+                  true_values=bc.CARD_TRUE, seed=22, note="a 15 g bracket on a 1e5 N/m spring to the frame")
+
+
+def _diagnose(case, folder: Path, kinds: str) -> tuple:
+    board, uffs, truth = bc.make_case(case, folder)
+    js = folder / "d.json"
+    args = ["diagnose", str(board), *bc.cli_tests(case, uffs), "--noise", f"f={case.noise[0]:g},shape={case.noise[1]:g}",
+            "--kinds", kinds, "--json", str(js)]
+    r = CliRunner().invoke(main, args)
+    assert r.exit_code == 0, r.output
+    return json.loads(js.read_text()), truth
+
+
+def _bar_mass(EI: float, length: float) -> float:
+    """Mass [kg] of a rib of the section's material and height with bending stiffness ``EI``."""
+    return SECTION.rho * (12.0 * EI / (SECTION.E * SECTION.h**3)) * SECTION.h * length
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="nothing reported: the parameters-only fit leaves 14.5 % (chi^2 3.9e5 for 703 "
+                   "degrees of freedom) and no stiffener trial is kept ('no candidate effect explains it beyond chance')")
+def test_glued_aluminium_bar_found_with_its_stiffness_and_mass(tmp_path):
+    data, truth = _diagnose(BAR, tmp_path, "stiffener,point_mass,line_mass")
+    (t,) = truth["effects"]
+    e, d = match(data["effects"], t)
+    assert e is not None and d <= max(15.0, 1e3 * bc.MODEL_MESH), data["effects"]
+    assert e["magnitude"] == pytest.approx(BAR_EI, rel=0.30)
+    true_mass = _bar_mass(BAR_EI, 0.162)
+    found_mass = _bar_mass(e["magnitude"], 1e-3 * abs(e["path_mm"][1][0] - e["path_mm"][0][0]))
+    found_mass += sum(x["magnitude"] for x in data["effects"] if x["type"] in ("point_mass", "line_mass"))
+    assert true_mass == pytest.approx(17.5e-3, rel=0.01) and found_mass == pytest.approx(true_mass, rel=0.30)
+    assert data["parameters_only"]["max_freq_error_pct"] > 2.0 and data["after"]["max_freq_error_pct"] <= 0.5
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="nothing reported: the bracket's own mode (test mode 1) has no model partner "
+                   "and is left out; the parameters-only fit leaves 3.3 % on the paired modes and no mass or spring "
+                   "trial is kept")
+def test_bracket_found_as_a_mass_on_a_spring(tmp_path):
+    data, truth = _diagnose(BRACKET, tmp_path, "point_mass,ground_spring")
+    for t in truth["effects"]:
+        e, d = match(data["effects"], t)
+        assert e is not None and d <= 15.0, (t["type"], data["effects"])
+        assert e["magnitude"] == pytest.approx(t["magnitude"], rel=0.30), (t["type"], e)
+    assert data["parameters_only"]["max_freq_error_pct"] > 2.0 and data["after"]["max_freq_error_pct"] <= 0.5

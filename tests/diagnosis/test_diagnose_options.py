@@ -1,0 +1,74 @@
+"""``pcbdyn diagnose --quick`` and ``--scheduler`` (issue 26) on a bench case (a standoff under the
+free card, :mod:`bench_cases`): a first look finds what the full run finds, and trial fits run on a
+Dask cluster give the full run's findings to rounding."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import bench_cases as bc  # noqa: E402
+from test_diagnose_bench import judge, location_error_mm  # noqa: E402
+
+from pcbdyn.cli import main  # noqa: E402
+
+CASE = bc.BY_NAME["gs_standoff"]
+#: the kinds searched (the standoff's and the one a point residual is most often mistaken for)
+KINDS = "ground_spring,point_mass"
+
+
+@pytest.fixture(scope="module")
+def case(tmp_path_factory):
+    return bc.make_case(CASE, tmp_path_factory.mktemp("options"))
+
+
+def _diagnose(case, out: Path, *extra) -> tuple:
+    board, uffs, truth = case
+    js = out / "d.json"
+    args = ["diagnose", str(board), *bc.cli_tests(CASE, uffs), "--noise", f"f={CASE.noise[0]:g},shape={CASE.noise[1]:g}",
+            "--kinds", KINDS, "--json", str(js), "--out", str(out / "o"), *extra]
+    r = CliRunner().invoke(main, args)
+    assert r.exit_code == 0, r.output
+    return json.loads(js.read_text()), r.output
+
+
+@pytest.fixture(scope="module")
+def default(case, tmp_path_factory):
+    data, _ = _diagnose(case, tmp_path_factory.mktemp("default"))
+    assert not judge(CASE, case[2], data)
+    return data
+
+
+def _same_findings(a: dict, b: dict, mag_rel: float, at_mm: float) -> None:
+    assert [e["type"] for e in a["effects"]] == [e["type"] for e in b["effects"]]
+    for x, y in zip(a["effects"], b["effects"]):
+        assert location_error_mm(x, {"at_mm": y["at_mm"]}) <= at_mm
+        assert x["magnitude"] == pytest.approx(y["magnitude"], rel=mag_rel)
+
+
+def test_quick_finds_what_the_full_run_finds(case, default, tmp_path):
+    """The first look: the standoff within the bench's tolerances (type, 15 mm, 30 %, after < 0.5 %),
+    at the full run's place within one model element and its stiffness within 10 %; the progress
+    names the one finer mesh level it measured."""
+    data, output = _diagnose(case, tmp_path, "--quick")
+    assert not judge(CASE, case[2], data)
+    _same_findings(data, default, 0.10, 1e3 * bc.MODEL_MESH)
+    assert "mesh level 1 of 1" in output and "mesh level 2 of" not in output
+    assert data["statistics"]["quick"] and not default["statistics"]["quick"]
+
+
+def test_scheduler_gives_the_same_findings(case, default, tmp_path):
+    """Trial fits on a Dask cluster (in this process): the default run's findings to rounding."""
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None) as cl:
+        data, output = _diagnose(case, tmp_path, "--scheduler", cl.scheduler_address)
+    assert "trial fits" in output
+    _same_findings(data, default, 1e-6, 1e-3)
+    assert data["after"]["max_freq_error_pct"] == pytest.approx(default["after"]["max_freq_error_pct"], rel=1e-6)
+    assert np.isfinite(data["effects"][0]["uncertainty"])
