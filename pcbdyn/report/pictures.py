@@ -18,11 +18,11 @@ import json
 import os
 import subprocess
 import sys
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from ..atomic import temporary_folder
 from .files import atomic_path
 
 CMAP = "coolwarm"
@@ -173,7 +173,7 @@ def mode_pictures(vtu: Path, model, frequencies, shapes, out_dir: Path, prefix: 
     tris = [c for c in cells if c.shape[1] == 3] + [c[:, [0, 1, 2]] for c in cells if c.shape[1] == 4]
     tris += [c[:, [0, 2, 3]] for c in cells if c.shape[1] == 4]
     tri = Triangulation(model.nodes[:, 0] * 1e3, model.nodes[:, 1] * 1e3, np.concatenate(tris))
-    with tempfile.TemporaryDirectory(prefix="pcbdyn-views-") as views:
+    with temporary_folder("pcbdyn-views") as views:
         renderer = "pyvista" if _render_child(vtu, Path(views), names) else "matplotlib"
         for k, (name, f) in enumerate(zip(names, frequencies)):
             w = shapes[2::6, k]
@@ -188,13 +188,15 @@ def mode_pictures(vtu: Path, model, frequencies, shapes, out_dir: Path, prefix: 
 
 
 def _render_child(vtu: Path, folder: Path, names: list, quantity: str = "w") -> bool:
-    """Run :func:`render_pyvista` in a child process; True when every view was written."""
-    code = ("import sys, json; from pathlib import Path; from pcbdyn.report.pictures import render_pyvista; "
-            "a = json.loads(sys.argv[1]); render_pyvista(Path(a[0]), Path(a[1]), a[2], a[3])")
+    """Run :func:`render_pyvista` in a child process (which dies with this one:
+    :func:`pcbdyn.children.die_with_parent`); True when every view was written."""
+    code = ("import sys, json; from pathlib import Path; from pcbdyn.children import die_with_parent; "
+            "a = json.loads(sys.argv[1]); die_with_parent(a[4]); from pcbdyn.report.pictures import render_pyvista; "
+            "render_pyvista(Path(a[0]), Path(a[1]), a[2], a[3])")
     env = {**os.environ, "VTK_DEFAULT_OPENGL_WINDOW": os.environ.get("VTK_DEFAULT_OPENGL_WINDOW",
                                                                        "vtkEGLRenderWindow")}
     try:
-        res = subprocess.run([sys.executable, "-c", code, json.dumps([str(vtu), str(folder), names, quantity])],
+        res = subprocess.run([sys.executable, "-c", code, json.dumps([str(vtu), str(folder), names, quantity, os.getpid()])],
                              env=env, capture_output=True, timeout=600)
     except subprocess.TimeoutExpired:
         return False
