@@ -22,7 +22,6 @@ import pytest
 from click.testing import CliRunner
 
 import pcbdyn
-from pcbdyn.children import alive, descendants
 from pcbdyn.cli import main
 
 CORPUS = Path(__file__).resolve().parent / "corpus"
@@ -86,6 +85,21 @@ def test_a_tiny_mesh_size_ends_at_once_with_an_estimate(tmp_path):
             print(exc)
         """, 120)
     assert "board.toml: board.mesh_size" in r.stdout and "DOFs" in r.stdout, r.stdout + r.stderr
+
+
+def test_gmsh_is_stopped_at_its_time_limit(tmp_path):
+    """gmsh ran in-process without a limit (a hang on a mesh it cannot finish); now it runs in a child
+    that is killed at PCBDYN_MESH_TIMEOUT, and the build ends with one error line naming board.toml."""
+    board = tmp_path / "board.toml"
+    board.write_text(BOARD.read_text())
+    env = {**os.environ, "PYTHONPATH": PACKAGE_ROOT, "OPENBLAS_NUM_THREADS": "1", "PCBDYN_MESH_TIMEOUT": "0.001"}
+    t0 = time.monotonic()
+    r = subprocess.run([sys.executable, "-c", "from pcbdyn.cli import main; main()", "build", str(board),
+                        "--no-pictures"], env=env, capture_output=True, text=True, timeout=120)
+    errors = [ln for ln in r.stderr.splitlines() if ln.startswith("error:")]
+    assert r.returncode == 2 and len(errors) == 1, r.stdout + r.stderr
+    assert "board.toml" in errors[0] and "PCBDYN_MESH_TIMEOUT" in errors[0], errors[0]
+    assert time.monotonic() - t0 < 60
 
 
 def test_quantities_that_hung_end_at_once():
@@ -230,6 +244,8 @@ def test_a_killed_writer_leaves_no_temporary_file(tmp_path):
 
 def _children(pid: int, marker: str) -> list:
     """Live descendants of ``pid`` whose command line holds ``marker``."""
+    from processes import descendants
+
     out = []
     for c in descendants(pid):
         try:
@@ -242,6 +258,7 @@ def _children(pid: int, marker: str) -> list:
 
 def test_the_picture_renderer_dies_with_a_killed_build(tmp_path):
     """The pyvista renderer (a child process) outlived a killed build by up to 2 s; now it dies with it."""
+    from processes import alive
     board = _card(tmp_path)
     env = {**os.environ, "PYTHONPATH": PACKAGE_ROOT, "OPENBLAS_NUM_THREADS": "1"}
     build = subprocess.Popen([sys.executable, "-c", "from pcbdyn.cli import main; main()", "build", str(board),

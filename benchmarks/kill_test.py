@@ -1,0 +1,169 @@
+"""Kill test (issue 22): runs that write results are stopped by SIGKILL at random points, and what they
+leave is checked. Each case first runs to the end twice into its output folder (the earlier results, and
+a check that the command writes the same bytes each time); then every trial starts the same run again
+and kills it at a random time within its usual duration. After each kill:
+
+- every earlier file (inputs and earlier results) has its earlier SHA-256 (a run rewrites a result with
+  the same bytes, so any other hash is a half-written or lost file);
+- no temporary file is left where the results go (``.*.pcbdyn~*``): counted right after the kill, and
+  again after the next trial's run, whose first write removes those of killed runs;
+- how many earlier files the run had already rewritten (same bytes, new time) before it was killed, to
+  show the kills land among the writes too;
+- no child process of the killed run (the gmsh mesher, the picture renderer) is still alive 0.5 s later.
+
+Cases: ``build --all-configs`` of the six-part card (three configurations, pictures), ``update`` of the
+card against the thesis' measured frequencies (iterations.png, tables, board.updated.toml) and ``build``
+of the plain plate with its JSON. Prints per case and in all: kills, files changed, temporary files
+after the kill and after the next run, orphaned processes; exits 1 on any change, leftover or orphan.
+
+Run: python benchmarks/kill_test.py [--kills 50] [--seed N]
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import os
+import random
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tests" / "fuzz"))
+
+from processes import alive, descendants  # noqa: E402
+
+from pcbdyn.atomic import MARK  # noqa: E402
+
+CARD = ROOT / "examples" / "six_part_card"
+PLATE = ROOT / "examples" / "plain_plate"
+
+
+def cases(work: Path) -> dict:
+    """name -> (argument list, folder the run writes into) for each case, inputs copied into ``work``."""
+    out = {}
+    for name, src, files in (("build", CARD, ("board.toml",)), ("update", CARD, ("board.toml",
+                             "measured_frequencies_table_7_2.csv")), ("build-json", PLATE, ("board.toml",))):
+        folder = work / name
+        folder.mkdir()
+        for f in files:
+            shutil.copy(src / f, folder / f)
+        out[name] = folder
+    b = out["build"]
+    u = out["update"]
+    p = out["build-json"]
+    return {
+        "build": (["build", b / "board.toml", "--all-configs", "--out", b / "out", "--json", b / "out" / "modes.json"], b),
+        "update": (["update", u / "board.toml", "--frequencies", u / "measured_frequencies_table_7_2.csv",
+                    "--max-iter", "2", "--out", u / "out", "--force", "--json", u / "out" / "update.json"], u),
+        "build-json": (["build", p / "board.toml", "--no-pictures", "--out", p / "out", "--json", p / "modes.json"], p),
+    }
+
+
+def start(args) -> subprocess.Popen:
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "OPENBLAS_NUM_THREADS": "1"}
+    return subprocess.Popen([sys.executable, "-c", "from pcbdyn.cli import main; main()", *map(str, args)], env=env,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+
+def digests(folder: Path) -> dict:
+    return {p.relative_to(folder).as_posix(): hashlib.sha256(p.read_bytes()).hexdigest()
+            for p in sorted(folder.rglob("*")) if p.is_file() and MARK not in p.name}
+
+
+def stamps(folder: Path) -> dict:
+    return {p: p.stat().st_mtime_ns for p in folder.rglob("*") if p.is_file()}
+
+
+def temporaries(folder: Path) -> list:
+    return [p for p in folder.rglob(f"*{MARK}*")]
+
+
+def complete_run(args) -> float:
+    t0 = time.perf_counter()
+    p = start(args)
+    if p.wait() != 0:
+        raise SystemExit(f"pcbdyn {' '.join(map(str, args))} failed (exit {p.returncode})")
+    return time.perf_counter() - t0
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--kills", type=int, default=50)
+    ap.add_argument("--seed", type=int, default=int(time.time()))
+    a = ap.parse_args()
+    rng = random.Random(a.seed)
+    print(f"seed {a.seed}", file=sys.stderr)
+    totals = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        runs = cases(Path(tmp))
+        durations, earlier = {}, {}
+        for name, (args, folder) in runs.items():
+            complete_run(args)
+            first = digests(folder)
+            durations[name] = complete_run(args)
+            earlier[name] = digests(folder)
+            differ = sorted(k for k in first if first[k] != earlier[name].get(k))
+            if differ:
+                raise SystemExit(f"{name}: two complete runs wrote different bytes in {differ}: no hash test possible")
+            print(f"  {name}: a complete run takes {durations[name]:.1f} s and writes {len(earlier[name])} files",
+                  file=sys.stderr)
+        names = list(runs)
+        pending = {}  # case -> temporaries its last killed run left
+        for k in range(a.kills):
+            name = names[k % len(names)]
+            args, folder = runs[name]
+            t = totals.setdefault(name, {"kills": 0, "changed": 0, "lost": 0, "tmp_at_kill": 0, "tmp_after_next": 0,
+                                         "orphans": 0, "finished": 0, "rewritten": 0})
+            before = stamps(folder)
+            delay = rng.uniform(0.3, durations[name])
+            p = start(args)
+            kids, t_end = set(), time.monotonic() + delay
+            while time.monotonic() < t_end and p.poll() is None:
+                kids |= descendants(p.pid)
+                time.sleep(0.02)
+            kids |= descendants(p.pid)
+            finished = p.poll() is not None
+            p.kill()
+            p.wait()
+            t["kills"] += 1
+            t["finished"] += finished
+            if name in pending:  # the previous kill of this case left temporaries: this run's writes clear them
+                t["tmp_after_next"] += len([q for q in pending.pop(name) if q.exists()])
+            time.sleep(0.5)
+            t["orphans"] += sum(alive(c) for c in kids)
+            for c in kids:  # leave no process behind whatever happened
+                if alive(c):
+                    os.kill(c, signal.SIGKILL)
+            after = stamps(folder)
+            t["rewritten"] += sum(1 for f, m in before.items() if after.get(f, m) != m)
+            now = digests(folder)
+            t["changed"] += sum(1 for f, h in earlier[name].items() if f in now and now[f] != h)
+            t["lost"] += sum(1 for f in earlier[name] if f not in now)
+            left = temporaries(folder)
+            t["tmp_at_kill"] += len(left)
+            if left:
+                pending[name] = left
+            print(f"  kill {k + 1:>3} {name:<11} at {delay:5.1f} s: {len(left)} temporaries, "
+                  f"{sum(alive(c) for c in kids)} orphans", file=sys.stderr)
+        for name, (args, folder) in runs.items():  # one last complete run: it removes what kills left
+            if name in pending:
+                complete_run(args)
+                totals[name]["tmp_after_next"] += len([q for q in pending.pop(name) if q.exists()])
+                totals[name]["changed"] += sum(1 for f, h in earlier[name].items() if digests(folder).get(f) != h)
+    cols = ["kills", "finished", "rewritten", "changed", "lost", "tmp_at_kill", "tmp_after_next", "orphans"]
+    print(f"{'case':<12}" + "".join(f"{c:>15}" for c in cols))
+    for name, t in totals.items():
+        print(f"{name:<12}" + "".join(f"{t[c]:>15}" for c in cols))
+    print(f"{'all':<12}" + "".join(f"{sum(t[c] for t in totals.values()):>15}" for c in cols))
+    bad = sum(t[c] for t in totals.values() for c in ("changed", "lost", "tmp_after_next", "orphans"))
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
