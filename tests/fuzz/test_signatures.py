@@ -87,11 +87,16 @@ def test_a_tiny_mesh_size_ends_at_once_with_an_estimate(tmp_path):
     assert "board.toml: board.mesh_size" in r.stdout and "DOFs" in r.stdout, r.stdout + r.stderr
 
 
+def _card(tmp_path) -> Path:
+    card = ROOT / "examples" / "six_part_card"
+    shutil.copy(card / "board.toml", tmp_path / "board.toml")
+    return tmp_path / "board.toml"
+
+
 def test_gmsh_is_stopped_at_its_time_limit(tmp_path):
     """gmsh ran in-process without a limit (a hang on a mesh it cannot finish); now it runs in a child
     that is killed at PCBDYN_MESH_TIMEOUT, and the build ends with one error line naming board.toml."""
-    board = tmp_path / "board.toml"
-    board.write_text(BOARD.read_text())
+    board = _card(tmp_path)
     env = {**os.environ, "PYTHONPATH": PACKAGE_ROOT, "OPENBLAS_NUM_THREADS": "1", "PCBDYN_MESH_TIMEOUT": "0.001"}
     t0 = time.monotonic()
     r = subprocess.run([sys.executable, "-c", "from pcbdyn.cli import main; main()", "build", str(board),
@@ -143,12 +148,6 @@ def test_a_shell_without_mass_is_named_with_its_file(tmp_path):
     r = CliRunner().invoke(main, ["build", str(board), "--no-pictures"])
     errors = [ln for ln in r.output.splitlines() if ln.startswith("error:")]
     assert r.exit_code == 2 and len(errors) == 1 and "board.toml: board." in errors[0], r.output
-
-
-def _card(tmp_path) -> Path:
-    card = ROOT / "examples" / "six_part_card"
-    shutil.copy(card / "board.toml", tmp_path / "board.toml")
-    return tmp_path / "board.toml"
 
 
 def test_update_json_is_json_when_the_condition_number_is_infinite(tmp_path):
