@@ -5,8 +5,9 @@ and kills it at a random time within its usual duration. After each kill:
 
 - every earlier file (inputs and earlier results) has its earlier SHA-256 (a run rewrites a result with
   the same bytes, so any other hash is a half-written or lost file);
-- no temporary file is left where the results go (``.*.pcbdyn~*``): counted right after the kill, and
-  again after the next trial's run, whose first write removes those of killed runs;
+- no temporary file is left where the results go (``.*.pcbdyn~*``), nor a stale temporary folder of the
+  picture renderer in the system's temporary folder: counted right after the kill, and again after the
+  next run of the same case, whose first write removes those of killed runs;
 - how many earlier files the run had already rewritten (same bytes, new time) before it was killed, to
   show the kills land among the writes too;
 - no child process of the killed run (the gmsh mesher, the picture renderer) is still alive 0.5 s later.
@@ -22,6 +23,7 @@ Run: python benchmarks/kill_test.py [--kills 50] [--seed N]
 from __future__ import annotations
 
 import argparse
+import fcntl
 import hashlib
 import os
 import random
@@ -81,7 +83,24 @@ def stamps(folder: Path) -> dict:
 
 
 def temporaries(folder: Path) -> list:
-    return [p for p in folder.rglob(f"*{MARK}*")]
+    """pcbdyn's temporary files in ``folder`` and the stale temporary folders (the picture views) in the
+    system's temporary folder: those whose lock no live process holds."""
+    return [p for p in folder.rglob(f"*{MARK}*")] + [p for p in Path(tempfile.gettempdir()).glob(f".*{MARK}*")
+                                                     if p.is_dir() and not held(p / ".lock")]
+
+
+def held(lock: Path) -> bool:
+    try:
+        fd = os.open(lock, os.O_RDONLY)
+    except OSError:
+        return False
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        return False
+    except OSError:
+        return True
+    finally:
+        os.close(fd)
 
 
 def complete_run(args) -> float:
