@@ -5,9 +5,9 @@ and kills it at a random time within its usual duration. After each kill:
 
 - every earlier file (inputs and earlier results) has its earlier SHA-256 (a run rewrites a result with
   the same bytes, so any other hash is a half-written or lost file);
-- no temporary file is left where the results go (``.*.pcbdyn~*``), nor a stale temporary folder of the
-  picture renderer in the system's temporary folder: counted right after the kill, and again after the
-  next run of the same case, whose first write removes those of killed runs;
+- temporary files where the results go (``.*.pcbdyn~*``) and stale temporary folders of the picture
+  renderer in the system's temporary folder: those a kill leaves are counted (tmp_at_kill), and those
+  still there after the next complete run of the case, whose writes must remove them (tmp_after_next);
 - how many earlier files the run had already rewritten (same bytes, new time) before it was killed, to
   show the kills land among the writes too;
 - no child process of the killed run (the gmsh mesher, the picture renderer) is still alive 0.5 s later.
@@ -133,7 +133,7 @@ def main() -> int:
             print(f"  {name}: a complete run takes {durations[name]:.1f} s and writes {len(earlier[name])} files",
                   file=sys.stderr)
         names = list(runs)
-        pending = {}  # case -> temporaries its last killed run left
+        pending = {}  # case -> temporaries its killed runs left, until a complete run
         for k in range(a.kills):
             name = names[k % len(names)]
             args, folder = runs[name]
@@ -152,8 +152,6 @@ def main() -> int:
             p.wait()
             t["kills"] += 1
             t["finished"] += finished
-            if name in pending:  # the previous kill of this case left temporaries: this run's writes clear them
-                t["tmp_after_next"] += len([q for q in pending.pop(name) if q.exists()])
             time.sleep(0.5)
             t["orphans"] += sum(alive(c) for c in kids)
             for c in kids:  # leave no process behind whatever happened
@@ -164,17 +162,19 @@ def main() -> int:
             now = digests(folder)
             t["changed"] += sum(1 for f, h in earlier[name].items() if f in now and now[f] != h)
             t["lost"] += sum(1 for f in earlier[name] if f not in now)
-            left = temporaries(folder)
-            t["tmp_at_kill"] += len(left)
-            if left:
+            left = set(temporaries(folder))
+            new = left - pending.get(name, set())
+            t["tmp_at_kill"] += len(new)
+            if finished:  # a complete run: its writes have removed what earlier kills left
+                t["tmp_after_next"] += len(left & pending.pop(name, set()))
+            elif left:
                 pending[name] = left
-            print(f"  kill {k + 1:>3} {name:<11} at {delay:5.1f} s: {len(left)} temporaries, "
+            print(f"  kill {k + 1:>3} {name:<11} at {delay:5.1f} s: {len(new)} temporaries, "
                   f"{sum(alive(c) for c in kids)} orphans", file=sys.stderr)
-        for name, (args, folder) in runs.items():  # one last complete run: it removes what kills left
-            if name in pending:
-                complete_run(args)
-                totals[name]["tmp_after_next"] += len([q for q in pending.pop(name) if q.exists()])
-                totals[name]["changed"] += sum(1 for f, h in earlier[name].items() if digests(folder).get(f) != h)
+        for name, (args, folder) in runs.items():  # a complete run of each case: it removes what kills left
+            complete_run(args)
+            totals[name]["tmp_after_next"] += len(set(temporaries(folder)) & pending.pop(name, set()))
+            totals[name]["changed"] += sum(1 for f, h in earlier[name].items() if digests(folder).get(f) != h)
     cols = ["kills", "finished", "rewritten", "changed", "lost", "tmp_at_kill", "tmp_after_next", "orphans"]
     print(f"{'case':<12}" + "".join(f"{c:>15}" for c in cols))
     for name, t in totals.items():

@@ -126,14 +126,15 @@ class Tally:
 
     def table(self) -> str:
         """One line per kind: inputs, ok, clean errors and each failure status."""
-        head = f"{'kind':<18}{'inputs':>8}{'ok':>7}{'clean':>7}" + "".join(f"{s:>10}" for s in FAILURES)
+        w = max([len(k) for k in self.kinds()] + [16]) + 2
+        head = f"{'kind':<{w}}{'inputs':>8}{'ok':>7}{'clean':>7}" + "".join(f"{s:>10}" for s in FAILURES)
         rows = [head]
         total = Counter()
         for k in self.kinds():
             n = {s: self.counts[k, s] for s in ("ok", "clean", *FAILURES)}
             total.update(n)
-            rows.append(f"{k:<18}{sum(n.values()):>8}{n['ok']:>7}{n['clean']:>7}"
+            rows.append(f"{k:<{w}}{sum(n.values()):>8}{n['ok']:>7}{n['clean']:>7}"
                         + "".join(f"{n[s]:>10}" for s in FAILURES))
-        rows.append(f"{'all':<18}{sum(total.values()):>8}{total['ok']:>7}{total['clean']:>7}"
+        rows.append(f"{'all':<{w}}{sum(total.values()):>8}{total['ok']:>7}{total['clean']:>7}"
                     + "".join(f"{total[s]:>10}" for s in FAILURES))
         return "\n".join(rows)
