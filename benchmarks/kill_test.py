@@ -82,11 +82,11 @@ def stamps(folder: Path) -> dict:
     return {p: p.stat().st_mtime_ns for p in folder.rglob("*") if p.is_file()}
 
 
-def temporaries(folder: Path) -> list:
-    """pcbdyn's temporary files in ``folder`` and the stale temporary folders (the picture views) in the
-    system's temporary folder: those whose lock no live process holds."""
+def temporaries(folder: Path, views: bool) -> list:
+    """pcbdyn's temporary files in ``folder`` and, with ``views`` (a case that renders pictures), the stale
+    temporary folders of the picture views in the system's temporary folder (no live process holds them)."""
     return [p for p in folder.rglob(f"*{MARK}*")] + [p for p in Path(tempfile.gettempdir()).glob(f".*{MARK}*")
-                                                     if p.is_dir() and not held(p / ".lock")]
+                                                     if views and p.is_dir() and not held(p / ".lock")]
 
 
 def held(lock: Path) -> bool:
@@ -162,7 +162,7 @@ def main() -> int:
             now = digests(folder)
             t["changed"] += sum(1 for f, h in earlier[name].items() if f in now and now[f] != h)
             t["lost"] += sum(1 for f in earlier[name] if f not in now)
-            left = set(temporaries(folder))
+            left = set(temporaries(folder, "--no-pictures" not in args))
             new = left - pending.get(name, set())
             t["tmp_at_kill"] += len(new)
             if finished:  # a complete run: its writes have removed what earlier kills left
@@ -173,7 +173,7 @@ def main() -> int:
                   f"{sum(alive(c) for c in kids)} orphans", file=sys.stderr)
         for name, (args, folder) in runs.items():  # a complete run of each case: it removes what kills left
             complete_run(args)
-            totals[name]["tmp_after_next"] += len(set(temporaries(folder)) & pending.pop(name, set()))
+            totals[name]["tmp_after_next"] += len(set(temporaries(folder, "--no-pictures" not in args)) & pending.pop(name, set()))
             totals[name]["changed"] += sum(1 for f, h in earlier[name].items() if digests(folder).get(f) != h)
     cols = ["kills", "finished", "rewritten", "changed", "lost", "tmp_at_kill", "tmp_after_next", "orphans"]
     print(f"{'case':<12}" + "".join(f"{c:>15}" for c in cols))
