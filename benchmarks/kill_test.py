@@ -44,6 +44,7 @@ from pcbdyn.atomic import MARK  # noqa: E402
 
 CARD = ROOT / "examples" / "six_part_card"
 PLATE = ROOT / "examples" / "plain_plate"
+VIEWS = "build"  # the case that renders mode pictures (through temporary view folders)
 
 
 def cases(work: Path) -> dict:
@@ -60,7 +61,8 @@ def cases(work: Path) -> dict:
     u = out["update"]
     p = out["build-json"]
     return {
-        "build": (["build", b / "board.toml", "--all-configs", "--out", b / "out", "--json", b / "out" / "modes.json"], b),
+        "build": (["build", b / "board.toml", "--all-configs", "--out", b / "out", "--json", b / "out" / "modes.json"],
+                  b),
         "update": (["update", u / "board.toml", "--frequencies", u / "measured_frequencies_table_7_2.csv",
                     "--max-iter", "2", "--out", u / "out", "--force", "--json", u / "out" / "update.json"], u),
         "build-json": (["build", p / "board.toml", "--no-pictures", "--out", p / "out", "--json", p / "modes.json"], p),
@@ -162,7 +164,7 @@ def main() -> int:
             now = digests(folder)
             t["changed"] += sum(1 for f, h in earlier[name].items() if f in now and now[f] != h)
             t["lost"] += sum(1 for f in earlier[name] if f not in now)
-            left = set(temporaries(folder, "--no-pictures" not in args))
+            left = set(temporaries(folder, name == VIEWS))
             new = left - pending.get(name, set())
             t["tmp_at_kill"] += len(new)
             if finished:  # a complete run: its writes have removed what earlier kills left
@@ -173,7 +175,8 @@ def main() -> int:
                   f"{sum(alive(c) for c in kids)} orphans", file=sys.stderr)
         for name, (args, folder) in runs.items():  # a complete run of each case: it removes what kills left
             complete_run(args)
-            totals[name]["tmp_after_next"] += len(set(temporaries(folder, "--no-pictures" not in args)) & pending.pop(name, set()))
+            left = set(temporaries(folder, name == VIEWS))
+            totals[name]["tmp_after_next"] += len(left & pending.pop(name, set()))
             totals[name]["changed"] += sum(1 for f, h in earlier[name].items() if digests(folder).get(f) != h)
     cols = ["kills", "finished", "rewritten", "changed", "lost", "tmp_at_kill", "tmp_after_next", "orphans"]
     print(f"{'case':<12}" + "".join(f"{c:>15}" for c in cols))
