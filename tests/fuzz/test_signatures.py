@@ -88,8 +88,10 @@ def test_a_tiny_mesh_size_ends_at_once_with_an_estimate(tmp_path):
 
 
 def _card(tmp_path) -> Path:
-    card = ROOT / "examples" / "six_part_card"
-    shutil.copy(card / "board.toml", tmp_path / "board.toml")
+    """The six-part card at a coarse mesh (13.5 mm: fast), as board.toml in ``tmp_path``."""
+    text = (ROOT / "examples" / "six_part_card" / "board.toml").read_text()
+    assert 'mesh_size = "6.75 mm"' in text
+    (tmp_path / "board.toml").write_text(text.replace('mesh_size = "6.75 mm"', 'mesh_size = "13.5 mm"'))
     return tmp_path / "board.toml"
 
 
