@@ -38,6 +38,10 @@ class Analysis:
     f_max: float | None = None
 
 
+#: most modes a structure's [analysis] (or a command's --modes) asks for
+MAX_MODES = 200
+
+
 class StructureError(ValueError):
     """A structure description, or data about it, that cannot be used: the message names the file,
     the field and the fix."""

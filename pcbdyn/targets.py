@@ -21,8 +21,8 @@ from typing import Callable
 import tomlkit
 
 from .domain import StructureError
-from .inputs import Reader
-from .units import UnitError, from_si, registry, to_si
+from .inputs import MAX_NAME, Reader
+from .units import UnitError, from_si, registry, shown, to_si
 
 
 class TargetError(StructureError):
@@ -119,10 +119,10 @@ def parse(text, collections=None) -> Target:
     if table or (len(parts) == 3 and parts[0] not in TABLES and all(parts)):
         if (parts[0], parts[-1]) in KINDS and (collections is None or parts[0] in collections):
             return Target(parts[0], None if table else parts[1], parts[-1])
-    close = difflib.get_close_matches(f"{parts[0]}.{parts[-1]}", [p.replace(".<name>", "").replace(".<ref>", "")
+    close = difflib.get_close_matches(f"{parts[0][:40]}.{parts[-1][:40]}", [p.replace(".<name>", "").replace(".<ref>", "")
                                                                   for p in patterns], n=1)
     hint = f"did you mean {close[0]}? " if close else ""
-    raise TargetError(f"'{text}' is not a target of this structure; {hint}targets are {', '.join(patterns)}")
+    raise TargetError(f"{shown(str(text))} is not a target of this structure; {hint}targets are {', '.join(patterns)}")
 
 
 def entry_name(collection: str, entry: dict, index: int) -> str:
@@ -164,10 +164,14 @@ def parameter_spec(entry: dict, where: str, value: Callable, file: str, collecti
     def fail(field, msg):
         raise TargetError(f"{file}: {where}{'.' + field if field else ''}: {msg}")
 
-    Reader(file, TargetError).table(entry, where, ["name", "target", "bounds"], required=["name", "target", "bounds"])
+    r = Reader(file, TargetError)
+    r.table(entry, where, ["name", "target", "bounds"], required=["name", "target", "bounds"])
+    name = r.text(entry["name"], f"{where}.name", MAX_NAME)
     raw = entry["target"] if isinstance(entry["target"], list) else [entry["target"]]
     if not raw:
         fail("target", "is empty; give one target or a list of targets that share the value")
+    for k, t in enumerate(raw):
+        r.text(t, f"{where}.target" + (f"[{k}]" if isinstance(entry["target"], list) else ""), 3 * MAX_NAME)
     values, kinds = [], []
     for t in raw:
         try:
@@ -196,13 +200,16 @@ def parameter_spec(entry: dict, where: str, value: Callable, file: str, collecti
         fail("bounds", f"must be finite, got {b!r}")
     if not lo < hi:
         fail("bounds", f"lower bound {b[0]!r} is not below the upper {b[1]!r}; swap them")
+    if lo < 0 or (lo == 0 and not any(k.log for k in kinds) and kinds[0].attribute not in ("mass", "inertia")):
+        fail("bounds", f"lower bound {b[0]!r} {'is negative' if lo < 0 else 'is 0'}: a {kinds[0].what} must stay "
+                       "above 0 while it is updated; give a positive lower bound")
     if not all(math.isclose(v, values[0], rel_tol=1e-12) for v in values):
         fail("target", f"the targets start from different values {values}; a shared parameter needs equal starting "
                        "values")
     if not lo <= values[0] <= hi:
         fail("bounds", f"the current value {values[0]:g} (SI) lies outside [{lo:g}, {hi:g}]; widen the bounds or "
                        "change the structure")
-    return ParameterSpec(str(entry["name"]), [str(t) for t in raw], (lo, hi), unit, all(k.log for k in kinds),
+    return ParameterSpec(name, [str(t) for t in raw], (lo, hi), unit, all(k.log for k in kinds),
                          values[0])
 
 

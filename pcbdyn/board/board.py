@@ -7,10 +7,13 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
+
 from .. import targets
 from ..atomic import write_checked
 from ..domain import Configured
-from ..inputs import Reader, read_toml
+from ..inputs import MAX_NAME, Reader, read_toml
+from ..units import shown
 from .entries import Analysis, BoardError, Component, Configuration, Outline
 from .laminate import Material
 from .enrich import enriched_text
@@ -163,13 +166,18 @@ def parse_board(data: dict, path: Path) -> Board:
                                          "smear", "transverse_shear"], required=["outline"])
     outline = read_outline(r, b["outline"])
     plate, iso = read_plate(r, b)
+    lo, hi = outline.bbox
+    if plate.t >= float(np.min(hi - lo)):
+        r.fail("board.thickness", f"{plate.t * 1e3:g} mm is as thick as the board is wide ({float(np.min(hi - lo)) * 1e3:g}"
+                                  " mm); a board is a plate: check the units")
     mesh_size = r.q(b.get("mesh_size", "5 mm"), "mm", "board.mesh_size", positive=True)
     smear = b.get("smear", "none")
     if smear not in ("none", "global"):
-        r.fail("board.smear", f"'{smear}' is not 'none' or 'global' (global: spread every part's mass over the board)")
+        r.fail("board.smear", f"{shown(smear)} is not 'none' or 'global' (global: spread every part's mass over the "
+                              "board)")
     shear = r.number(b.get("transverse_shear", 1.0), "board.transverse_shear", lo=0.0)
     board = Board(
-        name=str(b.get("name", Path(path).parent.name)), path=Path(path), outline=outline, plate=plate,
+        name=r.text(b["name"], "board.name", MAX_NAME) if "name" in b else Path(path).parent.name, path=Path(path), outline=outline, plate=plate,
         isotropic=iso, mesh_size=mesh_size, smear=smear, components=[], fixtures=[], masses=[],
         configurations=[], parameters=[], analysis=Analysis(), points=[], transverse_shear=shear,
     )
@@ -189,10 +197,12 @@ def parse_board(data: dict, path: Path) -> Board:
     for i, c in enumerate(r.list(data, "configurations")):
         where = f"configurations[{i}]"
         r.table(c, where, ["name", "masses"], required=["name"])
-        ms = [read_mass(r, m, f"{where}.masses[{j}]", board, j) for j, m in enumerate(c.get("masses", []))]
-        board.configurations.append(Configuration(str(c["name"]), ms))
+        name = r.name("configurations", c, i, where)
+        ms = [read_mass(r, m, f"{where}.masses[{j}]", board, j) for j, m in enumerate(r.list(c, "masses", f"{where}.masses"))]
+        r.unique([m.name for m in ms], f"{where}.masses", "name")
+        board.configurations.append(Configuration(name, ms))
     r.unique([c.name for c in board.configurations], "configurations", "name")
-    for i, p in enumerate(data.get("points", [])):
+    for i, p in enumerate(r.list(data, "points")):
         pt = r.point(p, f"points[{i}]")
         if not outline.contains(pt)[0]:
             r.fail(f"points[{i}]", f"{p} is not on the board; move it inside the outline")

@@ -14,6 +14,7 @@ from ..domain import Analysis, StructureError  # noqa: F401  (Analysis: a board 
 FIXTURE_TYPES = ("free", "clamped_edge", "hinged_edge", "wedge_lock", "standoff", "point_spring", "edge_spring")
 MIN_SEGMENT = 1e-4  # [m] shortest segment of an edge spring, line mass or stiffener piece
 GEOM_TOL = 1e-7  # [m] touching footprints or points on an edge are accepted within this
+MIN_SPAN = 1e-3  # [m] the narrowest a board's outline may be
 
 
 class BoardError(StructureError):

@@ -4,7 +4,40 @@ from __future__ import annotations
 
 import numpy as np
 
-from .entries import GEOM_TOL
+from .entries import GEOM_TOL, MIN_SEGMENT
+
+
+def polygon_problem(v) -> str | None:
+    """Why the closed polygon ``v`` (m, 2) [m] cannot be meshed (None when it can): corners closer than
+    :data:`MIN_SEGMENT` (a repeated vertex), or sides that cross or touch."""
+    from shapely import validation
+    from shapely.geometry import Polygon
+
+    v = np.asarray(v, dtype=float)
+    side = np.linalg.norm(np.roll(v, -1, axis=0) - v, axis=1)
+    if (side < MIN_SEGMENT).any():
+        k = int(np.argmax(side < MIN_SEGMENT))
+        return (f"corners {k} and {(k + 1) % len(v)} are {side[k] * 1e3:g} mm apart (a repeated point?); "
+                f"corners must be at least {MIN_SEGMENT * 1e3:g} mm apart")
+    poly = Polygon(v)
+    if not poly.is_valid:
+        return f"its sides cross or touch ({validation.explain_validity(poly)}); list the corners in order around it"
+    return None
+
+
+def hole_problem(outline_v, holes, hole) -> str | None:
+    """Why polygon ``hole`` cannot be cut from the board ``outline_v`` beside the ``holes`` before it
+    (None when it can): it must lie inside, clear of the edge and of the other holes."""
+    from shapely.geometry import Polygon
+
+    h = Polygon(hole)
+    board = Polygon(outline_v)
+    if not board.contains(h) or h.exterior.distance(board.exterior) < MIN_SEGMENT:
+        return "is not inside the outline (clear of its edge); move it or make it smaller"
+    for k, other in enumerate(holes):
+        if h.distance(Polygon(other)) < MIN_SEGMENT:
+            return f"overlaps or touches hole {k}; move one of them or merge them into one polygon"
+    return None
 
 
 def polys_overlap(p, q) -> bool:

@@ -1,4 +1,5 @@
-"""Quad-dominant shell meshes of a board with gmsh (OpenCASCADE kernel, in-process, quiet).
+"""Quad-dominant shell meshes of a board with gmsh (OpenCASCADE kernel, quiet, in a child process with a
+time limit: :func:`run_gmsh`).
 
 The board face is fragmented by every region that must own its own elements (part footprints)
 or whose outline element edges must follow (wedge-lock contact strips), and by the points that
@@ -19,7 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-_LOCK = threading.Lock()  # gmsh is one global state per process
+_LOCK = threading.Lock()  # gmsh is one global state per process (a child's, or this one's without fork)
 
 
 @dataclass
@@ -73,6 +74,35 @@ class BoardMesh:
             if (min(a, b), max(a, b)) not in known:
                 raise RuntimeError(f"segment {p0.tolist()} -> {p1.tolist()} m does not follow element edges")
         return chain
+
+
+#: [s] the longest gmsh may take to mesh one structure; the PCBDYN_MESH_TIMEOUT variable changes it
+MESH_TIMEOUT = 600.0
+
+
+def run_gmsh(fn, args):
+    """``fn(*args)`` (a function that meshes in a :func:`gmsh_session` and returns plain arrays) run in a
+    child process (:func:`pcbdyn.children.run_forked`) so that a mesh that does not finish within
+    :data:`MESH_TIMEOUT` (or PCBDYN_MESH_TIMEOUT) seconds ends with a message instead of a hang, and a
+    crash in gmsh cannot take pcbdyn down. gmsh's own errors come back as RuntimeError."""
+    import os
+
+    import gmsh  # noqa: F401 - loaded once here, inherited by every child
+
+    from ..children import run_forked
+
+    timeout = float(os.environ.get("PCBDYN_MESH_TIMEOUT", MESH_TIMEOUT))
+    try:
+        return run_forked(fn, args, timeout, "gmsh")
+    except TimeoutError as exc:
+        raise RuntimeError(f"{exc}; use a larger mesh size or simpler geometry, or raise PCBDYN_MESH_TIMEOUT "
+                           f"(now {timeout:g} s)") from None
+    except RuntimeError:
+        raise
+    except Exception as exc:  # gmsh raises bare Exceptions (e.g. for points it cannot join into a line)
+        if type(exc) is not Exception:
+            raise
+        raise RuntimeError(f"gmsh: {exc}") from None
 
 
 @contextmanager
@@ -187,11 +217,32 @@ def mesh_board(outline, regions, points, size: float, strips=(), lines=()) -> Bo
 
 
 def _mesh_board(outline, regions, points, size: float, strips=(), lines=()) -> BoardMesh:
+    """The mesh itself: gmsh in a child process under :func:`run_gmsh`'s time limit."""
+    xyz, cells, point_nodes = run_gmsh(_board_cells, (outline.vertices, outline.holes, regions, points, size, strips,
+                                                      lines))
+    nodes, new = used_nodes(xyz, cells)
+    for c in cells.values():
+        for k in c:
+            c[k] = _counter_clockwise(nodes, c[k])
+    pn = np.array([new[p] if p >= 0 else -1 for p in point_nodes], dtype=np.int64)
+    nodes[:, 2] = 0.0
+    missing = np.flatnonzero(pn < 0)
+    for i in missing:  # a point gmsh merged into an existing vertex: take the coincident node
+        d = np.linalg.norm(nodes[:, :2] - points[i], axis=1)
+        j = int(np.argmin(d))
+        if d[j] > 1e-7:
+            raise RuntimeError(f"point {points[i]} did not become a mesh node")
+        pn[i] = j
+    return BoardMesh(nodes, cells, pn)
+
+
+def _board_cells(vertices, holes, regions, points, size, strips, lines) -> tuple:
+    """(node xyz, cells {label: {etype: [conn, ...]}}, node row of each point) of the board meshed by gmsh."""
     with gmsh_session("board") as gmsh:
         occ = gmsh.model.occ
-        board = _polygon(occ, outline.vertices)
-        if outline.holes:
-            cut, _ = occ.cut([(2, board)], [(2, _polygon(occ, h)) for h in outline.holes])
+        board = _polygon(occ, vertices)
+        if holes:
+            cut, _ = occ.cut([(2, board)], [(2, _polygon(occ, h)) for h in holes])
             board_tags = [t for d, t in cut if d == 2]
         else:
             board_tags = [board]
@@ -231,21 +282,7 @@ def _mesh_board(outline, regions, points, size: float, strips=(), lines=()) -> B
                     )
                 key = "quad4" if npc == 4 else "tri3"
                 cells.setdefault(label, {}).setdefault(key, []).append(conn)
-        point_nodes = tagged_nodes(gmsh, point_tags, index)
-    nodes, new = used_nodes(xyz, cells)
-    for c in cells.values():
-        for k in c:
-            c[k] = _counter_clockwise(nodes, c[k])
-    pn = np.array([new[p] if p >= 0 else -1 for p in point_nodes], dtype=np.int64)
-    nodes[:, 2] = 0.0
-    missing = np.flatnonzero(pn < 0)
-    for i in missing:  # a point gmsh merged into an existing vertex: take the coincident node
-        d = np.linalg.norm(nodes[:, :2] - points[i], axis=1)
-        j = int(np.argmin(d))
-        if d[j] > 1e-7:
-            raise RuntimeError(f"point {points[i]} did not become a mesh node")
-        pn[i] = j
-    return BoardMesh(nodes, cells, pn)
+        return xyz, cells, tagged_nodes(gmsh, point_tags, index)
 
 
 def used_nodes(xyz, cells) -> tuple:

@@ -4,18 +4,19 @@
 from __future__ import annotations
 
 import numpy as np
-from matplotlib.path import Path as PolyPath
 
 from ..fe import ShellProperty
-from .entries import GEOM_TOL, Outline
+from ..units import shown
+from .entries import MIN_SPAN, Outline
+from .geometry import hole_problem, polygon_problem
 from .laminate import MATERIALS, LaminateProperty, Layer, Material
 
 
 def read_outline(r, o) -> Outline:
     r.table(o, "board.outline", ["width", "height", "polygon", "holes"])
     if "polygon" in o:
-        pts = o["polygon"]
-        if not isinstance(pts, list) or len(pts) < 3:
+        pts = r.list(o, "polygon", "board.outline.polygon")
+        if len(pts) < 3:
             r.fail("board.outline.polygon", "needs at least three points [[\"x mm\", \"y mm\"], ...]")
         v = np.array([r.point(p, f"board.outline.polygon[{i}]") for i, p in enumerate(pts)])
         rect = False
@@ -28,17 +29,24 @@ def read_outline(r, o) -> Outline:
         r.fail("board.outline", "give width and height, or polygon = [[\"x mm\", \"y mm\"], ...]")
     lo = v.min(axis=0)
     v = v - lo
+    where = "board.outline.polygon" if "polygon" in o else "board.outline"
+    if float(np.min(v.max(axis=0))) < MIN_SPAN:
+        r.fail(where, f"spans {float(np.min(v.max(axis=0))) * 1e3:g} mm across; a board spans at least "
+                      f"{MIN_SPAN * 1e3:g} mm (are the units right?)")
+    if (why := polygon_problem(v)) is not None:
+        r.fail(where, why)
     area2 = np.dot(v[:, 0], np.roll(v[:, 1], -1)) - np.dot(v[:, 1], np.roll(v[:, 0], -1))
-    if abs(area2) < 1e-12:
-        r.fail("board.outline.polygon", "encloses no area")
     if area2 < 0:
         v = v[::-1]
     holes = []
-    for i, h in enumerate(o.get("holes", [])):
+    for i, h in enumerate(r.list(o, "holes", "board.outline.holes")):
         where = f"board.outline.holes[{i}]"
         r.table(h, where, ["polygon", "at", "diameter", "size"])
         if "polygon" in h:
-            hv = np.array([r.point(p, f"{where}.polygon[{j}]") for j, p in enumerate(h["polygon"])]) - lo
+            hp = r.list(h, "polygon", f"{where}.polygon")
+            if len(hp) < 3:
+                r.fail(f"{where}.polygon", "needs at least three points [[\"x mm\", \"y mm\"], ...]")
+            hv = np.array([r.point(p, f"{where}.polygon[{j}]") for j, p in enumerate(hp)]) - lo
         elif "at" in h and "diameter" in h:
             c = np.array(r.point(h["at"], f"{where}.at")) - lo
             d = r.q(h["diameter"], "mm", f"{where}.diameter", positive=True)
@@ -46,12 +54,14 @@ def read_outline(r, o) -> Outline:
             hv = c + 0.5 * d * np.c_[np.cos(ang), np.sin(ang)]
         elif "at" in h and "size" in h:
             c = np.array(r.point(h["at"], f"{where}.at")) - lo
-            a, b = (r.q(s, "mm", f"{where}.size", positive=True) for s in h["size"])
+            if not (isinstance(h["size"], list) and len(h["size"]) == 2):
+                r.fail(f"{where}.size", "must be two lengths, e.g. [\"10 mm\", \"5 mm\"]")
+            a, b = (r.q(s, "mm", f"{where}.size[{k}]", positive=True) for k, s in enumerate(h["size"]))
             hv = c + np.array([[-a, -b], [a, -b], [a, b], [-a, b]]) / 2
         else:
             r.fail(where, "give polygon, or at with diameter (round) or size (rectangular)")
-        if not PolyPath(v).contains_points(hv, radius=-GEOM_TOL).all():
-            r.fail(where, "is not inside the outline; move it or make it smaller")
+        if (why := polygon_problem(hv) or hole_problem(v, holes, hv)) is not None:
+            r.fail(where, why)
         holes.append(hv)
     return Outline(v, holes, rect and not holes)
 
@@ -61,7 +71,7 @@ def read_plate(r, b):
         r.fail("board.thickness", "give either thickness with material, or stackup (its layers set the thickness)")
     if "stackup" in b:
         layers = []
-        for i, L in enumerate(b["stackup"]):
+        for i, L in enumerate(r.list(b, "stackup", "board.stackup")):
             where = f"board.stackup[{i}]"
             r.table(L, where, ["thickness", "material", "fill", "filler"], required=["thickness", "material"])
             mats = {}
@@ -69,14 +79,14 @@ def read_plate(r, b):
                 name = L.get(key, "FR4")
                 if isinstance(name, dict):
                     mats[key] = read_material(r, name, f"{where}.{key}")
-                elif name in MATERIALS:
+                elif isinstance(name, str) and name in MATERIALS:
                     mats[key] = Material(*MATERIALS[name])
                 else:
-                    r.fail(f"{where}.{key}", f"unknown material '{name}'; use one of {', '.join(MATERIALS)} "
+                    r.fail(f"{where}.{key}", f"unknown material {shown(name)}; use one of {', '.join(MATERIALS)} "
                                              "or a table { E = ..., nu = ..., rho = ... }")
             fill = L.get("fill", 1.0)
             if isinstance(fill, bool) or not isinstance(fill, (int, float)) or not 0 <= fill <= 1:
-                r.fail(f"{where}.fill", f"must be a number from 0 to 1, got {fill!r}")
+                r.fail(f"{where}.fill", f"must be a number from 0 to 1, got {shown(fill)}")
             layers.append(Layer(r.q(L["thickness"], "mm", f"{where}.thickness", positive=True), mats["material"],
                                 float(fill), mats["filler"]))
         if not layers:

@@ -7,17 +7,13 @@ import math
 
 import numpy as np
 
-from .. import targets
 from .entries import MIN_SEGMENT, LineMass, Region, RibSection, Stiffener
-from .geometry import on_board
+from .geometry import on_board, polygon_problem
 
 
 def entry_name(r, collection: str, e: dict, where: str) -> str:
-    """The name of entry ``where`` (e.g. ``stiffeners[2]``) of ``collection`` (:func:`pcbdyn.targets.entry_name`)."""
-    name = targets.entry_name(collection, e, int(where.rsplit("[", 1)[1].rstrip("]")))
-    if (why := targets.check_name(name)) is not None:
-        r.fail(f"{where}.name", why)
-    return name
+    """The name of entry ``where`` (e.g. ``stiffeners[2]``) of ``collection`` (:meth:`pcbdyn.inputs.Reader.name`)."""
+    return r.name(collection, e, int(where.rsplit("[", 1)[1].rstrip("]")), where)
 
 
 def read_segment(r, e, where, board):
@@ -44,8 +40,8 @@ def read_line_mass(r, e, where, board) -> LineMass:
 def read_stiffener(r, e, where, board) -> Stiffener:
     r.table(e, where, ["name", "path", "EI", "section"], required=["path", "EI"])
     name = entry_name(r, "stiffeners", e, where)
-    pts = e["path"]
-    if not isinstance(pts, list) or len(pts) < 2:
+    pts = r.list(e, "path", f"{where}.path")
+    if len(pts) < 2:
         r.fail(f"{where}.path", "needs at least two points [[\"x mm\", \"y mm\"], ...]")
     path = tuple(r.point(p, f"{where}.path[{k}]") for k, p in enumerate(pts))
     for k, (p0, p1) in enumerate(zip(path[:-1], path[1:])):
@@ -80,13 +76,15 @@ def read_region(r, e, where, board) -> Region:
             r.fail(f"{where}.rect", "has no area; give two opposite corners")
         poly = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
     else:
-        pts = e["polygon"]
-        if not isinstance(pts, list) or len(pts) < 3:
+        pts = r.list(e, "polygon", f"{where}.polygon")
+        if len(pts) < 3:
             r.fail(f"{where}.polygon", "needs at least three points [[\"x mm\", \"y mm\"], ...]")
         poly = np.array([r.point(p, f"{where}.polygon[{k}]") for k, p in enumerate(pts)])
     x, y = poly[:, 0], poly[:, 1]
     if abs(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))) < MIN_SEGMENT**2:
         r.fail(f"{where}.polygon", "has no area; give its corners in order")
+    if (why := polygon_problem(poly)) is not None:
+        r.fail(f"{where}.polygon", why)
     if not all(on_board(board.outline, a, b) for a, b in zip(poly, np.roll(poly, -1, axis=0))):
         r.fail(f"{where}", "the region reaches off the board (or over a hole); keep it inside the outline")
     factor = r.number(e["stiffness_factor"], f"{where}.stiffness_factor")

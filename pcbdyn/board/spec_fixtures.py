@@ -7,7 +7,8 @@ import difflib
 
 import numpy as np
 
-from .. import targets
+from ..inputs import MAX_NAME
+from ..units import shown
 from .entries import FIXTURE_TYPES, Fixture, PointMass
 from .geometry import circle, on_line
 from ..fixtures.supports import support_line
@@ -16,8 +17,8 @@ from .spec_effects import read_segment
 
 def _edge(r, text, where, outline):
     s = str(text).replace(" ", "")
-    if len(s) < 3 or s[0] not in "xy" or s[1] != "=":
-        r.fail(where, f"'{text}' is not an edge; write e.g. \"x=0\" or \"y=178 mm\"")
+    if not isinstance(text, str) or len(s) < 3 or s[0] not in "xy" or s[1] != "=":
+        r.fail(where, f"{shown(text)} is not an edge; write e.g. \"x=0\" or \"y=178 mm\"")
     axis = "xy".index(s[0])
     val = s[2:]
     value = 0.0 if val in ("0", "0.0") else r.q(text.split("=", 1)[1].strip(), "mm", where)
@@ -43,11 +44,11 @@ def read_fixture(r, f, where, board, i) -> Fixture:
     r.table(f, where, ["name", "type", "edge", "width", "k_rot", "at", "k", "diameter", "from", "to"],
             required=["type"])
     typ = f["type"]
-    if typ not in FIXTURE_TYPES:
-        close = difflib.get_close_matches(str(typ), FIXTURE_TYPES, n=1)
+    if not isinstance(typ, str) or typ not in FIXTURE_TYPES:
+        close = difflib.get_close_matches(str(typ)[:MAX_NAME], FIXTURE_TYPES, n=1)
         hint = f" (did you mean '{close[0]}'?)" if close else ""
-        r.fail(f"{where}.type", f"unknown fixture type '{typ}'{hint}; use one of {', '.join(FIXTURE_TYPES)}")
-    name = targets.entry_name("fixtures", f, i)
+        r.fail(f"{where}.type", f"unknown fixture type {shown(typ)}{hint}; use one of {', '.join(FIXTURE_TYPES)}")
+    name = r.name("fixtures", f, i, where)
     if board.fixture(name) is not None:
         r.fail(f"{where}.name", f"'{name}' is used by another fixture; names must be unique")
     fx = Fixture(name, typ)
@@ -60,11 +61,11 @@ def read_fixture(r, f, where, board, i) -> Fixture:
             if "k_rot" not in f:
                 r.fail(f"{where}.k_rot", "missing; add k_rot = \"1e4 N*m/rad/m\" (or \"clamped\" / \"hinged\")")
             k = f["k_rot"]
-            fx.k_rot = k if k in ("clamped", "hinged") else r.q(k, "N*m/rad/m", f"{where}.k_rot", nonneg=True)
+            fx.k_rot = k if isinstance(k, str) and k in ("clamped", "hinged") else r.q(k, "N*m/rad/m", f"{where}.k_rot", nonneg=True)
     elif typ == "standoff":
         fx.at = _point_on_board(r, board, f, where, "standoff")
         k = f.get("k", "rigid")
-        fx.k = "rigid" if k == "rigid" else r.q(k, "N/m", f"{where}.k", positive=True)
+        fx.k = "rigid" if isinstance(k, str) and k == "rigid" else r.q(k, "N/m", f"{where}.k", positive=True)
         fx.diameter = r.q(f.get("diameter", "6 mm"), "mm", f"{where}.diameter", positive=True)
         if not board.outline.contains(circle(fx.at, fx.diameter)).all():
             r.fail(f"{where}.diameter", "the standoff's pad reaches off the board; move it or make it smaller")
@@ -91,7 +92,7 @@ def read_mass(r, m, where, board, index) -> PointMass:
     """A point mass; ``inertia`` J is its rotary inertia about the x and y axes (Ixx = Iyy = J,
     Izz = 0), so mass = "0 g" with an inertia > 0 declares a rotary inertia alone."""
     r.table(m, where, ["name", "at", "mass", "inertia"], required=["at", "mass"])
-    pm = PointMass(targets.entry_name("masses", m, index), r.point(m["at"], f"{where}.at"),
+    pm = PointMass(r.name("masses", m, index, where), r.point(m["at"], f"{where}.at"),
                    r.q(m["mass"], "g", f"{where}.mass", nonneg=True),
                    r.q(m.get("inertia", "0 kg*m^2"), "kg*m^2", f"{where}.inertia", nonneg=True))
     if not pm.mass > 0 and not pm.inertia > 0:

@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import difflib
 
-from .. import targets
+from ..inputs import MAX_NAME
+from ..units import shown
 from ..components.library import MODELS, LibraryError, Package, available, find_package
 from .entries import Component
 from .geometry import polys_overlap
@@ -14,15 +15,14 @@ from .geometry import polys_overlap
 def read_component(r, c, where, board) -> Component:
     r.table(c, where, ["ref", "package", "at", "rotation", "model", "thickness", "size", "height", "mass", "E",
                        "rho"], required=["ref", "at"])
-    ref = str(c["ref"])
+    ref = r.name("components", c, 0, where)
     if board.component(ref) is not None:
         r.fail(f"{where}.ref", f"'{ref}' is used by another part; references must be unique")
-    if (why := targets.check_name(ref)) is not None:
-        r.fail(f"{where}.ref", why)
     pkg: Package | None = None
     if "package" in c:
+        r.text(c["package"], f"{where}.package", MAX_NAME)
         try:
-            pkg = find_package(str(c["package"]), board.path.parent)
+            pkg = find_package(c["package"], board.path.parent)
         except LibraryError as exc:
             r.fail(f"{where}.package", str(exc))
         if pkg is None:
@@ -46,10 +46,10 @@ def read_component(r, c, where, board) -> Component:
     height = r.q(c["height"], "mm", f"{where}.height", positive=True) if "height" in c else (
         pkg.height if pkg else 0.0)
     model = c.get("model", pkg.default_model if pkg else "lumped")
-    if model not in MODELS:
+    if not isinstance(model, str) or model not in MODELS:
         close = difflib.get_close_matches(str(model), MODELS, n=1)
         hint = f" (did you mean '{close[0]}'?)" if close else ""
-        r.fail(f"{where}.model", f"unknown part model '{model}'{hint}; use one of {', '.join(MODELS)}")
+        r.fail(f"{where}.model", f"unknown part model {shown(model)}{hint}; use one of {', '.join(MODELS)}")
     thickness = None
     if model == "equivalent_thickness":
         if "thickness" in c:
@@ -89,9 +89,15 @@ def read_component(r, c, where, board) -> Component:
 
 
 def check_overlaps(r, board):
+    """No two footprints overlap (touching is allowed); candidate pairs from a spatial index of their
+    bounding boxes, so many parts cost n log n."""
+    from shapely import STRtree, box
+
     cs = board.components
-    for i in range(len(cs)):
-        for j in range(i):
-            if polys_overlap(cs[i].corners(), cs[j].corners()):
-                r.fail(f"components[{i}].at", f"part {cs[i].ref} overlaps part {cs[j].ref}; move one of them "
-                                              "(footprints may touch but not overlap)")
+    corners = [c.corners() for c in cs]
+    boxes = [box(*k.min(axis=0), *k.max(axis=0)) for k in corners]
+    pairs = STRtree(boxes).query(boxes, predicate="intersects").T if boxes else []
+    for i, j in sorted((int(a), int(b)) for a, b in pairs if a > b):
+        if polys_overlap(corners[i], corners[j]):
+            r.fail(f"components[{i}].at", f"part {cs[i].ref} overlaps part {cs[j].ref}; move one of them "
+                                          "(footprints may touch but not overlap)")

@@ -12,9 +12,10 @@ import numpy as np
 
 from .. import targets
 from ..atomic import write_checked
-from ..inputs import Reader, read_toml
+from ..inputs import MAX_ENTRIES, MAX_NAME, Reader, read_toml
+from ..units import shown
 from ..domain import Analysis, Configured
-from .entries import RIB_MODELS, BoxError
+from .entries import MAX_PLATES, RIB_MODELS, BoxError
 from .enrich import enriched_text
 from .model import BoxModel, build_model
 from .spec import (check_plates, read_configuration, read_joint, read_mass, read_materials, read_plate, read_rib,
@@ -131,13 +132,12 @@ def load_box(path) -> Box:
     return parse_box(read_toml(path, BoxError)[1], Path(path))
 
 
-def _named(r, data, key, read, *args) -> list:
-    """The entries of array ``key``, each read by ``read(r, entry, where, name, *args)``, names unique."""
-    out = [read(r, e, f"{key}[{i}]", targets.entry_name(key, e, i), *args) for i, e in enumerate(r.list(data, key))]
+def _named(r, data, key, read, *args, limit: int = MAX_ENTRIES) -> list:
+    """The entries of array ``key`` (at most ``limit``), each read by ``read(r, entry, where, name, *args)``,
+    names unique."""
+    out = [read(r, e, f"{key}[{i}]", r.name(key, e, i, f"{key}[{i}]") if isinstance(e, dict) else "", *args)
+           for i, e in enumerate(r.list(data, key, limit=limit))]
     r.unique([e.name for e in out], key, "name")
-    for i, e in enumerate(out):
-        if (why := targets.check_name(e.name)) is not None:
-            r.fail(f"{key}[{i}].name", why)
     return out
 
 
@@ -148,13 +148,13 @@ def parse_box(data: dict, path: Path) -> Box:
                                 "configurations", "parameters", "analysis"], required=["box", "plates"])
     b = r.table(data["box"], "box", ["name", "mesh_size", "rib_model"])
     rib_model = b.get("rib_model", "beam")
-    if rib_model not in RIB_MODELS:
-        r.fail("box.rib_model", f"{rib_model!r} is not \"beam\" (eccentric beams) or \"shell\" (shell strips)")
+    if not isinstance(rib_model, str) or rib_model not in RIB_MODELS:
+        r.fail("box.rib_model", f"{shown(rib_model)} is not \"beam\" (eccentric beams) or \"shell\" (shell strips)")
     materials = read_materials(r, data)
-    plates = _named(r, data, "plates", read_plate, materials)
+    plates = _named(r, data, "plates", read_plate, materials, limit=MAX_PLATES)
     if not plates:
         r.fail("plates", "is empty; add [[plates]] with origin, u, v, thickness and material")
-    box = Box(name=str(b.get("name", Path(path).parent.name)), path=Path(path), plates=plates,
+    box = Box(name=r.text(b["name"], "box.name", MAX_NAME) if "name" in b else Path(path).parent.name, path=Path(path), plates=plates,
               mesh_size=r.q(b.get("mesh_size", "10 mm"), "mm", "box.mesh_size", positive=True), rib_model=rib_model)
     box.ribs = _named(r, data, "ribs", read_rib, plates, materials)
     box.supports = [read_support(r, e, f"supports[{i}]", plates) for i, e in enumerate(r.list(data, "supports"))]

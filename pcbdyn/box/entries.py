@@ -17,6 +17,8 @@ RIB_SIDES = ("+n", "-n")
 RIB_MODELS = ("beam", "shell")
 #: [m] plates meet, points lie on a plate, a rib end lies on its plate, within this
 GEOM_TOL = 1e-6
+#: most plates a box may have (every pair is checked for a shared edge)
+MAX_PLATES = 64
 
 
 class BoxError(StructureError):

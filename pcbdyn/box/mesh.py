@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..board.mesh import generate_quads, gmsh_session, mesh_nodes, surface_cells, tagged_nodes, used_nodes
+from ..board.mesh import generate_quads, gmsh_session, mesh_nodes, run_gmsh, surface_cells, tagged_nodes, used_nodes
 
 
 @dataclass
@@ -73,6 +73,12 @@ def mesh_box(plates, lines, points, size: float) -> BoxMesh:
     """Mesh ``plates`` (:class:`.entries.Plate`) at element size ``size`` [m] with the straight ``lines``
     [(p0, p1)] [m] (ribs) as element edges and ``points`` (k, 3) [m] as nodes."""
     points = np.asarray(points, dtype=float).reshape(-1, 3)
+    xyz, cells, point_nodes = run_gmsh(_box_cells, (plates, lines, points, size))
+    return _compact(xyz, cells, point_nodes, points)
+
+
+def _box_cells(plates, lines, points, size) -> tuple:
+    """(node xyz, cells {plate: {etype: [conn, ...]}}, node row of each point) of the box meshed by gmsh."""
     with gmsh_session("box") as gmsh:
         occ = gmsh.model.occ
         objects = [(2, _surface(occ, p.corners())) for p in plates]
@@ -93,8 +99,7 @@ def mesh_box(plates, lines, points, size: float) -> BoxMesh:
                 for conn in surface_cells(gmsh, t, index):
                     key = "quad4" if conn.shape[1] == 4 else "tri3"
                     cells.setdefault(plate.name, {}).setdefault(key, []).append(_oriented(xyz, conn, plate))
-        point_nodes = tagged_nodes(gmsh, point_tags, index)
-    return _compact(xyz, cells, point_nodes, points)
+        return xyz, cells, tagged_nodes(gmsh, point_tags, index)
 
 
 def _oriented(xyz, conn, plate) -> np.ndarray:

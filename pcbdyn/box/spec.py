@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..inputs import MAX_ENTRIES, MAX_NAME
+from ..units import shown
 from .entries import (EDGES, GEOM_TOL, RIB_SIDES, SUPPORT_TYPES, BoxMass, BoxMaterial, Configuration, Joint, Plate,
                       Rib, Support)
 from .geometry import contacts, groups, nearest_edges
@@ -31,7 +33,10 @@ def read_materials(r, data) -> dict:
     table = data.get("materials", {})
     if not isinstance(table, dict):
         r.fail("materials", "must be tables [materials.<name>] with E, nu and rho")
-    return {str(k): read_material(r, v, f"materials.{k}") for k, v in table.items()}
+    if len(table) > MAX_ENTRIES:
+        r.fail("materials", f"has {len(table):,} materials, more than the {MAX_ENTRIES:,} pcbdyn reads")
+    return {r.text(k, f"materials.{k[:MAX_NAME]}", MAX_NAME): read_material(r, v, f"materials.{k}")
+            for k, v in table.items()}
 
 
 def material_of(r, value, where, materials) -> BoxMaterial:
@@ -41,7 +46,8 @@ def material_of(r, value, where, materials) -> BoxMaterial:
     if isinstance(value, str) and value in materials:
         return materials[value]
     known = ", ".join(materials) or "none defined"
-    r.fail(where, f"unknown material {value!r} (materials: {known}); add a [materials.{value}] table or write "
+    name = value if isinstance(value, str) and len(value) <= MAX_NAME else "<name>"
+    r.fail(where, f"unknown material {shown(value)} (materials: {known}); add a [materials.{name}] table or write "
                   f"{MATERIAL_EXAMPLE}")
 
 
@@ -57,8 +63,11 @@ def read_plate(r, p, where, name, materials) -> Plate:
     mat = material_of(r, p["material"], f"{where}.material", materials)
     E = read_modulus(r, p["E"], f"{where}.E") if "E" in p else mat.E
     rho = r.q(p["rho"], "kg/m^3", f"{where}.rho", positive=True) if "rho" in p else mat.rho
-    return Plate(name, origin, u, v, r.q(p["thickness"], "mm", f"{where}.thickness", positive=True),
-                 BoxMaterial(E, mat.nu, rho), mat)
+    t = r.q(p["thickness"], "mm", f"{where}.thickness", positive=True)
+    if t >= min(np.linalg.norm(u), np.linalg.norm(v)):
+        r.fail(f"{where}.thickness", f"{t * 1e3:g} mm is as thick as the plate is wide; a plate is thin: check the "
+                                     "units")
+    return Plate(name, origin, u, v, t, BoxMaterial(E, mat.nu, rho), mat)
 
 
 def _on_plate(r, plate, ab, where) -> tuple:
@@ -73,7 +82,7 @@ def _on_plate(r, plate, ab, where) -> tuple:
 def _plate(r, plates, value, where):
     plate = next((p for p in plates if p.name == value), None)
     if plate is None:
-        r.fail(where, f"no plate is called {value!r} (plates: {', '.join(p.name for p in plates)}); name one of them")
+        r.fail(where, f"no plate is called {shown(value)} (plates: {', '.join(p.name for p in plates)}); name one of them")
     return plate
 
 
@@ -86,8 +95,8 @@ def read_rib(r, e, where, name, plates, materials) -> Rib:
     if np.linalg.norm(plate.point(*a) - plate.point(*b)) < 1e-4:
         r.fail(f"{where}.to", "is where the rib starts; a rib needs a length")
     side = e.get("side", "+n")
-    if side not in RIB_SIDES:
-        r.fail(f"{where}.side", f"{side!r} is not \"+n\" or \"-n\" (the side of the plate the rib stands on, "
+    if not isinstance(side, str) or side not in RIB_SIDES:
+        r.fail(f"{where}.side", f"{shown(side)} is not \"+n\" or \"-n\" (the side of the plate the rib stands on, "
                                 "n = u x v)")
     mat = material_of(r, e["material"], f"{where}.material", materials) if "material" in e else plate.declared
     if mat.orthotropic:
@@ -100,12 +109,12 @@ def read_rib(r, e, where, name, plates, materials) -> Rib:
 def read_support(r, e, where, plates) -> Support:
     r.table(e, where, ["plate", "edge", "type"], required=["plate", "edge"])
     plate = _plate(r, plates, e["plate"], f"{where}.plate")
-    if e["edge"] not in EDGES:
-        r.fail(f"{where}.edge", f"{e['edge']!r} is not an edge of a plate; use u0 (s = 0), u1 (s = 1), v0 (t = 0) or "
+    if not isinstance(e["edge"], str) or e["edge"] not in EDGES:
+        r.fail(f"{where}.edge", f"{shown(e['edge'])} is not an edge of a plate; use u0 (s = 0), u1 (s = 1), v0 (t = 0) or "
                                 "v1 (t = 1)")
     typ = e.get("type", "clamped")
-    if typ not in SUPPORT_TYPES:
-        r.fail(f"{where}.type", f"{typ!r} is not one of {', '.join(SUPPORT_TYPES)}")
+    if not isinstance(typ, str) or typ not in SUPPORT_TYPES:
+        r.fail(f"{where}.type", f"{shown(typ)} is not one of {', '.join(SUPPORT_TYPES)}")
     return Support(plate.name, str(e["edge"]), typ)
 
 
@@ -117,21 +126,19 @@ def read_mass(r, e, where, name, plates) -> BoxMass:
 
 
 def read_configuration(r, e, where, plates) -> Configuration:
-    from ..targets import entry_name
-
     r.table(e, where, ["name", "masses"], required=["name"])
-    ms = e.get("masses", [])
-    if not isinstance(ms, list):
-        r.fail(f"{where}.masses", "must be a list of tables { plate = ..., at = [...], mass = ... }")
-    return Configuration(str(e["name"]), [read_mass(r, m, f"{where}.masses[{j}]", entry_name("masses", m, j), plates)
-                                          for j, m in enumerate(ms)])
+    ms = r.list(e, "masses", f"{where}.masses")
+    masses = [read_mass(r, m, f"{where}.masses[{j}]", r.name("masses", m, j, f"{where}.masses[{j}]") if
+                        isinstance(m, dict) else "", plates) for j, m in enumerate(ms)]
+    r.unique([m.name for m in masses], f"{where}.masses", "name")
+    return Configuration(r.name("configurations", e, 0, where), masses)
 
 
 def read_joint(r, e, where, name, found) -> Joint:
     r.table(e, where, ["name", "plates", "k_rot"], required=["plates", "k_rot"])
     pair = e["plates"]
     if not (isinstance(pair, list) and len(pair) == 2 and all(isinstance(p, str) for p in pair)):
-        r.fail(f"{where}.plates", f"must name two plates, e.g. [\"upper\", \"left\"], got {pair!r}")
+        r.fail(f"{where}.plates", f"must name two plates, e.g. [\"upper\", \"left\"], got {shown(pair)}")
     if not any(set(c.plates) == set(pair) for c in found):
         r.fail(f"{where}.plates", f"plates {pair[0]!r} and {pair[1]!r} share no edge; a joint is the edge two plates "
                                   "share (without an entry it is rigid)")

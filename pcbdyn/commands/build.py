@@ -11,13 +11,11 @@ import click
 from .common import done, folder_outputs, input_errors, library_option, solve_structure, step
 
 
-def analyse(board, config, out: Path | None, pictures: bool = True, written: list | None = None,
-            stds: dict | None = None) -> dict:
-    """Build and solve one configuration; print its table; write CSV/VTU/PNG under ``out`` (and
-    append their paths to ``written``). ``stds``: the library's family standard deviations
-    (:func:`pcbdyn.problems.uncertainty.library_uncertainty`), propagated to each frequency."""
+def analyse(board, config, stds: dict | None = None) -> dict:
+    """Build and solve one configuration and print its table; returns what :func:`write_results` writes
+    (``stds``: the library's family standard deviations, :func:`pcbdyn.problems.uncertainty.library_uncertainty`,
+    propagated to each frequency)."""
     from ..correlation import static_mass
-    from ..report.files import write_text
     from ..report.modes import format_table, mode_table
 
     label = config or "base"
@@ -32,28 +30,7 @@ def analyse(board, config, out: Path | None, pictures: bool = True, written: lis
                f"{sum(len(es.conn) for es in bm.model.sets.values() if es.etype in ('quad4', 'tri3'))} shells"
                + (f", {modes.n_rigid} rigid-body modes" if modes.n_rigid else ""))
     click.echo(format_table(table) + "\n")
-    renderer = None
-    if out is not None:
-        stem = f"modes_{label}"
-        write_text(out / f"{stem}.csv", table.to_csv(index=False))
-        from ..report.vtu import write_modes_vtu
-
-        vtu = out / f"{stem}.vtu"
-        write_modes_vtu(vtu, bm.model, modes.frequencies, modes.shapes)
-        files = [out / f"{stem}.csv", vtu]
-        if pictures:
-            from ..report.pictures import mode_pictures, picture_names
-
-            t0 = step(f"[{label}] rendering {modes.frequencies.size} mode-shape pictures")
-            renderer = mode_pictures(vtu, bm.model, modes.frequencies, modes.shapes, out / "png", prefix=stem,
-                                     title=f"{board.name} [{label}]", outlines=board.outlines(config))
-            files += [out / "png" / n for n in picture_names(stem, modes.frequencies.size)]
-            done(t0)
-            if renderer != "pyvista":
-                click.echo("  note: 3-D rendering (pyvista) failed; the 3-D views are drawn by matplotlib", err=True)
-        if written is not None:
-            written += files
-    return {
+    summary = {
         "configuration": label,
         "modes": [{"n": int(row.mode), "frequency_hz": float(row.frequency_hz), "eff_mass_z": float(row.eff_mass_z),
                    "shape": row.shape, **({"frequency_std_hz": float(row.frequency_std_hz)} if stds is not None else {})}
@@ -62,6 +39,33 @@ def analyse(board, config, out: Path | None, pictures: bool = True, written: lis
         "dofs": int(bm.model.n_dof),
         "rigid_body_modes": int(modes.n_rigid),
     }
+    return {"config": config, "model": bm, "modes": modes, "table": table, "summary": summary}
+
+
+def write_results(board, solved: dict, out: Path, pictures: bool = True) -> list:
+    """Write one solved configuration (:func:`analyse`) as CSV, VTU and PNG under ``out``; returns the
+    paths written."""
+    from ..report.files import write_text
+    from ..report.vtu import write_modes_vtu
+
+    config, bm, modes = solved["config"], solved["model"], solved["modes"]
+    label = config or "base"
+    stem = f"modes_{label}"
+    write_text(out / f"{stem}.csv", solved["table"].to_csv(index=False))
+    vtu = out / f"{stem}.vtu"
+    write_modes_vtu(vtu, bm.model, modes.frequencies, modes.shapes)
+    files = [out / f"{stem}.csv", vtu]
+    if pictures:
+        from ..report.pictures import mode_pictures, picture_names
+
+        t0 = step(f"[{label}] rendering {modes.frequencies.size} mode-shape pictures")
+        renderer = mode_pictures(vtu, bm.model, modes.frequencies, modes.shapes, out / "png", prefix=stem,
+                                 title=f"{board.name} [{label}]", outlines=board.outlines(config))
+        files += [out / "png" / n for n in picture_names(stem, modes.frequencies.size)]
+        done(t0)
+        if renderer != "pyvista":
+            click.echo("  note: 3-D rendering (pyvista) failed; the 3-D views are drawn by matplotlib", err=True)
+    return files
 
 
 def uncertainty_note(stds: dict) -> str:
@@ -97,7 +101,10 @@ def command(board_toml, config, all_configs, out, json_path, no_pictures, html, 
 
             board, stds = library_uncertainty(board)
             click.echo(uncertainty_note(stds), err=True)
-        results = [analyse(board, c, out, pictures=not no_pictures, written=written, stds=stds) for c in configs]
+        solved = [analyse(board, c, stds=stds) for c in configs]  # every configuration solves before any file
+        results = [r["summary"] for r in solved]
+        if out is not None:
+            written = [f for r in solved for f in write_results(board, r, out, pictures=not no_pictures)]
     if json_path is not None:
         data = dict(results[0]) if len(results) == 1 else {**results[0], "configurations": results}
         data["board"] = board.name

@@ -76,7 +76,7 @@ def command(board_toml, test_uff, configs, freq_csv, joint_toml, families, with_
         fail("--frequencies holds no shapes: use --method freq")
     extras = parse_extra(configs)
     f_pct, shape_pct = parse_noise(noise)
-    with input_errors(ValueError):
+    with input_errors():
         t0 = step("reading the boards and their tests")
         items = [] if board_toml is None else [load_board_tests(board_toml, test_uff, extras, freq_csv)]
         items += [] if joint_toml is None else read_joint(joint_toml)

@@ -35,17 +35,20 @@ def fail(message: str, code: int = 2):
 @contextlib.contextmanager
 def input_errors(*more):
     """Bad input met inside (a structure's, test or library file, a quantity, an FE model that cannot be
-    solved, and the exception classes ``more``) ends the command with its one-line message (exit 2)."""
+    solved, updating equations the data leave empty, and the exception classes ``more``) ends the command
+    with its one-line message (exit 2). Each reader raises these classes at its boundary, so anything
+    else that escapes is a bug (reported as one by the CLI)."""
     from ..components.library import LibraryError
     from ..domain import StructureError
     from ..fe import ModelError
     from ..testdata import TestDataError
     from ..units import UnitError
+    from ..updating.errors import UpdatingError
 
     try:
         yield
-    except (StructureError, TestDataError, ModelError, UnitError, LibraryError, *more) as exc:
-        fail(str(exc).strip("'\""))
+    except (StructureError, TestDataError, ModelError, UnitError, LibraryError, UpdatingError, *more) as exc:
+        fail(" ".join(str(exc).strip("'\"").split()))  # one line, whatever a library put in the text
 
 
 def solve_structure(structure, config: str | None, n_modes: int | None = None, f_max: float | None = None):

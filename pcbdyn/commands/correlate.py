@@ -9,6 +9,7 @@ from pathlib import Path
 
 import click
 
+from ..domain import MAX_MODES
 from .common import PROBE_TOL, done, fail, folder_outputs, input_errors, library_option, solve_structure, step
 
 @click.command("correlate")
@@ -17,7 +18,7 @@ from .common import PROBE_TOL, done, fail, folder_outputs, input_errors, library
 @click.option("--config", default=None, help="configuration name from [[configurations]]")
 @click.option("--min-mac", type=click.FloatRange(0.0, 1.0), default=0.5, show_default=True,
               help="pairs with a lower MAC are dropped (their test modes are reported unpaired)")
-@click.option("--modes", "n_modes", type=click.IntRange(min=1), default=None,
+@click.option("--modes", "n_modes", type=click.IntRange(1, MAX_MODES), default=None,
               help="model modes to pair with (default: the board's [analysis] modes, at least 1.5 x the test's)")
 @folder_outputs("folder for pairs.csv, comac.csv and the PNG pictures",
                 "write pairs, unpaired test modes and COMAC as JSON", html=True)
@@ -37,7 +38,7 @@ def command(board_toml, test_uff, config, min_mac, n_modes, out, json_path, html
         board = load_structure(board_toml)
         test_modes = read_modes(test_uff)
         board.check_points(test_modes.measured_points(), test_uff)
-        n_model = n_modes or max(board.analysis.modes, math.ceil(1.5 * test_modes.n_modes))
+        n_model = n_modes or min(MAX_MODES, max(board.analysis.modes, math.ceil(1.5 * test_modes.n_modes)))
         bm, modes, _, _ = solve_structure(board, config, n_modes=n_model)
         t0 = step(f"reading the model at {len(test_modes.dofs)} test DOFs and pairing {test_modes.n_modes} test "
                   f"with {modes.frequencies.size} model modes")

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import click
 
+from ..domain import MAX_MODES
 from .common import checked_outputs, done, fail, library_option, step
 
 
@@ -33,7 +34,7 @@ def changed_quantities(base, updated, base_name: str, updated_name: str) -> dict
 @click.option("--updated", type=click.Path(exists=True, dir_okay=False, path_type=Path), default=None,
               help="board.updated.toml from 'pcbdyn update': export its values (same board, same mesh)")
 @click.option("--config", default=None, help="configuration name from [[configurations]]")
-@click.option("--modes", "n_modes", type=click.IntRange(min=1), default=None,
+@click.option("--modes", "n_modes", type=click.IntRange(1, MAX_MODES), default=None,
               help="modes asked for on EIGRL (default: [analysis] modes of the board)")
 @click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="write the card counts, mass, changed values and notes as JSON")

@@ -51,7 +51,7 @@ def command(board_toml, test_uff, config_tests, method, eq_type, params, rank, a
 
     extra = parse_extra(config_tests)
     freq_pct, shape_pct = parse_noise(noise)
-    with input_errors(KeyError, ValueError):
+    with input_errors():
         board = load_structure(board_toml)
         names = [n.strip() for n in params.split(",")] if params else None
         t0 = step("building the model and its parameter derivatives")

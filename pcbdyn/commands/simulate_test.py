@@ -11,6 +11,7 @@ from pathlib import Path
 import click
 import numpy as np
 
+from ..domain import MAX_MODES
 from .common import PROBE_TOL, checked_outputs, done, input_errors, library_option, number_pair, solve_structure, step
 
 
@@ -40,7 +41,7 @@ def check_band(f_range, df: float) -> None:
 @click.option("--damping", type=float, default=0.01, show_default=True, help="viscous damping ratio of every mode")
 @click.option("--kind", type=click.Choice(["receptance", "mobility", "accelerance"]), default="accelerance",
               show_default=True, help="FRF kind")
-@click.option("--modes", "n_modes", type=click.IntRange(min=1), default=None,
+@click.option("--modes", "n_modes", type=click.IntRange(1, MAX_MODES), default=None,
               help="number of modes written, and summed in the FRFs (default: [analysis] modes of the board)")
 @click.option("--out", type=click.Path(dir_okay=False, path_type=Path), default=Path("test.uff"), show_default=True,
               help="UFF file to write (points 2411, modes 55, FRFs 58)")

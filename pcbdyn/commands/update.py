@@ -78,7 +78,7 @@ def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping,
         fail("give either TEST_UFF (and NAME=FILE for other configurations) or --frequencies FILE.csv")
     if freq_csv is not None and method != "freq":
         fail("--frequencies holds no shapes: use --method freq")
-    with input_errors(KeyError, ValueError):
+    with input_errors():
         board = load_structure(board_toml)
         ms = to_si(mesh_size, "mm", "--mesh-size") if mesh_size else None
         t0 = step("building the models")

@@ -55,7 +55,7 @@ def command(board_toml, test_uff, configs, freq_csv, per_guide, tol_pct, noise, 
     if (test_uff is None) == (freq_csv is None):
         fail("give either TEST_UFF (and NAME=FILE for other configurations) or --frequencies FILE.csv")
     freq_noise, _ = parse_noise(noise)
-    with input_errors(ValueError):
+    with input_errors():
         board = load_structure(board_toml)
         ms = to_si(mesh_size, "mm", "--mesh-size") if mesh_size else None
         if freq_csv is not None:

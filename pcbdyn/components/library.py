@@ -11,13 +11,14 @@ it).
 from __future__ import annotations
 
 import os
+import re
 from contextlib import contextmanager
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 
-from ..inputs import read_toml
-from ..units import UnitError, to_si
+from ..inputs import MAX_NAME, MAX_TEXT, Reader, read_toml
+from ..units import shown
 
 MODELS = ("lumped", "spread", "smeared_local", "equivalent_thickness")
 
@@ -89,61 +90,67 @@ def available(board_dir: Path | None = None) -> list[str]:
 
 
 def read_package(path: Path) -> Package:
-    """Read one library file (table ``[package]``)."""
+    """Read one library file (table ``[package]``); a LibraryError names the file, the field and the fix."""
     path = Path(path)
     data = read_toml(path, LibraryError)[1]
-    p = data.get("package")
-    if not isinstance(p, dict):
-        raise LibraryError(f"{path}: needs a [package] table with size, height, mass, default_model, equivalent_thickness")
-    where = f"{path.name}: package"
-    try:
-        for key in ("size", "height", "mass", "default_model", "equivalent_thickness"):
-            if key not in p:
-                raise LibraryError(f"{path}: package.{key} is missing; add it")
-        size = p["size"]
-        if not (isinstance(size, list) and len(size) == 2):
-            raise LibraryError(f"{path}: package.size must be two lengths, e.g. [\"40 mm\", \"40 mm\"]")
-        model = p["default_model"]
-        if model not in MODELS:
-            raise LibraryError(f"{path}: package.default_model '{model}' is not one of {', '.join(MODELS)}")
-        return Package(
-            name=str(p.get("name", path.stem)),
-            size=tuple(to_si(s, "mm", f"{where}.size") for s in size),
-            height=to_si(p["height"], "mm", f"{where}.height"),
-            mass=to_si(p["mass"], "g", f"{where}.mass"),
-            default_model=model,
-            equivalent_thickness=to_si(p["equivalent_thickness"], "mm", f"{where}.equivalent_thickness"),
-            provenance=str(p.get("provenance", "")),
-            path=path,
-            steinberg_c=_steinberg_c(path, p),
-            equivalent_thickness_std=_std(path, p, where),
-        )
-    except UnitError as exc:
-        raise LibraryError(str(exc)) from None
+    r = Reader(path, LibraryError)
+    if not isinstance(data.get("package"), dict):
+        r.fail("package", "missing; the file needs a [package] table with size, height, mass, default_model and "
+                          "equivalent_thickness")
+    p = r.table(data["package"], "package", PACKAGE_KEYS, required=PACKAGE_KEYS[1:6])
+    size = p["size"]
+    if not (isinstance(size, list) and len(size) == 2):
+        r.fail("package.size", f"must be two lengths, e.g. [\"40 mm\", \"40 mm\"], got {shown(size)}")
+    model = p["default_model"]
+    if not isinstance(model, str) or model not in MODELS:
+        r.fail("package.default_model", f"{shown(model)} is not one of {', '.join(MODELS)}")
+    return Package(
+        name=r.text(p["name"], "package.name", MAX_NAME) if "name" in p else path.stem,
+        size=tuple(r.q(s, "mm", f"package.size[{i}]", positive=True) for i, s in enumerate(size)),
+        height=r.q(p["height"], "mm", "package.height", nonneg=True),
+        mass=r.q(p["mass"], "g", "package.mass", positive=True),
+        default_model=model,
+        equivalent_thickness=r.q(p["equivalent_thickness"], "mm", "package.equivalent_thickness", positive=True),
+        provenance=r.text(p.get("provenance", ""), "package.provenance", 20 * MAX_TEXT, lines=True),
+        path=path,
+        steinberg_c=_steinberg_c(r, p),
+        equivalent_thickness_std=r.q(p["equivalent_thickness_std"], "mm", "package.equivalent_thickness_std",
+                                     nonneg=True) if "equivalent_thickness_std" in p else None,
+    )
 
 
-def _std(path: Path, p: dict, where: str) -> float | None:
-    if "equivalent_thickness_std" not in p:
+#: the fields of ``[package]``
+PACKAGE_KEYS = ["name", "size", "height", "mass", "default_model", "equivalent_thickness", "provenance", "steinberg_c",
+                "equivalent_thickness_std"]
+
+
+def _steinberg_c(r, p: dict) -> float | None:
+    if "steinberg_c" not in p:
         return None
-    sd = to_si(p["equivalent_thickness_std"], "mm", f"{where}.equivalent_thickness_std")
-    if not sd >= 0:
-        raise LibraryError(f"{path}: package.equivalent_thickness_std must not be negative, got "
-                           f"{p['equivalent_thickness_std']!r}")
-    return sd
+    c = r.number(p["steinberg_c"], "package.steinberg_c")
+    if not 0 < c <= 10:
+        r.fail("package.steinberg_c", f"must be a number above 0 (Steinberg's package constant, e.g. 1.0 for a "
+                                      f"standard DIP, 1.75 for a BGA), got {c!r}")
+    return c
 
 
-def _steinberg_c(path: Path, p: dict) -> float | None:
-    c = p.get("steinberg_c")
-    if c is None:
-        return None
-    if isinstance(c, bool) or not isinstance(c, (int, float)) or not c > 0:
-        raise LibraryError(f"{path}: package.steinberg_c must be a positive number (Steinberg's package constant, "
-                           f"e.g. 1.0 for a standard DIP, 1.75 for a BGA), got {c!r}")
-    return float(c)
+def check_family(name) -> str | None:
+    """Why ``name`` cannot name a part family (None when it can): a family is a file ``<name>.toml`` in a
+    library folder, so its name is a plain file name of letters, digits and ``_-+.``."""
+    if not isinstance(name, str) or not _FAMILY.fullmatch(name):
+        return (f"{shown(name)} is not a family name: use at most {MAX_NAME} letters, digits and _ - + . (not "
+                "starting with a dot), e.g. \"QFP44\"")
+    return None
+
+
+_FAMILY = re.compile(rf"[A-Za-z0-9_+\-][A-Za-z0-9_+.\-]{{0,{MAX_NAME - 1}}}")
 
 
 def locate(name: str, board_dir: Path | None = None) -> Path | None:
-    """The file of family ``name`` in the first library folder that has it, or None."""
+    """The file of family ``name`` in the first library folder that has it, or None; a LibraryError
+    for a name that is no family name (:func:`check_family`)."""
+    if (why := check_family(name)) is not None:
+        raise LibraryError(why)
     for d in search_path(board_dir):
         f = d / f"{name}.toml"
         if f.is_file():

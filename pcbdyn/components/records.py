@@ -26,7 +26,8 @@ from datetime import datetime
 import numpy as np
 import tomlkit
 
-from ..units import UnitError, from_si, to_si
+from ..inputs import MAX_TEXT, Reader
+from ..units import UnitError, from_si, shown, to_si
 from .library import LibraryError
 
 #: a run this many standard deviations from the pooled other runs is flagged (not averaged in)
@@ -117,11 +118,28 @@ def _record(path, i, r) -> Record:
         raise LibraryError(f"{where}.std_mesh: the mesh's part of std must lie between 0 and std ({r['std']!r}), "
                            f"got {r.get('std_mesh')!r}")
     errors = [r.get(k, math.nan) for k in ("max_freq_error_before_pct", "max_freq_error_after_pct")]
-    if any(isinstance(e, bool) or not isinstance(e, (int, float)) for e in errors):
-        raise LibraryError(f"{where}: max_freq_error_before_pct/after_pct must be numbers (percent), got {errors}")
-    return Record(str(r["run"]), r["date"], str(r["method"]), value, std, before, tuple(r.get("boards", ())),
-                  tuple(r.get("tests", ())), float(errors[0]), float(errors[1]), r["flagged"], str(r.get("reason", "")),
-                  {k: r[k] for k in EXTRA_KEYS if k in r}, mesh)
+    if any(isinstance(e, bool) or not isinstance(e, (int, float)) or (k in r and not math.isfinite(e))
+           for k, e in zip(("max_freq_error_before_pct", "max_freq_error_after_pct"), errors)):
+        raise LibraryError(f"{where}: max_freq_error_before_pct/after_pct must be finite numbers (percent), got "
+                           f"{[shown(e) for e in errors]}")
+    text = Reader(path, LibraryError)
+    run, method, reason = (text.text(r.get(k, ""), f"calibrations[{i}].{k}", MAX_TEXT) for k in ("run", "method", "reason"))
+    files = {key: _files(text, r.get(key, []), f"calibrations[{i}].{key}") for key in ("boards", "tests")}
+    return Record(run, r["date"], method, value, std, before, files["boards"], files["tests"], float(errors[0]),
+                  float(errors[1]), r["flagged"], reason, {k: r[k] for k in EXTRA_KEYS if k in r}, mesh)
+
+
+def _files(r, items, where) -> tuple:
+    """The ``boards`` or ``tests`` of a record: inline tables of text (file, sha256, board, configuration)."""
+    if not isinstance(items, list):
+        r.fail(where, f"must be a list of {{ file = ..., sha256 = ... }} tables, got {shown(items)}")
+    for k, item in enumerate(items):
+        if not isinstance(item, dict) or not all(isinstance(v, str) for v in item.values()):
+            r.fail(f"{where}[{k}]", f"must be a table of texts such as {{ file = \"board.toml\", sha256 = \"...\" }}, "
+                                    f"got {shown(item)}")
+        for key, v in item.items():
+            r.text(v, f"{where}[{k}].{key}", MAX_TEXT)
+    return tuple(items)
 
 
 def pool(records) -> Pooled | None:

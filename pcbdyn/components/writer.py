@@ -48,7 +48,6 @@ def add_calibration(directory, family: str, record: Record, seed=None) -> tuple:
     path = directory / f"{family}.toml"
     try:
         with FileLock(lock_path(directory, family), timeout=LOCK_TIMEOUT):
-            _clear_leftovers(directory, family)
             source = path if path.is_file() else (Path(seed) if seed is not None else None)
             if source is None:
                 raise LibraryError(f"{path}: no such library file and no entry to start it from; the family "
@@ -79,9 +78,3 @@ def _write_pooled(doc, pooled: Pooled | None) -> None:
     pkg = doc["package"]
     pkg["equivalent_thickness"] = length(pooled.value)
     pkg["equivalent_thickness_std"] = length(pooled.std, 3)
-
-
-def _clear_leftovers(directory: Path, family: str) -> None:
-    """Remove temporary files a killed writer of ``family`` left (only the lock holder writes them)."""
-    for tmp in directory.glob(f".{family}.*.toml"):
-        tmp.unlink(missing_ok=True)

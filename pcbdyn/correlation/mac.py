@@ -14,12 +14,19 @@ def _cols(a, name):
     return a
 
 
+def _unit_scale(a) -> np.ndarray:
+    """Columns divided by their largest magnitude (the MAC does not change, and no square of a large or
+    small shape value over- or underflows)."""
+    big = np.max(np.abs(a), axis=0) if a.size else np.ones(a.shape[1])
+    return a / np.where(big > 0, big, 1.0)
+
+
 def mac(phi_x, phi_a) -> np.ndarray:
     """MAC matrix (n_x, n_a): |phi_x^H phi_a|^2 / ((phi_x^H phi_x)(phi_a^H phi_a)) (thesis eq. 2.3).
 
     Columns are shapes at the same DOFs (rows); complex shapes are allowed. A zero shape gives 0.
     """
-    X, A = _cols(phi_x, "phi_x"), _cols(phi_a, "phi_a")
+    X, A = _unit_scale(_cols(phi_x, "phi_x")), _unit_scale(_cols(phi_a, "phi_a"))
     if X.shape[0] != A.shape[0]:
         raise ValueError(f"shapes have {X.shape[0]} and {A.shape[0]} DOFs: read both at the same DOFs")
     num = np.abs(X.conj().T @ A) ** 2

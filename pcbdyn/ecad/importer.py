@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from collections import defaultdict
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
@@ -125,7 +126,10 @@ def import_kicad(pcb_path, map_path) -> Imported:
     layout = read_kicad(pcb_path)
     pmap = read_map(map_path)
     notes: list = []
-    stackup = _stackup(layout, pmap, notes)
+    try:
+        stackup = _stackup(layout, pmap, notes)
+    except KicadError as exc:
+        raise KicadError(f"{Path(pcb_path).name}: {exc}") from None
     parts, unmapped, standoffs, kept_out, used = [], defaultdict(list), [], [], set()
     ignored = 0
     for i, fp in enumerate(layout.footprints):

@@ -165,6 +165,18 @@ def read_kicad(path) -> Layout:
         raise KicadError(f"{path}: not a readable KiCad board ({type(exc).__name__}: {exc}); open and save it in "
                          "KiCad 6-8, or check that the file is a .kicad_pcb") from None
     try:
+        return _layout(pcb, path)
+    except KicadError:
+        raise
+    except (AttributeError, TypeError, ValueError, IndexError, KeyError, ZeroDivisionError) as exc:
+        # kiutils reads some malformed boards without a word and leaves fields None or text
+        raise KicadError(f"{path}: not a usable KiCad board ({type(exc).__name__}: {str(exc)[:200]}); open and save "
+                         "it in KiCad 6-8") from None
+
+
+def _layout(pcb, path) -> Layout:
+    """The layout of a board kiutils read from ``path``."""
+    try:
         pieces, loops = _edge_pieces([g for g in pcb.graphicItems if getattr(g, "layer", None) == "Edge.Cuts"])
         loops += _chain(pieces)
     except KicadError as exc:
@@ -173,6 +185,8 @@ def read_kicad(path) -> Layout:
     if not polys:
         raise KicadError(f"{path}: no closed board outline on the Edge.Cuts layer; draw the board's edge there")
     outer = max(polys, key=lambda lp: _area(lp[1]))[1]
+    if not np.isfinite(outer).all():
+        raise KicadError(f"{path}: the board outline on Edge.Cuts has coordinates that are not finite numbers")
     xmin, ymax = outer[:, 0].min(), outer[:, 1].max()
 
     def board(p) -> np.ndarray:

@@ -18,10 +18,10 @@ out of the board and listed with their count: a part's mass is never guessed.
 from __future__ import annotations
 
 import fnmatch
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..inputs import read_toml
 from .kicad import KicadError
 
 PART_KEYS = ("package", "mass", "height", "model", "thickness")
@@ -43,32 +43,46 @@ class PackageMap:
 
 
 def read_map(path) -> PackageMap:
+    """The footprint map of ``path``, every entry checked (family names, quantities with their units, part
+    models, materials); a KicadError names the file, the entry and the fix."""
+    from ..components.library import MODELS, check_family
+    from ..inputs import MAX_NAME, Reader
+
     path = Path(path)
     if not path.is_file():
         raise KicadError(f"{path}: no such file; give the footprint map with --packages map.toml")
-    try:
-        data = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as exc:
-        raise KicadError(f"{path.name}: not valid TOML: {exc}; fix the syntax at that line") from None
-    unknown = set(data) - {"footprints", "materials"}
-    if unknown:
-        raise KicadError(f"{path.name}: unknown table(s) {', '.join(sorted(unknown))}; use [footprints] and [materials]")
+    data = read_toml(path, KicadError)[1]
+    r = Reader(path, KicadError)
+    r.table(data, "top level", ["footprints", "materials"])
     entries = []
-    for pattern, value in data.get("footprints", {}).items():
-        where = f"{path.name}: footprints.\"{pattern}\""
-        if isinstance(value, str):
-            entries.append((pattern, value if value in KEYWORDS else {"package": value}))
-        elif isinstance(value, dict):
-            bad = set(value) - set(PART_KEYS)
-            if bad:
-                raise KicadError(f"{where}: unknown key(s) {', '.join(sorted(bad))}; use {', '.join(PART_KEYS)}")
-            if "package" not in value and "mass" not in value:
-                raise KicadError(f"{where}: give a package (library family) or a mass, e.g. {{ mass = \"2 g\" }}")
-            entries.append((pattern, dict(value)))
-        else:
-            raise KicadError(f"{where}: must be a family name, \"ignore\", \"standoff\" or a table {{ package = ... }}")
-    materials = data.get("materials", {})
+    for pattern, value in r.table(data.get("footprints", {}), "footprints").items():
+        where = f"footprints.\"{pattern[:MAX_NAME]}\""
+        r.text(pattern, where, 200)
+        if isinstance(value, str) and value in KEYWORDS:
+            entries.append((pattern, value))
+            continue
+        table = {"package": value} if isinstance(value, str) else value
+        if not isinstance(table, dict):
+            r.fail(where, "must be a family name, \"ignore\", \"standoff\" or a table { package = ... }")
+        r.table(table, where, list(PART_KEYS))
+        if "package" not in table and "mass" not in table:
+            r.fail(where, "give a package (library family) or a mass, e.g. { mass = \"2 g\" }")
+        if "package" in table and (why := check_family(table["package"])) is not None:
+            r.fail(f"{where}.package", why)
+        for key, unit, positive in (("mass", "g", True), ("height", "mm", False), ("thickness", "mm", True)):
+            if key in table:
+                r.q(table[key], unit, f"{where}.{key}", positive=positive, nonneg=True)
+        if "model" in table and (not isinstance(table["model"], str) or table["model"] not in MODELS):
+            r.fail(f"{where}.model", f"must be one of {', '.join(MODELS)}")
+        entries.append((pattern, dict(table)))
+    materials = r.table(data.get("materials", {}), "materials")
     for name, m in materials.items():
-        if not (isinstance(m, (str, dict))):
-            raise KicadError(f"{path.name}: materials.\"{name}\": give a pcbdyn material name or {{ E, nu, rho }}")
+        where = f"materials.\"{name[:MAX_NAME]}\""
+        if isinstance(m, dict):
+            r.table(m, where, ["E", "nu", "rho"], required=["E", "nu", "rho"])
+            r.q(m["E"], "Pa", f"{where}.E", positive=True)
+            r.number(m["nu"], f"{where}.nu", -1.0, 0.5)
+            r.q(m["rho"], "kg/m^3", f"{where}.rho", positive=True)
+        elif not isinstance(m, str):
+            r.fail(where, "give a pcbdyn material name or { E, nu, rho }")
     return PackageMap(path, entries, materials)

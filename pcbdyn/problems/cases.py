@@ -8,6 +8,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..domain import StructureError
 from ..fe.assembly import element_matrices, scatter
 from ..fe.generate import rectangle
 from ..fe.model import Model
@@ -25,6 +26,11 @@ from ..updating.success import add_noise
 from ..updating.weighting import unit_row_weights
 from .load import load_structure
 from .problem import UpdateProblem
+
+class CaseError(StructureError):
+    """Options of a study case that cannot be used (an element or node that does not exist, a truth
+    equal to the model); the message names the option and the fix."""
+
 
 #: the thesis' simulated free PCB (section 5.4.4, Table 5.10): 162 x 178 x 2.8 mm, E 26 GPa,
 #: rho 2640 kg/m^3 on a 6 x 7 mesh; element thicknesses [mm] of the model ("pa") and of the
@@ -80,11 +86,11 @@ class SimulatedFreePCB(StudyCase):
         errors = c["thickness_mm"]["px"] if errors_mm is None else errors_mm
         for k, v in errors.items():
             if not 1 <= int(k) <= n_el:
-                raise ValueError(f"errors_mm: element {k} does not exist; elements are 1..{n_el}")
+                raise CaseError(f"errors_mm: element {k} does not exist; elements are 1..{n_el}")
             self.p_x[int(k) - 1] = float(v) * 1e-3
         self.true_errors = np.flatnonzero(np.abs(self.p_x / self.p_a - 1) > 1e-12)
         if self.true_errors.size == 0:
-            raise ValueError("errors_mm: no element differs from the model (p_a): nothing to localise")
+            raise CaseError("errors_mm: no element differs from the model (p_a): nothing to localise")
 
         model = Model(nodes)
         self._base = ShellProperty(E=c["E"], nu=nu, rho=c["rho"], t=c["t_base_m"])
@@ -119,7 +125,7 @@ class SimulatedFreePCB(StudyCase):
                 out.append(np.asarray(T.T @ (d @ T)))
         for key, node in (("excitation_node", excitation_node), ("perturbation_node", perturbation_node)):
             if not 1 <= int(node) <= nn:
-                raise ValueError(f"{key} = {node}: thesis node numbers run 1..{nn} (n = 8 ix + iy + 1, Fig. 5.41)")
+                raise CaseError(f"{key} = {node}: thesis node numbers run 1..{nn} (n = 8 ix + iy + 1, Fig. 5.41)")
         self.excitation = int(self.node_of[excitation_node - 1])
         dm = np.zeros(nn)
         dm[self.node_of[perturbation_node - 1]] = perturbation_kg
@@ -150,7 +156,7 @@ class SimulatedFreePCB(StudyCase):
             return add_noise(c["omega_x"], level_pct, rng), add_noise(c["phi_x"], level_pct, rng)
         if kind in ("frf", "frf+pbc"):
             return tuple(add_noise(c["H_x"], level_pct, rng) for c in self.configs[: 1 if kind == "frf" else 2])
-        raise ValueError(f"equation type {kind!r}: choose one of {', '.join(self.kinds)}")
+        raise CaseError(f"equation type {kind!r}: choose one of {', '.join(self.kinds)}")
 
     def build(self, kind: str, data: tuple):
         """Weighted (A, b) of equation type ``kind`` from test data (:meth:`measure`)."""
@@ -182,15 +188,15 @@ class StructureCase(StudyCase):
         self.p_a = problem.p0.copy()
         self.p_x = self.p_a.copy()
         if not truth:
-            raise ValueError("truth: give the true value of at least one parameter, e.g. t_U1 = \"4 mm\"")
+            raise CaseError("truth: give the true value of at least one parameter, e.g. t_U1 = \"4 mm\"")
         for name, value in truth.items():
             if name not in self.parameter_names:
-                raise ValueError(f"truth: {name!r} is not a parameter (known: {', '.join(self.parameter_names)})")
+                raise CaseError(f"truth: {name!r} is not a parameter (known: {', '.join(self.parameter_names)})")
             i = self.parameter_names.index(name)
             self.p_x[i] = to_si(value, problem.units[i], f"truth.{name}") if isinstance(value, str) else float(value)
         self.true_errors = np.flatnonzero(np.abs(self.p_x / self.p_a - 1) > 1e-12)
         if self.true_errors.size == 0:
-            raise ValueError("truth: every value equals the board's: nothing to localise")
+            raise CaseError("truth: every value equals the board's: nothing to localise")
         points, dofs = read_points_csv(points_csv)
         sysm = problem.system(None)
         P = sysm.measurement_matrix(points.xyz[points.index(dofs.point_ids)], dofs.directions)
@@ -202,7 +208,7 @@ class StructureCase(StudyCase):
         self.omega_x, self.phi_x = np.sqrt(lam_x[el]), np.asarray(P @ phi_full[:, el])
         mac = np.diag(mac_matrix(np.asarray(P @ Phi_a[:, el]), self.phi_x))
         if np.any(mac < 0.8):
-            raise ValueError(f"truth: the true board's modes do not pair in order with the model's (MAC "
+            raise CaseError(f"truth: the true board's modes do not pair in order with the model's (MAC "
                              f"{np.round(mac, 2).tolist()}); use smaller errors or fewer modes (n_modes)")
         self.K, self.M, self.dKs, self.dMs = matching.reduce_system(K, M, dKs, dMs, P)
         blk = frequency_equations(lam_a[el], Phi_a[:, el], frequencies_hz(lam_x[el]), dKs, dMs, self.p_a)
@@ -214,7 +220,7 @@ class StructureCase(StudyCase):
         """(omega,) or (omega, shapes) of the simulated test with ``level_pct`` % uniform noise
         (eqs. 5.72-5.73) drawn from ``rng``."""
         if kind not in self.kinds:
-            raise ValueError(f"equation type {kind!r}: choose one of {', '.join(self.kinds)}")
+            raise CaseError(f"equation type {kind!r}: choose one of {', '.join(self.kinds)}")
         om = add_noise(self.omega_x, level_pct, rng)
         return (om,) if kind == "freq" else (om, add_noise(self.phi_x, level_pct, rng))
 

@@ -16,7 +16,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..inputs import Reader, read_toml
+from ..domain import StructureError
+from ..inputs import MAX_NAME, Reader, read_toml
+from ..testdata import TestDataError
 from ..testdata.measured import read_frequency_table, read_tests
 from .calibration import BoardTests, CalibrationError
 from .load import load_structure
@@ -53,8 +55,12 @@ def read_joint(path) -> list:
         extra = e.get("configurations", {})
         if not isinstance(extra, dict):
             r.fail(f"{where}.configurations", "must be a table of configuration = \"test file\", e.g. { c2 = \"c2.uff\" }")
-        extras = [(str(c), _file(r, path, f, f"{where}.configurations.{c}")) for c, f in extra.items()]
-        out.append(load_board_tests(files["board"], files.get("test"), extras, files.get("frequencies")))
+        extras = [(r.text(c, f"{where}.configurations", MAX_NAME), _file(r, path, f, f"{where}.configurations.{c}"))
+                  for c, f in extra.items()]
+        try:
+            out.append(load_board_tests(files["board"], files.get("test"), extras, files.get("frequencies")))
+        except (StructureError, TestDataError) as exc:  # in a file the entry names: say which entry
+            r.fail(where, str(exc))
     return out
 
 

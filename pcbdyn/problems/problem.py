@@ -26,7 +26,7 @@ import numpy as np
 
 from ..updating.frf_lines import choose_frf_frequencies, model_receptance
 from ..updating.iteration import Configuration
-from .system import ConfigSystem, DynamicReduced, shape_pairing
+from .system import ConfigSystem, DynamicReduced, ProblemError, shape_pairing
 
 
 class UpdateProblem:
@@ -44,12 +44,12 @@ class UpdateProblem:
         known = list(dict.fromkeys(p.name for s in self.structures for p in s.parameters))
         files = ", ".join(s.path.name for s in self.structures)
         if not known:
-            raise ValueError(f"{files}: no [[parameters]] to update; add e.g. [[parameters]] name = \"t_U1\", "
+            raise ProblemError(f"{files}: no [[parameters]] to update; add e.g. [[parameters]] name = \"t_U1\", "
                              "target = \"components.U1.thickness\", bounds = [\"2 mm\", \"10 mm\"]")
         self.names = list(names) if names else known
         bad = [n for n in self.names if n not in known]
         if bad:
-            raise ValueError(f"--params: {bad} are not parameters of {files} (known: {', '.join(known)})")
+            raise ProblemError(f"--params: {bad} are not parameters of {files} (known: {', '.join(known)})")
         self.systems: dict = {}
         self.parameters = []
         for n in self.names:
@@ -62,7 +62,7 @@ class UpdateProblem:
         self.units = [p.unit for p in self.parameters]
         bad0 = [p.name for p in self.parameters if p.value == 0]
         if bad0:
-            raise ValueError(f"parameters {bad0} start at zero; relative updating (x = dp/p, thesis eq. 4.41) needs "
+            raise ProblemError(f"parameters {bad0} start at zero; relative updating (x = dp/p, thesis eq. 4.41) needs "
                              "a non-zero starting value in the structure's file")
 
     def _check_shared(self) -> None:
@@ -71,7 +71,7 @@ class UpdateProblem:
             for s in self.structures:
                 spec = next((p for p in s.parameters if p.name == par.name), None)
                 if spec is not None and (spec.unit != par.unit or not np.isclose(spec.value, par.value, rtol=1e-12)):
-                    raise ValueError(f"parameter '{par.name}' starts at {spec.value:g} in {s.path.name} but at "
+                    raise ProblemError(f"parameter '{par.name}' starts at {spec.value:g} in {s.path.name} but at "
                                      f"{par.value:g} elsewhere; a shared parameter needs one starting value and unit")
 
     def label(self, config, structure: int = 0) -> str:
@@ -110,7 +110,7 @@ class UpdateProblem:
         are small)."""
         sysm = self.system(config, structure)
         if measured.shapes is None:
-            raise ValueError(f"configuration {sysm.label!r}: {method} needs measured shapes")
+            raise ProblemError(f"configuration {sysm.label!r}: {method} needs measured shapes")
         P = sysm.measurement_matrix(measured.xyz, measured.directions)
         return [Configuration(model=DynamicReduced(sysm, P, 2 * np.pi * f), f_x=measured.frequencies[k:k + 1],
                               phi_x=measured.shapes[:, k:k + 1], method=method, n_modes=P.shape[0],
@@ -144,7 +144,7 @@ class UpdateProblem:
             else:
                 want = np.atleast_1d(np.asarray(freqs, float))
                 if want.min() < f.min() or want.max() > f.max():
-                    raise ValueError(f"--frf-freqs: {want.tolist()} Hz must lie within the measured lines "
+                    raise ProblemError(f"--frf-freqs: {want.tolist()} Hz must lie within the measured lines "
                                      f"{f.min():g}-{f.max():g} Hz")
                 idx = np.unique(np.argmin(np.abs(f[:, None] - want[None, :]), axis=0))
             H = m.H[idx].T

@@ -8,11 +8,17 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..correlation.pairing import pair_modes
+from ..domain import StructureError
 from ..fe.assembly import assemble
 from ..fe.constraints import build_reduction
 from ..fe.probe import model_probe
 from ..updating.matching import dynamic_basis
 from .models import parameter_derivatives, parameter_values
+
+
+class ProblemError(StructureError):
+    """An updating problem that its structures and tests cannot make (no parameters, an unknown one, a
+    method that needs shapes the test lacks, ...); the message names the file or option and the fix."""
 
 
 class ConfigSystem:
@@ -75,7 +81,7 @@ class ConfigSystem:
         w = np.abs(row)
         where = np.round(np.asarray(xyz) * 1e3, 2).tolist()
         if w.max() == 0:
-            raise ValueError(f"excitation at {where} mm moves no free DOF")
+            raise ProblemError(f"excitation at {where} mm moves no free DOF")
         j = int(np.argmax(w))
         if np.isclose(row[j], 1.0) and np.sum(w > 1e-9) == 1:
             return j, None

@@ -4,9 +4,9 @@ parameters, the runs behind a family value and their plot (value and band agains
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 from ..units import from_si
+from .files import save_figure
 from .update_report import format_correlation
 
 __all__ = ["format_correlation", "format_families", "format_library", "format_runs", "format_with", "headline",
@@ -117,6 +117,4 @@ def plot_runs(path, family: str, records, pooled, default: float | None = None) 
     ax.set_xticks(x)
     ax.legend(fontsize=7)
     fig.tight_layout()
-    Path(path).parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
+    save_figure(fig, path, dpi=100)

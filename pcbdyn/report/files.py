@@ -6,11 +6,13 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import json
+import math
 import sys
+from pathlib import Path
 
 from ..atomic import atomic_path
 
-__all__ = ["atomic_path", "json_to_stdout", "write_text", "write_json"]
+__all__ = ["atomic_path", "json_to_stdout", "save_figure", "write_text", "write_json"]
 
 #: the standard output a ``--json -`` run keeps for its JSON while its report goes to stderr
 _JSON_STDOUT = contextvars.ContextVar("pcbdyn_json_stdout", default=None)
@@ -21,9 +23,33 @@ def write_text(path, text: str) -> None:
         tmp.write_text(text)
 
 
+def save_figure(fig, path, **options) -> Path:
+    """A matplotlib figure saved to ``path`` atomically (format from its suffix; ``options`` for
+    savefig, e.g. dpi) and closed; returns ``path``."""
+    import matplotlib.pyplot as plt
+
+    path = Path(path)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format=path.suffix.lstrip(".") or "png", **options)
+    plt.close(fig)
+    return path
+
+
+def finite(data):
+    """``data`` (dicts, lists, numbers) with every float that is not finite replaced by None."""
+    if isinstance(data, float):
+        return data if math.isfinite(data) else None
+    if isinstance(data, dict):
+        return {k: finite(v) for k, v in data.items()}
+    if isinstance(data, (list, tuple)):
+        return [finite(v) for v in data]
+    return data
+
+
 def write_json(path, data) -> None:
-    """``data`` as JSON to the file ``path``, or to the standard output when ``path`` is ``-``."""
-    text = json.dumps(data, indent=2) + "\n"
+    """``data`` as JSON to the file ``path``, or to the standard output when ``path`` is ``-``. JSON has no
+    NaN or infinity: a number that is not finite (an undefined quantity) is written as null."""
+    text = json.dumps(finite(data), indent=2, allow_nan=False) + "\n"
     if str(path) == "-":
         stream = _JSON_STDOUT.get() or sys.stdout
         stream.write(text)

@@ -8,6 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .files import save_figure
+
 
 def _pyplot():
     import matplotlib
@@ -67,16 +69,12 @@ def save_map(path, xy, cells, values, title: str, per: str = "node") -> Path:
 
         fig = plt.figure(figsize=(6.5, 5.5))
         point_map_3d(fig, 111, xy, values, "", title=title)
-        fig.savefig(path, dpi=120)
-        plt.close(fig)
-        return Path(path)
+        return save_figure(fig, path, dpi=120)
     fig, ax = plt.subplots(figsize=(5.5, 5))
     m = (node_map if per == "node" else element_map)(ax, xy, cells, values, title)
     fig.colorbar(m, ax=ax)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return Path(path)
+    return save_figure(fig, path, dpi=120)
 
 
 def condition_curve_plot(ax, curve, rank: int | None = None):
@@ -117,9 +115,7 @@ def localisation_figure(path, subset, names) -> Path:
     axs[1, 1].set_ylabel("relative change")
     axs[1, 1].set_title(f"{subset.method} solution")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return Path(path)
+    return save_figure(fig, path, dpi=110)
 
 
 def success_ratio_figure(path, summary, equations: str | None = None) -> Path:
@@ -144,6 +140,4 @@ def success_ratio_figure(path, summary, equations: str | None = None) -> Path:
         ax.set_title(method)
         ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return Path(path)
+    return save_figure(fig, path, dpi=110)

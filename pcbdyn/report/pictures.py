@@ -14,11 +14,11 @@ when that child fails, matplotlib draws the 3-D view too. The page itself is mat
 
 from __future__ import annotations
 
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from ..atomic import temporary_folder
 from .files import atomic_path
 from .pictures3d import mode_pictures_3d
 from .rendering import CMAP, OTHER, QUANTITY, STYLE, picture_names, render_child, trim
@@ -109,7 +109,7 @@ def mode_pictures(vtu: Path, model, frequencies, shapes, out_dir: Path, prefix: 
     tris = [c for c in cells if c.shape[1] == 3] + [c[:, [0, 1, 2]] for c in cells if c.shape[1] == 4]
     tris += [c[:, [0, 2, 3]] for c in cells if c.shape[1] == 4]
     tri = Triangulation(model.nodes[:, 0] * 1e3, model.nodes[:, 1] * 1e3, np.concatenate(tris))
-    with tempfile.TemporaryDirectory(prefix="pcbdyn-views-") as views:
+    with temporary_folder("pcbdyn-views") as views:
         renderer = "pyvista" if render_child(vtu, Path(views), names) else "matplotlib"
         for k, (name, f) in enumerate(zip(names, frequencies)):
             w = shapes[2::6, k]

@@ -9,11 +9,11 @@ fails; the second is matplotlib's. Formatting only."""
 
 from __future__ import annotations
 
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from ..atomic import temporary_folder
 from .files import atomic_path
 from .rendering import CMAP, OTHER, STYLE, picture_names, render_child, trim
 
@@ -97,7 +97,7 @@ def mode_pictures_3d(vtu: Path, model, frequencies, shapes, out_dir: Path, prefi
 
     names = picture_names(prefix, len(frequencies))
     mag = magnitudes(model, shapes)
-    with tempfile.TemporaryDirectory(prefix="pcbdyn-views-") as views:
+    with temporary_folder("pcbdyn-views") as views:
         renderer = "pyvista" if render_child(vtu, Path(views), names, "magnitude") else "matplotlib"
         for k, (name, f) in enumerate(zip(names, frequencies)):
             view = plt.imread(Path(views) / name) if renderer == "pyvista" else None

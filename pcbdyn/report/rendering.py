@@ -76,13 +76,15 @@ def trim(image, pad: int = 8):
 
 
 def render_child(vtu: Path, folder: Path, names: list, quantity: str = "w") -> bool:
-    """Run :func:`render_pyvista` in a child process; True when every view was written."""
-    code = ("import sys, json; from pathlib import Path; from pcbdyn.report.rendering import render_pyvista; "
-            "a = json.loads(sys.argv[1]); render_pyvista(Path(a[0]), Path(a[1]), a[2], a[3])")
+    """Run :func:`render_pyvista` in a child process (which dies with this one:
+    :func:`pcbdyn.children.die_with_parent`); True when every view was written."""
+    code = ("import sys, json; from pathlib import Path; from pcbdyn.children import die_with_parent; "
+            "a = json.loads(sys.argv[1]); die_with_parent(a[4]); from pcbdyn.report.rendering import render_pyvista; "
+            "render_pyvista(Path(a[0]), Path(a[1]), a[2], a[3])")
     env = {**os.environ, "VTK_DEFAULT_OPENGL_WINDOW": os.environ.get("VTK_DEFAULT_OPENGL_WINDOW",
                                                                        "vtkEGLRenderWindow")}
     try:
-        res = subprocess.run([sys.executable, "-c", code, json.dumps([str(vtu), str(folder), names, quantity])],
+        res = subprocess.run([sys.executable, "-c", code, json.dumps([str(vtu), str(folder), names, quantity, os.getpid()])],
                              env=env, capture_output=True, timeout=600)
     except subprocess.TimeoutExpired:
         return False

@@ -3,11 +3,11 @@ iteration plots and the JSON."""
 
 from __future__ import annotations
 
-from pathlib import Path
 
 import numpy as np
 
 from ..units import from_si
+from .files import save_figure
 
 #: SI unit of the JSON values for the display units the input files use (others are SI already)
 SI_UNITS = {"mm": "m", "g": "kg"}
@@ -73,9 +73,7 @@ def plot_iterations(path, problem, result) -> None:
     ax[2].semilogy(it, [_finite(h["condition_stacked"]) for h in result.history], "o-")
     ax[2].set(xlabel="iteration", ylabel="condition number", title="stacked equations")
     fig.tight_layout()
-    Path(path).parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
+    save_figure(fig, path, dpi=100)
 
 
 def _finite(v):

@@ -14,6 +14,7 @@ import re
 
 import numpy as np
 
+from ..units import shown
 from .data import Dofs, Modes, Points, TestDataError
 from .uff_write import _atomic
 
@@ -22,20 +23,36 @@ _HEAD = re.compile(r"^\s*([A-Za-z][A-Za-z0-9 ]*?)\s*(?:[\[(]\s*([^\])]*)\s*[\])]
 
 
 def _table(path):
-    import pandas as pd
+    from ..inputs import read_csv
 
     path = os.fspath(path)
-    try:
-        df = pd.read_csv(path, skipinitialspace=True, comment="#")
-    except Exception as exc:
-        raise TestDataError(f"{path}: not a readable CSV file ({exc})") from None
+    df = read_csv(path, TestDataError, skipinitialspace=True)
+    if df.empty:
+        raise TestDataError(f"{path}: no data rows below the header")
     cols = {}
     for c in df.columns:
-        m = _HEAD.match(str(c))
+        m = _HEAD.match(str(c)[:100])
         if not m:
-            raise TestDataError(f"{path}: column '{c}' is not 'name' or 'name [unit]'")
-        cols[m.group(1).strip().lower()] = (c, m.group(2) or m.group(3))
+            raise TestDataError(f"{path}: column {shown(str(c))} is not 'name' or 'name [unit]'")
+        name = m.group(1).strip().lower()
+        if name in cols:
+            raise TestDataError(f"{path}: two columns are called '{name}'; keep one")
+        cols[name] = (c, m.group(2) or m.group(3))
     return df, cols
+
+
+def numbers(path, df, col, whole: bool = False) -> np.ndarray:
+    """Column ``col`` of ``df`` as finite floats (``whole``: whole numbers as int64); a TestDataError names
+    the file, the column and the first row that is not one."""
+    import pandas as pd
+
+    v = pd.to_numeric(df[col], errors="coerce").to_numpy(dtype=float)
+    bad = ~np.isfinite(v) | ((v != np.round(v)) | (np.abs(v) > 2**53) if whole else False)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise TestDataError(f"{path}: data row {i + 1}: column '{col}' holds {shown(str(df[col].iloc[i]))}, not a "
+                            f"{'whole number' if whole else 'finite number'}; give one in every row")
+    return v.astype(np.int64) if whole else v
 
 
 def _length_col(path, df, cols, name, unit, required=True):
@@ -49,7 +66,7 @@ def _length_col(path, df, cols, name, unit, required=True):
         raise TestDataError(f"{path}: column '{col}' has no unit; write it as '{name} [mm]' (or '{name} [m]')")
     if u not in _LENGTH:
         raise TestDataError(f"{path}: column '{col}': unit '{u}' is not one of {', '.join(_LENGTH)}")
-    return df[col].to_numpy(dtype=float) * _LENGTH[u]
+    return numbers(path, df, col) * _LENGTH[u]
 
 
 def read_points_csv(path, unit: str | None = None):
@@ -60,7 +77,7 @@ def read_points_csv(path, unit: str | None = None):
     key = "point" if "point" in cols else "id" if "id" in cols else None
     if key is None:
         raise TestDataError(f"{path}: no 'point' column with the point ids")
-    ids = df[cols[key][0]].to_numpy(dtype=np.int64)
+    ids = numbers(path, df, cols[key][0], whole=True)
     xyz = np.column_stack([_length_col(path, df, cols, "x", unit), _length_col(path, df, cols, "y", unit),
                            _length_col(path, df, cols, "z", unit, required=False)])
     dirs = df[cols["dir"][0]].astype(str).tolist() if "dir" in cols else ["+z"] * len(df)
@@ -73,6 +90,12 @@ def read_points_csv(path, unit: str | None = None):
         dofs = Dofs.from_codes(ids, dirs)
     except TestDataError as exc:
         raise TestDataError(f"{path}: {exc}") from None
+    seen = {}
+    for i, key in enumerate(zip(ids.tolist(), map(tuple, np.round(dofs.directions, 12).tolist()))):
+        if key in seen:
+            raise TestDataError(f"{path}: data rows {seen[key] + 1} and {i + 1} give point {key[0]} in the same "
+                                "direction; keep one of them")
+        seen[key] = i
     return Points(uid, xyz[first]), dofs
 
 
@@ -126,17 +149,23 @@ def read_modes_csv(freq_path, shapes_path) -> Modes:
     scale = {None: 1.0, "hz": 1.0, "khz": 1e3}.get((u or "hz").lower())
     if scale is None:
         raise TestDataError(f"{freq_path}: frequency unit '{u}' is not Hz or kHz")
-    f = df[col].to_numpy(dtype=float) * scale
-    zeta = df[cols["damping ratio"][0]].to_numpy(dtype=float) if "damping ratio" in cols else None
-    mpc = df[cols["mpc"][0]].to_numpy(dtype=float) if "mpc" in cols else None
+    f = numbers(freq_path, df, col) * scale
+    zeta = numbers(freq_path, df, cols["damping ratio"][0]) if "damping ratio" in cols else None
+    mpc = numbers(freq_path, df, cols["mpc"][0]) if "mpc" in cols else None
     sf, scols = _table(shapes_path)
-    ids = sf[scols["point"][0]].to_numpy(dtype=np.int64)
+    for name in ("point", "dx", "dy", "dz"):
+        if name not in scols:
+            raise TestDataError(f"{shapes_path}: no column '{name}' (point, x [m], y [m], z [m], dx, dy, dz, mode 1, ...)")
+    ids = numbers(shapes_path, sf, scols["point"][0], whole=True)
     xyz = np.column_stack([_length_col(shapes_path, sf, scols, a, "m") for a in "xyz"])
-    d = np.column_stack([sf[scols[a][0]].to_numpy(dtype=float) for a in ("dx", "dy", "dz")])
+    d = np.column_stack([numbers(shapes_path, sf, scols[a][0]) for a in ("dx", "dy", "dz")])
     names = [f"mode {j + 1}" for j in range(f.size)]
     missing = [n for n in names if n not in scols]
     if missing:
         raise TestDataError(f"{shapes_path}: no columns {missing[:5]} for the {f.size} modes of {freq_path}")
-    shapes = np.column_stack([sf[scols[n][0]].to_numpy(dtype=float) for n in names])
+    shapes = np.column_stack([numbers(shapes_path, sf, scols[n][0]) for n in names])
     uid, first = np.unique(ids, return_index=True)
-    return Modes(Points(uid, xyz[first]), Dofs(ids, d), f, shapes, zeta, mpc)
+    try:
+        return Modes(Points(uid, xyz[first]), Dofs(ids, d), f, shapes, zeta, mpc)
+    except TestDataError as exc:
+        raise TestDataError(f"{freq_path}, {shapes_path}: {exc}") from None

@@ -35,6 +35,10 @@ class Points:
         self.xyz = np.asarray(self.xyz, dtype=float).reshape(-1, 3)
         if self.ids.size != self.xyz.shape[0]:
             raise TestDataError(f"points: {self.ids.size} ids but {self.xyz.shape[0]} coordinates")
+        bad = ~np.isfinite(self.xyz).all(axis=1)
+        if bad.any():
+            raise TestDataError(f"points: {self.ids[bad].tolist()[:20]} have coordinates that are not finite numbers; "
+                                "give each point three numbers")
         uniq, counts = np.unique(self.ids, return_counts=True)
         if np.any(counts > 1):
             raise TestDataError(
@@ -75,6 +79,8 @@ class Dofs:
         if d.shape[0] != self.point_ids.size:
             raise TestDataError(f"dofs: {self.point_ids.size} points but {d.shape[0]} directions")
         norm = np.linalg.norm(d, axis=1)
+        if not np.isfinite(norm).all():
+            raise TestDataError("dofs: a measured direction holds a value that is not a finite number")
         if np.any(norm == 0):
             raise TestDataError("dofs: a measured direction is the zero vector; give a direction such as +z")
         self.directions = d / norm[:, None]
@@ -114,8 +120,11 @@ def _code_vector(code):
         sign = -1.0 if s.startswith("-") else 1.0
         s = s.lstrip("+-")
         if s not in _AXIS_NAMES:
-            raise TestDataError(f"direction '{code}' is not one of x, y, z (optionally signed, e.g. '+z')")
+            raise TestDataError(f"direction {code[:20]!r} is not one of x, y, z (optionally signed, e.g. '+z')")
         code = int(sign) * _AXIS_NAMES[s]
+    if isinstance(code, (bool, np.bool_)) or not isinstance(code, (int, float, np.integer, np.floating)) \
+            or not np.isfinite(code) or code != int(code):
+        raise TestDataError(f"direction code {str(code)[:20]!r} is not a translation (use +-1, +-2, +-3 for x, y, z)")
     code = int(code)
     if abs(code) not in AXES:
         raise TestDataError(f"direction code {code} is not a translation (use +-1, +-2, +-3 for x, y, z)")
@@ -152,8 +161,14 @@ class Modes:
             self.shapes = np.asarray(self.shapes, dtype=float).reshape(len(self.dofs), -1)
             if self.shapes.shape[1] != n:
                 raise TestDataError(f"modes: {n} frequencies but {self.shapes.shape[1]} shape columns")
+            if not np.isfinite(self.shapes).all():
+                raise TestDataError("modes: a shape holds a value that is not a finite number (NaN or infinity); "
+                                    "give every measured DOF a number")
             self.points.index(np.unique(self.dofs.point_ids))
         self.damping = np.zeros(n) if self.damping is None else np.asarray(self.damping, float).ravel()
+        if self.damping.size != n or not (np.all(np.isfinite(self.damping)) and np.all(np.abs(self.damping) < 1)):
+            raise TestDataError(f"modes: damping ratios must be finite and below 1 in size, one per mode, got "
+                                f"{self.damping.tolist()[:20]}")
         self.mpc = np.ones(n) if self.mpc is None else np.asarray(self.mpc, float).ravel()
         self.numbers = np.arange(1, n + 1) if self.numbers is None else np.asarray(self.numbers, int).ravel()
         if self.numbers.size != n:

@@ -16,7 +16,12 @@ BASE_NAMES = ("base", "c1", "")
 
 def read_modes(path) -> Modes:
     """The measured modes of a UFF file; a clear error when there are none."""
+    from ..domain import MAX_MODES
+
     data = read_uff(path)
+    if data.modes is not None and data.modes.n_modes > MAX_MODES:
+        raise TestDataError(f"{path}: {data.modes.n_modes} modes, more than the {MAX_MODES} pcbdyn pairs with a model; "
+                            "keep the measured modes of interest")
     if data.modes is None or data.modes.n_modes == 0:
         what = " (it holds FRFs only: identify modes from them first)" if data.frfs is not None else ""
         raise TestDataError(f"{path}: no mode shapes (UFF dataset 55) in the file{what}; export the test's mode "
@@ -45,24 +50,29 @@ def read_frequency_table(path, structure) -> list:
     """[(configuration or None, Modes of frequencies only)] from a CSV of measured frequencies with
     columns configuration, mode, frequency_hz (configuration base or c1: the base configuration);
     each mode pairs with the model's elastic mode of its number."""
-    import pandas as pd
+    from ..domain import MAX_MODES
+    from ..inputs import read_csv
+    from .csvio import numbers
 
     path = Path(path)
-    try:
-        df = pd.read_csv(path, comment="#")
-    except (ValueError, OSError, UnicodeDecodeError) as exc:
-        raise TestDataError(f"{path.name}: cannot be read as CSV ({exc})") from None
+    df = read_csv(path, TestDataError, dtype={"configuration": str}, keep_default_na=False)
     need = {"configuration", "mode", "frequency_hz"}
     if not need <= set(df.columns):
-        raise TestDataError(f"{path.name}: needs columns {sorted(need)}, found {list(df.columns)}")
+        raise TestDataError(f"{path.name}: needs columns {sorted(need)}, found {[str(c)[:40] for c in df.columns][:10]}")
+    if df.empty:
+        raise TestDataError(f"{path.name}: no data rows below the header; give one row per measured mode")
+    f, n = numbers(path.name, df, "frequency_hz"), numbers(path.name, df, "mode", whole=True)
     out = []
-    for name, g in df.groupby("configuration", sort=False):
+    for name, rows in df.groupby("configuration", sort=False).indices.items():
         cfg = None if str(name) in BASE_NAMES else _configuration(structure, str(name), path.name)
-        try:
-            f, n = g["frequency_hz"].to_numpy(float), g["mode"].to_numpy(float)
-        except ValueError as exc:
-            raise TestDataError(f"{path.name}: configuration {name}: {exc}; give numbers") from None
-        if np.any(n != np.round(n)) or np.any(n < 1):
-            raise TestDataError(f"{path.name}: configuration {name}: mode numbers must be whole numbers >= 1")
-        out.append((cfg, Modes.frequencies_only(f, n.astype(int))))
+        fc, nc = f[rows], n[rows]
+        if np.any(nc < 1) or np.any(nc > MAX_MODES):
+            raise TestDataError(f"{path.name}: configuration {name}: mode numbers must be whole numbers from 1 to "
+                                f"{MAX_MODES}")
+        if np.unique(nc).size < nc.size:
+            raise TestDataError(f"{path.name}: configuration {name}: a mode number is given twice; give each mode once")
+        if not np.all(fc > 0):
+            raise TestDataError(f"{path.name}: configuration {name}: frequency {fc[fc <= 0][0]:g} Hz; measured "
+                                "frequencies are above 0")
+        out.append((cfg, Modes.frequencies_only(fc, nc)))
     return out

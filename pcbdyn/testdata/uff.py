@@ -23,6 +23,7 @@ to SI (mode shapes keep their scaling: it is arbitrary anyway). Files are writte
 
 from __future__ import annotations
 
+import math
 import os
 import re
 
@@ -35,15 +36,22 @@ _NUM = re.compile(rb"[-+]?(?:(?:\d+\.\d*|\.\d+|\d+)(?:[ED][-+]?\d+)?|nan|inf(?:i
 _SPEC_KIND = {8: "receptance", 11: "mobility", 12: "accelerance"}
 _G = 9.80665
 _TAG = b"    -1"
+#: largest magnitude of a mode shape value read (shapes are scaled as the test gave them)
+MAX_SHAPE = 1e30
 
 
-def _numbers(line: bytes, where: str) -> list:
-    """The numbers on one data line; any other character on it is an error naming ``where``."""
+def _numbers(line: bytes, where: str, nan: bool = False) -> list:
+    """The numbers on one data line; any other character on it, or a value that is not finite (``nan``:
+    NaN allowed, an FRF value not measured), is an error naming ``where``."""
     rest = _NUM.sub(b" ", line).strip()
     if rest:
         text = line.decode("latin-1").strip()[:60]
         raise TestDataError(f"{where}: '{rest.decode('latin-1')[:20]}' is not a number (the line reads '{text}')")
-    return [float(t.replace(b"D", b"E").replace(b"d", b"e")) for t in _NUM.findall(line)]
+    out = [float(t.replace(b"D", b"E").replace(b"d", b"e")) for t in _NUM.findall(line)]
+    if not all(math.isfinite(v) or (nan and math.isnan(v)) for v in out):
+        text = line.decode("latin-1").strip()[:60]
+        raise TestDataError(f"{where}: a value is not a finite number (the line reads '{text}'); write a number there")
+    return out
 
 
 class _Cursor:
@@ -155,13 +163,20 @@ def _node_records(lines, first: int):
         if not line.strip():
             continue
         if _INT_LINE.match(line):
-            nodes.append(int(line))
+            nodes.append(_label(int(line), f"line {first + k + 1} of the dataset"))
             vals.append([])
         elif not nodes:
             raise TestDataError(f"values before the first node number (line {first + k + 1} of the dataset)")
         else:
             vals[-1].extend(_numbers(line, f"node {nodes[-1]}, line {first + k + 1} of the dataset"))
     return nodes, vals
+
+
+def _label(n, where: str) -> int:
+    """A node label: a whole number from 1 to 2^31 - 1 (the standard's I10 field)."""
+    if not (n == int(n) and 1 <= n < 2**31):
+        raise TestDataError(f"{where}: node label {n:g} is not a whole number from 1 to 2147483647")
+    return int(n)
 
 
 _NODE_FIELDS = {4: "label, two coordinate systems, colour", 3: "x, y, z",
@@ -186,6 +201,8 @@ def _parse_nodes(raw: bytes, t: int) -> dict:
     if part:
         raise TestDataError(f"node {int(part[0][0])} has no coordinates line (the dataset ends after its label line)")
     v = np.array(rows, dtype=float).reshape(-1, 7)
+    for label in v[:, 0]:
+        _label(label, "a node record")
     return {"type": t, "node_nums": v[:, 0], "x": v[:, 4], "y": v[:, 5], "z": v[:, 6]}
 
 
@@ -199,6 +216,9 @@ def _parse164(raw: bytes) -> dict:
     except ValueError:
         raise TestDataError(f"record 1 '{lines[2][:10].decode('latin-1')}' is not a units code") from None
     f = _Cursor(lines[3:], 3).take(4, "record 2 (length, force, temperature, offset)")
+    if not (f[0] > 0 and f[1] > 0 and f[2] > 0):
+        raise TestDataError(f"record 2: the length, force and temperature factors must be above 0, got {f[:3]} (a "
+                            "file in SI has 1.0 for each)")
     return {"type": 164, "units_code": code, "length": f[0], "force": f[1], "temp": f[2], "temp_offset": f[3]}
 
 
@@ -206,14 +226,31 @@ def _mode_from55(d: dict):
     """(frequency, damping, {node: 3 translations (complex)}) of one parsed 55 dataset, or None."""
     a, r = d["analysis"], d["reals"]
     if a == 2:
+        if not r:
+            raise TestDataError("record 8 holds no frequency")
         freq, zeta = r[0], (r[2] if len(r) > 2 else 0.0)
     elif a in (3, 7):
+        if len(r) < 2:
+            raise TestDataError("record 8 holds no eigenvalue (real and imaginary parts)")
         lam = complex(r[0], r[1])
         freq, zeta = abs(lam) / (2 * np.pi), (-lam.real / abs(lam) if abs(lam) > 0 else 0.0)
     else:
         return None
     if d["values"].shape[1] < 3:
         raise TestDataError("a mode shape needs 3 values per node (x, y, z); this one has fewer")
+    if not freq > 0:
+        raise TestDataError(f"record 8: the mode's frequency is {freq:g} Hz; a measured mode has a frequency above 0")
+    if not 0 <= zeta < 1:
+        raise TestDataError(f"record 8: the damping ratio {zeta:g} is not from 0 to below 1 (a measured mode's "
+                            "viscous damping ratio, e.g. 0.02)")
+    nodes, counts = np.unique(d["nodes"], return_counts=True)
+    if (counts > 1).any():
+        raise TestDataError(f"node {int(nodes[counts > 1][0])} is given twice; give each node's values once")
+    if not np.any(d["values"][:, :3] != 0):
+        raise TestDataError("the mode shape is zero at every node; remove the dataset or give the shape")
+    if np.abs(d["values"]).max() > MAX_SHAPE:
+        raise TestDataError(f"a shape value of {np.abs(d['values']).max():.3g} is beyond any scaling of a mode shape "
+                            f"(at most {MAX_SHAPE:g}); check record 10 of the dataset")
     return freq, zeta, d["nodes"], d["values"][:, :3]
 
 
@@ -225,10 +262,13 @@ def real_modes(psi: np.ndarray):
     for a mode whose components are all in phase (a true normal mode) and 0 for a travelling wave.
     """
     psi = np.asarray(psi, dtype=complex)
+    big = np.max(np.abs(psi), axis=0) if psi.size else np.ones(psi.shape[1:])
+    scale = np.ldexp(1.0, np.frexp(np.where(big > 0, big, 1.0))[1])  # a power of 2: scaling by it is exact
+    psi = psi / scale  # MPC and the real part are unchanged by scale: no overflow in the squares
     s = np.sum(psi * psi, axis=0)
     n2 = np.sum(np.abs(psi) ** 2, axis=0)
     theta = 0.5 * np.angle(s)
-    phi = np.real(psi * np.exp(-1j * theta))
+    phi = np.real(psi * np.exp(-1j * theta)) * scale
     with np.errstate(invalid="ignore", divide="ignore"):
         mpc = np.where(n2 > 0, np.abs(s) ** 2 / n2**2, 1.0)
     return phi, mpc
@@ -317,11 +357,11 @@ def _read58(uff, k, raw) -> dict:
         n, got = int(d["num_pts"]), len(d["data"])
         if got < n:
             raise TestDataError(f"its binary data holds {got} values, record 7 announces {n}")
-        return d
+        return _checked58(d)
     d = uff.read_sets(k, header_only=True)
     vals = []
     for i, line in enumerate(raw.splitlines()[13:]):
-        vals.extend(_numbers(line, f"record 12, line {i + 14} of the dataset"))
+        vals.extend(_numbers(line, f"record 12, line {i + 14} of the dataset", nan=True))
     v = np.array(vals)
     n = int(d["num_pts"])
     complex_ = d["ord_data_type"] in (5, 6)
@@ -333,6 +373,22 @@ def _read58(uff, k, raw) -> dict:
     d["x"] = d["abscissa_min"] + np.arange(n) * d["abscissa_inc"] if even else v[:, 0]
     y = v[:, 0 if even else 1 :]
     d["data"] = y[:, 0] + 1j * y[:, 1] if complex_ else y[:, 0]
+    return _checked58(d)
+
+
+def _checked58(d: dict) -> dict:
+    """A 58 dataset with at least one line, its frequency axis finite and rising from 0 Hz up, its values
+    finite or NaN (a line not measured: pcbdyn writes NaN where no receptance exists, at 0 Hz)."""
+    n = int(d["num_pts"])
+    x, y = np.asarray(d["x"], dtype=float)[:n], np.asarray(d["data"])[:n]
+    if n < 1:
+        raise TestDataError("record 7 announces no data points")
+    if not np.isfinite(x).all() or np.isinf(y).any():
+        raise TestDataError("its abscissa or data hold infinite values (record 7 or 12); write numbers (or NaN for "
+                            "a value not measured)")
+    if x[0] < 0 or (n > 1 and not np.all(np.diff(x) > 0)):
+        raise TestDataError(f"its frequency axis must start at 0 Hz or above and rise ({x[0]:g} Hz first, step "
+                            f"{(x[1] - x[0]) if n > 1 else 0:g} Hz); check record 7 (abscissa minimum and increment)")
     return d
 
 
@@ -368,6 +424,9 @@ def _frf_scale(d, kind, L, F) -> float:
     lab = str(d.get("ordinate_axis_units_lab", "")).strip().lower()
     a, b = d.get("ordinate_len_unit_exp", 0), d.get("ordinate_force_unit_exp", 0)
     c, e = d.get("orddenom_len_unit_exp", 0), d.get("orddenom_force_unit_exp", 0)
+    if any(not isinstance(v, (int, float)) or abs(v) > 4 for v in (a, b, c, e)):
+        raise TestDataError(f"the unit exponents of records 9 and 10 ({a}, {b}, {c}, {e}) "
+                            "are not small whole numbers (an FRF has length, force exponents -2 to 2)")
     if a == 0 and b == 0:
         a = 1  # a displacement, velocity or acceleration: length in the numerator
     if c == 0 and e == 0:
@@ -392,7 +451,10 @@ def _assemble_frfs(frf58, geo: Points, L, F, frf_kind) -> FRFs:
         kinds.add(kind)
         n = int(d.get("num_pts", len(d["data"])))
         x = np.asarray(d["x"], dtype=float)[:n]  # some tools pad the last line (pyuff issue 22)
-        y = np.asarray(d["data"])[:n] * _frf_scale(d, kind, L, F)
+        try:
+            y = np.asarray(d["data"])[:n] * _frf_scale(d, kind, L, F)
+        except TestDataError as exc:
+            raise TestDataError(f"dataset #{k}: {exc}") from None
         if x0 is None:
             x0 = x
         elif x.size != x0.size or not np.allclose(x, x0, rtol=1e-9, atol=0):

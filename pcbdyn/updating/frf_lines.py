@@ -6,6 +6,7 @@ import numpy as np
 
 from ..correlation.frf import fdac
 from ..fe.modal import eigenpairs
+from .errors import UpdatingError
 
 
 def resonance_lines(f, H) -> np.ndarray:
@@ -44,7 +45,7 @@ def choose_frf_frequencies(f, H_x, H_a, gap: float = 0.1, n_max: int = 8, min_fd
         note = (f"no line away from the resonances has FDAC >= {min_fdac}; the best-correlated ones are used "
                 "(check the pairing of test and model, or give --frf-freqs)")
     if not ok.any():
-        raise ValueError("no measured line lies away from the resonances; give the updating frequencies (--frf-freqs)")
+        raise UpdatingError("no measured line lies away from the resonances; give the updating frequencies (--frf-freqs)")
     picks = [k[np.argmax(cos[k])] for i in np.unique(interval[ok]) for k in [np.flatnonzero(ok & (interval == i))]]
     picks = sorted(picks, key=lambda k: -cos[k])[:n_max]
     return np.sort(np.asarray(picks, int)), cos, note

@@ -17,6 +17,7 @@ import numpy as np
 
 from . import equations as eq
 from . import matching
+from .errors import UpdatingError
 from .pbc import condition_number, stack
 from .sensitivity import frequencies_hz, solve_modes
 from .solvers import SOLVERS, Solution, bayes_alpha, frequency_residue, line_search
@@ -239,7 +240,7 @@ def build_equations(configs, p, pairing: Callable | None = None, stack_reduce: b
     states = [_state(c, p, pairing) for c in configs]
     active = [(c, st) for c, st in zip(configs, states) if not st.get("set_aside")]
     if not active:
-        raise ValueError("no measured mode of any configuration found an analytical partner; check that test and "
+        raise UpdatingError("no measured mode of any configuration found an analytical partner; check that test and "
                          "model are the same structure and configuration, and the points' frame and units")
     blocks = [_block(c, st, p) for c, st in active]
     stacked = stack([_weighted(c, blk, st) for (c, st), blk in zip(active, blocks)], reduce=stack_reduce)

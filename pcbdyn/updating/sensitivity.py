@@ -11,6 +11,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..fe.modal import eigenpairs
+from .errors import UpdatingError
 
 def as_dense(A) -> np.ndarray:
     """Dense ndarray view of a dense or scipy-sparse matrix."""
@@ -88,7 +89,7 @@ def frequency_derivatives(lam, Phi, dKs, dMs) -> np.ndarray:
     """d f_i / d p_j [Hz per parameter unit] (thesis eq. 3.6): d lambda / (8 pi^2 f)."""
     f = frequencies_hz(lam)
     if np.any(f <= 0):
-        raise ValueError("frequency derivatives need elastic modes (f > 0); drop rigid-body modes first")
+        raise UpdatingError("frequency derivatives need elastic modes (f > 0); drop rigid-body modes first")
     return eigenvalue_derivatives(lam, Phi, dKs, dMs) / (8 * np.pi**2 * f[:, None])
 
 
@@ -125,7 +126,7 @@ def eigenvector_derivatives_modal(lam, Phi, i: int, dKs, dMs) -> np.ndarray:
     gap = lam[i] - lam
     gap[i] = 1.0
     if np.any(np.abs(gap) < 1e-10 * max(abs(lam[i]), 1.0)):
-        raise ValueError(f"mode {i} has a repeated eigenvalue: eq. 3.12 is invalid for repeated modes")
+        raise UpdatingError(f"mode {i} has a repeated eigenvalue: eq. 3.12 is invalid for repeated modes")
     BK, BM = bilinear_forms(Phi, Phi[:, i:i + 1], dKs, dMs)
     _, C = eigen_derivatives(BK, BM, lam, [i])
     beta = C[:, :, 0]

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .errors import UpdatingError
+
 
 def unit_row_weights(A) -> np.ndarray:
     """d_i = 1 / ||row i of A|| (thesis eq. 4.42); zero rows get weight 0 (they carry no information)."""
@@ -39,7 +41,7 @@ def tls_column_weight(A, b, precision_ratio: float = 1.0) -> float:
     """
     nb = np.linalg.norm(b)
     if nb == 0:
-        raise ValueError("b is zero: nothing to update (the model already matches the data)")
+        raise UpdatingError("b is zero: nothing to update (the model already matches the data)")
     return precision_ratio * np.linalg.norm(A) / nb
 
 

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..units import UnitError, to_si
+from ..units import UnitError, shown, to_si
 
 #: standard gravity [m/s^2]: the "g" of vibration specifications
 G = 9.80665
@@ -137,13 +137,12 @@ def _read_columns(path: Path, spec: dict) -> dict:
     [(pint unit, unit as shown in messages), ...]}, the kinds of unit accepted, tried in turn."""
     import pandas as pd
 
-    try:
-        df = pd.read_csv(path, skipinitialspace=True, comment="#")
-    except Exception as exc:  # pandas raises several types for unreadable files
-        raise VibrationError(f"{path}: not a readable CSV file ({exc})") from None
+    from ..inputs import read_csv
+
+    df = read_csv(path, VibrationError, skipinitialspace=True)
     cols = {}
     for c in df.columns:
-        m = _COLUMN.match(str(c))
+        m = _COLUMN.match(str(c)[:100])
         if m:
             cols[m.group(1).strip().lower()] = (str(c), m.group(2))
     out = {}
@@ -157,7 +156,7 @@ def _read_columns(path: Path, spec: dict) -> dict:
         raw = pd.to_numeric(df[col], errors="coerce").to_numpy(dtype=float)
         bad = np.flatnonzero(~np.isfinite(raw))
         if bad.size:
-            raise VibrationError(f"{path}: data row {bad[0] + 1}: column '{col}' holds {df[col].iloc[bad[0]]!r}, "
+            raise VibrationError(f"{path}: data row {bad[0] + 1}: column '{col}' holds {shown(df[col].iloc[bad[0]])}, "
                                  "not a number")
         for k, (expected, _) in enumerate(units):
             try:
