@@ -135,6 +135,18 @@ def entry_name(collection: str, entry: dict, index: int) -> str:
     return f"{prefix}{index + 1}"
 
 
+def new_entry_name(text: str, used: set, fallback: str) -> str:
+    """A name for a new entry made from ``text`` (a diagnosed effect's label): letters, digits, _ and -
+    only (usable in targets), within the readers' length limit, and not in ``used`` (to which it is
+    added)."""
+    base = (re.sub(r"[^A-Za-z0-9_-]+", "_", text).strip("_") or fallback)[:MAX_NAME - 4]
+    out, k = base, 2
+    while out in used:
+        out, k = f"{base}_{k}", k + 1
+    used.add(out)
+    return out
+
+
 def check_name(name: str) -> str | None:
     """Why ``name`` cannot name an entry that targets address (None when it can)."""
     return f"'{name}' contains '.', which parameter targets use as a separator; rename it" if "." in name else None

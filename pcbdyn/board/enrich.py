@@ -17,7 +17,6 @@ A point_mass and a point_inertia at the same point become one ``[[masses]]`` ent
 from __future__ import annotations
 
 import datetime as _dt
-import re
 from pathlib import Path
 
 import numpy as np
@@ -62,12 +61,7 @@ class _Names:
                      for key in ("fixtures", "masses", "line_masses", "stiffeners", "regions")}
 
     def __call__(self, key: str, name: str) -> str:
-        base = re.sub(r"[^A-Za-z0-9_-]+", "_", name).strip("_") or key
-        out, k = base, 2
-        while out in self.used[key]:
-            out, k = f"{base}_{k}", k + 1
-        self.used[key].add(out)
-        return out
+        return targets.new_entry_name(name, self.used[key], key)
 
 
 def _entries(effects, names) -> list:

@@ -10,7 +10,6 @@ value (SI), at (x, y, z) [m] and plate.
 
 from __future__ import annotations
 
-import re
 
 import numpy as np
 import tomlkit
@@ -21,10 +20,7 @@ from .entries import BoxError
 
 def _name(doc, base: str) -> str:
     used = {targets.entry_name("masses", e, i) for i, e in enumerate(doc.get("masses", []))}
-    out, k = re.sub(r"[^A-Za-z0-9_-]+", "_", base).strip("_") or "mass", 2
-    while out in used:
-        out, k = f"{base}_{k}", k + 1
-    return out
+    return targets.new_entry_name(base, used, "mass")
 
 
 def enriched_text(box, text: str, effects) -> str:

@@ -322,3 +322,20 @@ def test_writer_validates_before_writing(base, tmp_path):
     assert not out.exists() and not list(tmp_path.glob(".x.*"))
     with pytest.raises(BoardError, match=r"effects\[0\]\.type: unknown effect type"):
         write_enriched(path, [{"type": "magic", "name": "x", "value": 1.0}], out_path=out)
+
+
+def test_merged_region_with_a_long_label_is_written_under_a_short_name(base, tmp_path):
+    """Two overlapping regions found by diagnose are reported as one whose label joins both (94
+    characters on the bench's region_bare_wedge case), longer than a board.toml name may be: the
+    enriched file must still load, the entry named within the limit and the full label kept in its
+    comment."""
+    from pcbdyn.inputs import MAX_NAME
+
+    path, _, cands, _ = base
+    c = pick(cands, "region_stiffness", (0.05, 0.05))
+    label = "+".join([c.name] * 4)
+    assert len(label) > MAX_NAME
+    out = write_enriched(path, [{**as_effect(c, 0.5), "name": label}], out_path=tmp_path / "b.toml")
+    b = load_board(out)
+    assert len(b.regions) == 1 and len(b.regions[0].name) <= MAX_NAME
+    assert label in out.read_text()
