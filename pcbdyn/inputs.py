@@ -125,6 +125,7 @@ class Reader:
         most :data:`MAX_NAME` printable characters without '.', which parameter targets use."""
         from .targets import NAME_FIELD, check_name, entry_name
 
+        self.table(entry, where)
         key = NAME_FIELD.get(collection, "name")
         if key in entry:
             self.text(entry[key], f"{where}.{key}", MAX_NAME)

@@ -135,7 +135,7 @@ def load_box(path) -> Box:
 def _named(r, data, key, read, *args, limit: int = MAX_ENTRIES) -> list:
     """The entries of array ``key`` (at most ``limit``), each read by ``read(r, entry, where, name, *args)``,
     names unique."""
-    out = [read(r, e, f"{key}[{i}]", r.name(key, e, i, f"{key}[{i}]") if isinstance(e, dict) else "", *args)
+    out = [read(r, e, f"{key}[{i}]", r.name(key, e, i, f"{key}[{i}]"), *args)
            for i, e in enumerate(r.list(data, key, limit=limit))]
     r.unique([e.name for e in out], key, "name")
     return out

@@ -128,8 +128,8 @@ def read_mass(r, e, where, name, plates) -> BoxMass:
 def read_configuration(r, e, where, plates) -> Configuration:
     r.table(e, where, ["name", "masses"], required=["name"])
     ms = r.list(e, "masses", f"{where}.masses")
-    masses = [read_mass(r, m, f"{where}.masses[{j}]", r.name("masses", m, j, f"{where}.masses[{j}]") if
-                        isinstance(m, dict) else "", plates) for j, m in enumerate(ms)]
+    masses = [read_mass(r, m, f"{where}.masses[{j}]", r.name("masses", m, j, f"{where}.masses[{j}]"),
+                        plates) for j, m in enumerate(ms)]
     r.unique([m.name for m in masses], f"{where}.masses", "name")
     return Configuration(r.name("configurations", e, 0, where), masses)
 

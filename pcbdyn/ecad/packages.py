@@ -21,6 +21,7 @@ import fnmatch
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..board.spec import read_material
 from ..inputs import read_toml
 from .kicad import KicadError
 
@@ -79,10 +80,7 @@ def read_map(path) -> PackageMap:
     for name, m in materials.items():
         where = f"materials.\"{name[:MAX_NAME]}\""
         if isinstance(m, dict):
-            r.table(m, where, ["E", "nu", "rho"], required=["E", "nu", "rho"])
-            r.q(m["E"], "Pa", f"{where}.E", positive=True)
-            r.number(m["nu"], f"{where}.nu", -1.0, 0.5)
-            r.q(m["rho"], "kg/m^3", f"{where}.rho", positive=True)
+            read_material(r, m, where)
         elif not isinstance(m, str):
             r.fail(where, "give a pcbdyn material name or { E, nu, rho }")
     return PackageMap(path, entries, materials)
