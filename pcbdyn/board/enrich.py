@@ -20,10 +20,11 @@ import datetime as _dt
 from pathlib import Path
 
 import numpy as np
+import shapely
 import tomlkit
 
 from .. import targets
-from .entries import BoardError
+from .entries import MIN_SEGMENT, BoardError
 
 TYPES = ("point_mass", "point_inertia", "ground_spring", "edge_stiffness", "line_mass", "stiffener",
          "region_stiffness")
@@ -62,6 +63,13 @@ class _Names:
 
     def __call__(self, key: str, name: str) -> str:
         return targets.new_entry_name(name, self.used[key], key)
+
+
+def _outline(polygon) -> np.ndarray:
+    """``polygon`` (m, 2) without the corners closer than a board.toml polygon may have
+    (:data:`.entries.MIN_SEGMENT`): a union of overlapping regions has repeated and collinear ones."""
+    simple = shapely.Polygon(np.asarray(polygon, float)).simplify(MIN_SEGMENT)
+    return np.asarray(simple.exterior.coords)[:-1]
 
 
 def _entries(effects, names) -> list:
@@ -105,7 +113,7 @@ def _entries(effects, names) -> list:
                 "EI": targets.formatted(kind["stiffeners", "EI"], v)}))
         elif typ == "region_stiffness":
             out.append(("regions", f"{name}: stiffness changed by {100 * v:.4g} %", {
-                "name": names("regions", name), "polygon": [_point(p) for p in e["polygon"]],
+                "name": names("regions", name), "polygon": [_point(p) for p in _outline(e["polygon"])],
                 "stiffness_factor": targets.formatted(kind["regions", "stiffness_factor"], 1.0 + v)}))
     return out
 

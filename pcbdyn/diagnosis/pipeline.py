@@ -49,9 +49,6 @@ from .fitting import estimate
 from .scan import Runner
 from .select import ALPHA, adopt, penalty, refine, search, without_vanished
 
-#: [m] corners of a merged region's outline closer than this are merged (the board readers' shortest side)
-CORNER_TOL = 1e-4
-
 #: kinds whose effects :func:`_with_masses` carries onto the finer meshes
 MASS_KINDS = ("point_mass", "point_inertia", "line_mass")
 
@@ -455,9 +452,7 @@ def _merged(chosen, values, cov, group) -> dict:
         d["merged_at_mm"] = np.round(1e3 * np.array([chosen[k].at for k in group]), 3).tolist()
         if c.kind == "region_stiffness":
             boxes = [shapely.box(*_rectangle(chosen[k])) for k in group]
-            # corners closer than a board.toml polygon may have (repeated, collinear or sliver steps)
-            # are dropped, so that the enriched board that declares the region loads
-            union = shapely.union_all(boxes).simplify(CORNER_TOL)
+            union = shapely.union_all(boxes)
             w = np.array([b.area for b in boxes]) / union.area
             d["polygon_mm"] = np.round(1e3 * np.asarray(union.exterior.coords)[:-1], 3).tolist()
             d["at_mm"] = np.round(1e3 * np.asarray(union.centroid.coords)[0], 3).tolist()

@@ -53,12 +53,13 @@ class _Set:
         """(2, n_pos): the K and M values at scaled parameters ``x`` (all names), or their
         derivative along scaled parameter ``d`` (an index into the names)."""
         xs = x[self.js]
-        w = np.prod(xs ** self.exps, axis=1) if d is None else np.zeros(len(self.exps))
-        if d is not None:
+        if d is None:
+            w = np.prod(xs ** self.exps, axis=1)
+        else:
             k = self.js.index(d)
             e = self.exps[:, k]
             others = np.delete(np.arange(len(self.js)), k)
-            w = np.where(e > 0, e * xs[k] ** np.maximum(e - 1, 0), 0.0) * np.prod(xs[others] ** self.exps[:, others], axis=1)
+            w = e * xs[k] ** np.maximum(e - 1, 0) * np.prod(xs[others] ** self.exps[:, others], axis=1)
         return (w @ self.coef.reshape(len(w), -1)).reshape(2, -1)
 
 
