@@ -76,17 +76,19 @@ def worth_full(res, state, trials: list, p, bounds, limit: float, steps: int = R
     reach it; True otherwise (and for the trials a reanalysis cannot follow). ``steps``: Gauss-Newton
     steps of the quick fits (as many as the full fits they stand for, so that only the reanalysis
     differs)."""
-    rx = P = None
-    out = []
-    for cands, v0 in trials:
-        if not _followed(state, cands):
-            out.append(True)
-            continue
-        if rx is None:  # the parameters' columns are held: a reanalysed state has no full modes
-            rx, P = Reanalysis(res, state), res.param_columns(state)
-        quick = estimate(res, p, cands, v0, steps, bounds, param_columns=P, reduced=rx)
-        out.append(bool(quick.chi2 <= limit + SCREEN_MARGIN * state.chi2))
+    idx = [k for k, (cands, _) in enumerate(trials) if _followed(state, cands)]
+    chi2 = _screen(res, state, [trials[k] for k in idx], p, bounds, res.param_columns(state) if idx else None, steps)
+    out = [True] * len(trials)
+    for k, c in zip(idx, chi2):
+        out[k] = bool(c <= limit + SCREEN_MARGIN * state.chi2)
     return out
+
+
+def _screen(res, state, trials: list, p, bounds, P, steps: int) -> list:
+    """chi^2 of each of ``trials`` fitted on the reanalysis of ``state`` (``P``: the declared
+    parameters' columns, held: a reanalysed state has no full modes)."""
+    rx = Reanalysis(res, state) if trials else None
+    return [estimate(res, p, cands, v0, steps, bounds, param_columns=P, reduced=rx).chi2 for cands, v0 in trials]
 
 
 def rank(res, state, trials: list, p, bounds, P, runner: Runner | None = None) -> list:
@@ -97,9 +99,7 @@ def rank(res, state, trials: list, p, bounds, P, runner: Runner | None = None) -
     quick = [k for k, (cands, _) in enumerate(trials) if _followed(state, cands)]
     full = [k for k in range(len(trials)) if k not in quick]
     if len(quick) > FULL_RANK:
-        rx = Reanalysis(res, state)
-        chi2 = [estimate(res, p, trials[k][0], trials[k][1], RANK_STEPS, bounds, param_columns=P, reduced=rx).chi2
-                for k in quick]
+        chi2 = _screen(res, state, [trials[k] for k in quick], p, bounds, P, RANK_STEPS)
         quick = [quick[i] for i in np.argsort(chi2, kind="stable")[:FULL_RANK]]
         if runner.progress is not None:
             runner.progress(f"{len(chi2)} of {len(trials)} trials screened on the reanalysis")
