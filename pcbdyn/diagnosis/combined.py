@@ -16,7 +16,7 @@ from collections import OrderedDict
 import numpy as np
 import scipy.sparse as sp
 
-from ..fe.sparsity import canonical_csr, same_array
+from ..fe.sparsity import canonical_csr
 from .catalogue import BlockCache, derivatives, kind
 
 #: patterns of effect sets kept (least recently used dropped first)
@@ -37,13 +37,11 @@ class EffectPlan:
         for dK, dM in parts:
             union = union + abs(dK) + abs(dM)
         union.sum_duplicates()
-        # held: the plan is found again by the memory of the base's index arrays (fe.sparsity.same_array)
-        self.of, self.of_ptr = base.indices, base.indptr
+        self.of = base.indices  # held: the plan is found again by the identity of the base's index
         self.indptr, self.indices, self.shape = union.indptr, union.indices, union.shape
         where = _keys(union)
         self.base = np.searchsorted(where, _keys(base))
         self.at = [(np.searchsorted(where, _keys(dK)), np.searchsorted(where, _keys(dM))) for dK, dM in parts]
-        self.sizes = [(dK.nnz, dM.nnz) for dK, dM in parts]
 
     def combine(self, K, M, parts, values) -> tuple[sp.csr_matrix, sp.csr_matrix]:
         """K + sum v_k dK_k and M + sum v_k dM_k on the union pattern (shared index arrays)."""
@@ -87,10 +85,9 @@ class Effects:
         if not on:
             return K, M
         parts = [self.derivative(k, model, c, p) for c, _ in on]
-        key = (k, K.shape, tuple(c.name for c, _ in on))
+        key = (k, K.shape, id(K.indices), tuple(c.name for c, _ in on))
         plan = self._plans.get(key)
-        if plan is None or not (same_array(plan.of, K.indices) and same_array(plan.of_ptr, K.indptr)
-                                and plan.sizes == [(dK.nnz, dM.nnz) for dK, dM in parts]):
+        if plan is None or plan.of is not K.indices:
             plan = self._plans[key] = EffectPlan(K, parts)
             while len(self._plans) > PLANS_KEPT:
                 self._plans.popitem(last=False)
