@@ -2,24 +2,31 @@
 rename it over the target, so an interrupted run never leaves a half-written or lost file.
 
 A temporary file is named ``.<stem>.pcbdyn~<random><suffix>`` beside its target and held under an
-exclusive lock (flock) while it is written. A run killed mid-write (SIGKILL: no cleanup code runs)
-leaves its temporary behind, but the kernel drops the lock with the process: the next atomic write
-into that folder removes every such temporary whose lock it can take (:func:`clear_stale`), while
-those of live writers, locked, stay. Temporary folders (:func:`temporary_folder`) work alike.
+exclusive lock (flock) while it is written. A run killed mid-write (SIGKILL: no cleanup code runs in
+it) loses its locks with the process, and a small cleaner process started with the first temporary
+(:func:`_watch`) notices the end of the run, however it ended, and removes every temporary in the
+folders the run wrote to whose lock it can take (:func:`clear_stale`); those of live writers, locked,
+stay. The next atomic write into a folder does the same, for runs the cleaner could not serve (a
+machine reset). Temporary folders (:func:`temporary_folder`) work alike.
 """
 
 from __future__ import annotations
 
 import fcntl
 import os
+import select
 import shutil
+import sys
 import tempfile
+import time
 from contextlib import contextmanager
 from pathlib import Path
 
 #: marks pcbdyn's temporary files and folders (never a name a user would give)
 MARK = ".pcbdyn~"
 _LOCK_FILE = ".lock"
+#: this process's pipe to its cleaner: (pid of the process that opened it, write end, folders told)
+_cleaner: list = []
 
 
 def _umask() -> int:
@@ -68,6 +75,44 @@ def clear_stale(folder) -> list:
     return removed
 
 
+def _watch(folder: Path) -> None:
+    """Have ``folder`` cleared of this run's temporaries when the run ends, even by SIGKILL: a cleaner
+    process, started once per process in a session of its own (no terminal signal reaches it), reads the
+    folders from a pipe whose write end only this process holds (close-on-exec: no mesher or renderer
+    inherits it); the kernel closes that end with the process. At end-of-file the cleaner waits until the
+    process has fully ended (its pidfd: a dying process closes the pipe before it drops its locks), then
+    runs :func:`clear_stale` on each folder and exits, milliseconds after the run."""
+    if not _cleaner or _cleaner[0] != os.getpid():
+        read, write = os.pipe()
+        actions = [(os.POSIX_SPAWN_DUP2, read, 0), (os.POSIX_SPAWN_CLOSE, read),
+                   (os.POSIX_SPAWN_OPEN, 1, os.devnull, os.O_WRONLY, 0),
+                   (os.POSIX_SPAWN_OPEN, 2, os.devnull, os.O_WRONLY, 0)]
+        os.posix_spawn(sys.executable, [sys.executable, "-I", __file__, str(os.getpid())], dict(os.environ),
+                       file_actions=actions, setsid=True)
+        os.close(read)
+        _cleaner[:] = [os.getpid(), write, set()]
+    folder = os.fsencode(Path(folder).resolve())
+    if folder not in _cleaner[2]:
+        os.write(_cleaner[1], folder + b"\0")
+        _cleaner[2].add(folder)
+
+
+def _clean_after_writer(writer: int) -> None:
+    """The cleaner's work (see :func:`_watch`): wait for the end of the process ``writer``, then clear its
+    folders."""
+    try:
+        ended = os.pidfd_open(writer)
+    except (AttributeError, OSError):  # no pidfd (not Linux), or the writer is gone already
+        ended = None
+    told = sys.stdin.buffer.read()
+    if ended is not None:
+        select.select([ended], [], [])
+    while os.getppid() == writer:  # without a pidfd: the writer has ended when this process is adopted
+        time.sleep(0.01)
+    for folder in filter(None, set(told.split(b"\0"))):
+        clear_stale(os.fsdecode(folder))
+
+
 @contextmanager
 def atomic_path(path):
     """Yield a temporary path next to ``path``; on success it replaces ``path`` with the usual
@@ -76,6 +121,7 @@ def atomic_path(path):
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     clear_stale(path.parent)
+    _watch(path.parent)
     fd, tmp = _locked_temp(path.parent, f".{path.stem}{MARK}", path.suffix)
     try:
         yield tmp
@@ -94,6 +140,7 @@ def temporary_folder(prefix: str = "pcbdyn"):
     run is removed by the next use (:func:`clear_stale`)."""
     base = Path(tempfile.gettempdir())
     clear_stale(base)
+    _watch(base)
     folder = Path(tempfile.mkdtemp(prefix=f".{prefix}{MARK}", dir=base))
     fd = os.open(folder / f"{_LOCK_FILE}.new", os.O_RDWR | os.O_CREAT, 0o600)
     fcntl.flock(fd, fcntl.LOCK_EX)
@@ -117,3 +164,7 @@ def write_checked(path, text: str, load, error=ValueError) -> Path:
         except ValueError as exc:
             raise error(f"{path.name}: the file to write does not load ({exc}); nothing was written") from None
     return path
+
+
+if __name__ == "__main__":
+    _clean_after_writer(int(sys.argv[1]))
