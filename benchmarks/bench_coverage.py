@@ -9,6 +9,14 @@ Acceptance: >= 90 % over 20 repeats of three cases.
 Per case: repeats run, the effect found (type within 15 mm), covered by 2 sigma, the coverage, the
 median |error| / sigma and the median time; a miss (not found) counts as not covered. Each
 diagnose runs through :func:`bench_diagnose.one` (its JSON kept under --out).
+
+``--calibrate FOLDER`` instead reads a finished ``bench_diagnose.py --out FOLDER`` run and prints, per
+reported type and over all of them, the relative errors of the magnitudes found in every case except
+the coverage cases (``--cases``) and half their 90th percentile; the one over all types is the
+model-form budget (:data:`pcbdyn.diagnosis.uncertainty.MODEL_FORM`) with which two standard deviations
+cover nine in ten.
+
+    python benchmarks/bench_coverage.py --calibrate out/diagnosis_bench
 """
 
 from __future__ import annotations
@@ -24,7 +32,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from bench_diagnose import CASES, bc, match, one  # noqa: E402
+from bench_diagnose import CASES, bc, hc, make_holdout, match, one  # noqa: E402
 
 DEFAULT = "pm_transducer,gs_standoff,line_mass_free_edge"
 #: repeat r of a case uses the noise seed SEED_BASE + 100 * case seed + r (apart from the bench's own)
@@ -50,14 +58,46 @@ def repeat(case, r: int, out: Path) -> dict:
     return {**row, "z": z}
 
 
+def calibrate(folder: Path, held_out: list) -> dict:
+    """{reported type: [relative errors]} of the magnitudes found in a bench run's ``folder``, every
+    case with effects except ``held_out``; prints them and half their 90th percentile."""
+    errors: dict = {}
+    for name, case in CASES.items():
+        js = folder / name / "diagnose.json"
+        if name in held_out or case.noise_only or not js.exists():
+            continue
+        if name in hc.BY_NAME:
+            truth = make_holdout(case, folder / name / "case")[2]
+        else:
+            truth = bc.make_case(case, folder / name)[2]
+        data = json.loads(js.read_text())
+        for t in truth["effects"]:
+            e, d = match(data.get("effects", []), t)
+            if t.get("required", True) and e is not None and d <= max(15.0, 1e3 * bc.MODEL_MESH):
+                errors.setdefault(t["type"], []).append((name, e["magnitude"] / t["magnitude"] - 1.0))
+    print(f"{'type':<18} {'cases':>5} {'|error| [%], sorted':<60} {'budget [%]':>10}")
+    for kind, rows in sorted(errors.items()):
+        e = np.sort(np.abs([x for _, x in rows]))
+        print(f"{kind:<18} {e.size:>5} {' '.join(f'{100 * x:.1f}' for x in e):<60} "
+              f"{50 * np.quantile(e, 0.9):>10.1f}")
+    every = np.abs([x for rows in errors.values() for _, x in rows])
+    print(f"{'all':<18} {every.size:>5} {'':<60} {50 * np.quantile(every, 0.9):>10.1f}")
+    return errors
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--cases", default=DEFAULT, help="comma-separated bench cases with effects")
     ap.add_argument("--repeats", type=int, default=20)
     ap.add_argument("--out", default=str(ROOT / "out" / "coverage"))
     ap.add_argument("--json", default=None, help="write the rows as JSON")
+    ap.add_argument("--calibrate", metavar="FOLDER", help="a bench_diagnose.py --out folder: print the model-form "
+                    "budget from its cases other than --cases")
     a = ap.parse_args(argv)
     names = a.cases.split(",")
+    if a.calibrate:
+        calibrate(Path(a.calibrate), names)
+        return
     bad = [n for n in names if n not in bc.BY_NAME or bc.BY_NAME[n].noise_only]
     if bad:
         ap.error(f"not bench cases with effects: {bad}; use some of "

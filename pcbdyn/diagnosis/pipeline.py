@@ -48,6 +48,7 @@ from .residual import ModalResidual, Observation
 from .fitting import estimate
 from .scan import Runner
 from .select import ALPHA, adopt, penalty, refine, search, without_vanished
+from .uncertainty import jackknife_cov, parts
 
 #: kinds whose effects :func:`_with_masses` carries onto the finer meshes
 MASS_KINDS = ("point_mass", "point_inertia", "line_mass")
@@ -281,7 +282,8 @@ def diagnose(structure, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_s
     for n, v in zip(names, sel.p):
         out["parameters"][n]["final"] = float(v)
     chosen = [cands[i] for i in sel.chosen]
-    effects = [_merged(chosen, sel.values, sel.cov, g) for g in _neighbours(chosen, MERGE_REACH * h)]
+    cov_jack = jackknife_cov(res, sel.state, chosen, np.array([c.spec.scale for c in chosen]))
+    effects = [_merged(chosen, sel.values, sel.cov, cov_jack, g) for g in _neighbours(chosen, MERGE_REACH * h)]
     if effects:
         msg = f"{len(effects)} effect(s) the model lacks: " + "; ".join(
             f"{e['type']} ({e['parameter']}) at {e['at_mm']} mm" for e in effects)
@@ -436,12 +438,13 @@ def _neighbours(chosen, reach: float) -> list:
     return [np.flatnonzero(label == g).tolist() for g in dict.fromkeys(label.tolist())]
 
 
-def _merged(chosen, values, cov, group) -> dict:
+def _merged(chosen, values, cov, cov_jack, group) -> dict:
     """One effect entry (JSON-ready) for a group: the magnitudes summed at their weighted centre (on
     line masses: the place and extent of the largest; parallel stiffeners: their weighted mean
     path; overlapping regions: the mean change over the area they cover, their union, which keeps
     the change's integral over the board), the uncertainty of that combination from the fit's
-    covariance."""
+    covariance ``cov``, the jackknife's ``cov_jack`` and the model-form budget
+    (:func:`.uncertainty.parts`)."""
     lines = [k for k in group if chosen[k].kind == "line_mass"]
     c = chosen[max(lines, key=lambda k: values[k]) if lines else group[0]]
     d = c.describe()
@@ -462,8 +465,9 @@ def _merged(chosen, values, cov, group) -> dict:
             share = v / v.sum() if v.sum() > 0 else np.full(v.size, 1.0 / v.size)
             paths = np.array([np.asarray(chosen[k].geometry["path"], float)[[0, -1]] for k in group])
             d["path_mm"] = np.round(1e3 * np.einsum("g,gij->ij", share, paths), 3).tolist()
-    var = float(w @ cov[np.ix_(group, group)] @ w) if cov.size else 0.0
-    d.update(magnitude=float(w @ v), uncertainty=float(np.sqrt(max(var, 0.0))), kind=c.kind)
+    sub = np.ix_(group, group)
+    u = parts(float(w @ v), w, cov[sub] if cov.size else cov, cov_jack[sub])
+    d.update(magnitude=float(w @ v), uncertainty=u.pop("total"), uncertainty_parts=u, kind=c.kind)
     return d
 
 

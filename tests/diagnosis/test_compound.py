@@ -6,12 +6,14 @@ free six-part card carrying
   162 mm), found as a ``stiffener`` whose section (aluminium, 4 mm high, :class:`RibSection`) makes
   its mass follow from its bending stiffness;
 - a bracket: a 15 g mass on a 1e5 N/m spring to the frame at one point, found as a mass and the
-  spring under it (the selection tries a spring on the nodes of a mass found).
+  spring under it (tried together as one addition).
 
 Each: every part of the addition within 30 % and the max frequency error after <= 0.5 %.
 
-Not met yet (strict xfails, so that a fix shows): measured on branch ``diag`` at 80bac8f, the
-diagnosis reports nothing on either (see the reasons).
+Both are found: the bar since the held-out check follows the secant of a large addition
+(:func:`pcbdyn.diagnosis.select.held_out_share`), the bracket since a mass and the spring under it are
+tried together (:data:`pcbdyn.diagnosis.select.COMPOUND_KINDS`). Not met yet (strict xfails, so that
+a fix shows): the max frequency error after stays near 0.6 % in both.
 """
 
 from __future__ import annotations
@@ -56,12 +58,20 @@ def _bar_mass(EI: float, length: float) -> float:
     return SECTION.rho * (12.0 * EI / (SECTION.E * SECTION.h**3)) * SECTION.h * length
 
 
-@pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="nothing reported: the parameters-only fit leaves 14.5 % (chi^2 3.9e5 for 703 "
-                   "degrees of freedom) and no stiffener trial is kept ('no candidate effect explains it beyond chance')")
-def test_glued_aluminium_bar_found_with_its_stiffness_and_mass(tmp_path):
-    data, truth = _diagnose(BAR, tmp_path, "stiffener,point_mass,line_mass")
+@pytest.fixture(scope="module")
+def bar(tmp_path_factory):
+    """The diagnosis of the card with the bar, and the bar's truth entry."""
+    data, truth = _diagnose(BAR, tmp_path_factory.mktemp("bar"), "stiffener,point_mass,line_mass")
     (t,) = truth["effects"]
+    return data, t
+
+
+@pytest.mark.slow
+@pytest.mark.xdist_group("compound_bar")
+def test_glued_aluminium_bar_found_with_its_stiffness_and_mass(bar):
+    """Found since the held-out check follows the secant of the addition (nothing was reported while it
+    was linearised at the state without the bar: 5 of 7 modes predicted better, 0.71 < 0.75)."""
+    data, t = bar
     e, d = match(data["effects"], t)
     assert e is not None and d <= max(15.0, 1e3 * bc.MODEL_MESH), data["effects"]
     assert e["magnitude"] == pytest.approx(BAR_EI, rel=0.30)
@@ -69,17 +79,36 @@ def test_glued_aluminium_bar_found_with_its_stiffness_and_mass(tmp_path):
     found_mass = _bar_mass(e["magnitude"], 1e-3 * abs(e["path_mm"][1][0] - e["path_mm"][0][0]))
     found_mass += sum(x["magnitude"] for x in data["effects"] if x["type"] in ("point_mass", "line_mass"))
     assert true_mass == pytest.approx(17.5e-3, rel=0.01) and found_mass == pytest.approx(true_mass, rel=0.30)
-    assert data["parameters_only"]["max_freq_error_pct"] > 2.0 and data["after"]["max_freq_error_pct"] <= 0.5
+    assert data["parameters_only"]["max_freq_error_pct"] > 2.0
+
+
+@pytest.fixture(scope="module")
+def bracket(tmp_path_factory):
+    """The diagnosis of the card with the bracket, and the truth's entries."""
+    data, truth = _diagnose(BRACKET, tmp_path_factory.mktemp("bracket"), "point_mass,ground_spring")
+    return data, truth["effects"]
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="nothing reported: the bracket's own mode (test mode 1) has no model partner "
-                   "and is left out; the parameters-only fit leaves 3.3 % on the paired modes and no mass or spring "
-                   "trial is kept")
-def test_bracket_found_as_a_mass_on_a_spring(tmp_path):
-    data, truth = _diagnose(BRACKET, tmp_path, "point_mass,ground_spring")
-    for t in truth["effects"]:
+@pytest.mark.xdist_group("compound_bracket")
+def test_bracket_found_as_a_mass_on_a_spring(bracket):
+    """Found since the mass and the spring under it are tried together (alone, neither was kept)."""
+    data, truth = bracket
+    for t in truth:
         e, d = match(data["effects"], t)
         assert e is not None and d <= 15.0, (t["type"], data["effects"])
         assert e["magnitude"] == pytest.approx(t["magnitude"], rel=0.30), (t["type"], e)
-    assert data["parameters_only"]["max_freq_error_pct"] > 2.0 and data["after"]["max_freq_error_pct"] <= 0.5
+    assert data["parameters_only"]["max_freq_error_pct"] > 2.0
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("addition", [
+    pytest.param("bar", marks=[pytest.mark.xdist_group("compound_bar"), pytest.mark.xfail(
+        strict=True, reason="0.61 % after (mode 1): the bar on the model's mesh (111.3 mm for 112) does not "
+        "follow every mode of the finer truth")]),
+    pytest.param("bracket", marks=[pytest.mark.xdist_group("compound_bracket"), pytest.mark.xfail(
+        strict=True, reason="0.60 % after (mode 7): the pair sits on the model's node 4.4 mm from the bracket")]),
+])
+def test_addition_leaves_at_most_half_a_percent(addition, request):
+    data, _ = request.getfixturevalue(addition)
+    assert data["after"]["max_freq_error_pct"] <= 0.5
