@@ -3,13 +3,14 @@ the noise's share, and the model's own errors (its mesh, its plate theory, what 
 do differently) bias a magnitude far beyond it (a 10 g mass once reported as 11.44 +- 0.09 g). So the
 reported standard deviation combines, in quadrature,
 
-- the larger of the fit's covariance (thesis eq. 5.40: the noise propagated through the sensitivities)
-  and a jackknife over the held-out folds of :func:`.select.held_out_share` (one configuration, or
-  one mode, left out at a time, to first order at the fitted state): when the modes or
-  configurations disagree on a magnitude, the spread between them is the better measure;
-- a model-form budget, a fixed share of the magnitude (:data:`MODEL_FORM`),
-  measured on the diagnosis bench: the magnitudes found from tests meshed four times finer than the
-  model and from tests computed by another FE code (OpenSees).
+- the larger of the fit's covariance (:func:`pcbdyn.updating.solvers.covariance`: the noise, rows
+  weighted as in thesis eq. 4.28, propagated through the sensitivities) and a jackknife over the
+  held-out folds of :func:`.select.held_out_share` (one configuration, or one mode, left out at a
+  time, to first order at the fitted state): when the modes or configurations disagree on a
+  magnitude, the spread between them is the better measure;
+- a model-form budget, a fixed share of the magnitude (:data:`MODEL_FORM`), measured on the
+  diagnosis bench: the magnitudes found from tests meshed four times finer than the model and from
+  tests computed by another FE code (OpenSees).
 
 The three parts are kept apart in the report (``uncertainty_parts``) so that a user sees which one
 rules.
