@@ -9,11 +9,8 @@ every candidate by the chi^2 its column removes (the cos^2 criterion of thesis e
 applied to the residual), among those whose estimated value is physical (``lower`` of its kind).
 The best ``shortlist`` of every kind are re-estimated nonlinearly (a spring's effect on the
 frequencies saturates, so the linear score alone under-rates large ones; :func:`.scan.rank`: quick
-fits on a reanalysis of the state, the best of them with full re-solves), each alone and, for the
-kinds of :data:`COMPOUND_KINDS`, together with its partner on the same node (a bracket: a mass on a
-spring, whose parts alone explain little); the least chi^2 plus the penalty of each part wins, so a
-compound must beat its parts by more than its extra penalty. Magnitudes stay within [lower,
-UPPER * scale], declared parameters within their bounds.
+fits on a reanalysis of the state, the best of them with full re-solves) and the least chi^2 wins.
+Magnitudes stay within [lower, UPPER * scale], declared parameters within their bounds.
 
 A new effect is kept only if its chi^2 drop exceeds the penalty
     q = max(ln n, chi^2_1 quantile exceeded with probability ALPHA / P)
@@ -81,7 +78,6 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
     kinds = np.array([c.kind for c in candidates])
     scale = np.array([c.spec.scale for c in candidates])
     lower = np.array([c.spec.lower for c in candidates])
-    compounds = _compound_partners(candidates)
     for _ in range(max_effects):
         if sel.chi2[-1] <= pen:  # chi^2 >= 0: one more effect cannot lower the criterion
             break
@@ -100,61 +96,49 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
         order = np.union1d(_shortlist(gain, kinds, shortlist), _companions(candidates, sel.chosen))
         if not order.size:
             break
-        additions = [[int(j)] for j in order] + compounds(order, sel.chosen)
-        trials = [([candidates[i] for i in sel.chosen + add], np.r_[sel.values, np.maximum(value[add], 0.0)])
-                  for add in additions]
+        trials = [([candidates[i] for i in sel.chosen + [j]], np.r_[sel.values, max(value[j], 0.0)]) for j in order]
         fits = rank(res, st, trials, fit.p, bounds, P, runner)
-        # the criterion, not chi^2 alone: a compound must beat its parts by more than its extra penalty
-        best = int(np.argmin([np.inf if f is None else f.chi2 + pen * len(add) for f, add in zip(fits, additions)]))
-        if fits[best] is None or not np.isfinite(fits[best].chi2):
+        best = int(np.argmin([np.inf if f is None else f.chi2 for f in fits]))
+        if not np.isfinite(fits[best].chi2):
             break
-        add = additions[best]
-        idx = sel.chosen + add
-        new = estimate(res, fit.p, [candidates[i] for i in idx], fits[best].values, newton_steps, bounds)
-        if not worth(sel.chi2[-1], new.chi2, n, p0.size + len(idx), pen * len(add)):
-            break
-        if held_out_share(res, st.r, *_secant(res, held, A[:, add], new, [candidates[i] for i in idx],
-                                              scale[idx])) < HELD_OUT_SHARE:
+        idx = sel.chosen + [int(order[best])]
+        new = _kept(res, candidates, sel, fit, idx, fits[best], held, A[:, idx[-1:]], scale[idx], newton_steps,
+                    bounds, pen, p0.size)
+        if new is None:
             break
         idx, fit = _prune(res, candidates, idx, new, newton_steps, bounds, pen, p0.size)
         adopt(sel, idx, fit, pen)
     return sel
 
 
+def _kept(res, candidates, sel, fit, idx, trial, held, columns, scale, newton_steps, bounds, pen, n_params):
+    """The estimate of effects ``idx`` (the chosen ones and an addition, whose trial fit is ``trial``
+    and columns at the state without it ``columns``) when the addition is kept: its chi^2 drop is
+    worth its penalty ``pen`` (:func:`worth`) and it predicts the held-out folds to first order
+    (:func:`held_out_share`) from the state without it or along the secant to the state with it
+    (:func:`_secant`); else None. Either first-order model can fail a real effect where the modes
+    respond nonlinearly (a share of a mass beside another: the secant; a bar across the card: the
+    state without it); a model error taken for an effect fails both."""
+    new = estimate(res, fit.p, [candidates[i] for i in idx], trial.values, newton_steps, bounds)
+    if not worth(sel.chi2[-1], new.chi2, res.n_rows, n_params + len(idx), pen):
+        return None
+    r = fit.state.r
+    if held_out_share(res, r, held, columns) >= HELD_OUT_SHARE:
+        return new
+    share = held_out_share(res, r, *_secant(res, held, columns, new, [candidates[i] for i in idx], scale))
+    return new if share >= HELD_OUT_SHARE else None
+
+
 def _secant(res, held, columns, fit: Fit, effects: list, scale: np.ndarray) -> tuple:
     """(held, columns) for :func:`held_out_share` on the secant from the state without the new effects
     (their columns ``held`` and ``columns``, the new ones last in ``effects``) to the fitted state of
     ``fit``: the mean of the columns at both ends. A large addition (a bar across a card) moves the
-    modes so far that a first-order prediction from either end alone misses the other; the mean of
+    modes so far that a first-order prediction from the state without it misses the data; the mean of
     the two slopes follows the whole step, as the trapezoidal rule does."""
     st = fit.state
     m = columns.shape[1]
     E = res.effect_columns(st, effects) * scale
     return 0.5 * (held + np.hstack([res.param_columns(st), E[:, :-m]])), 0.5 * (columns + E[:, -m:])
-
-
-#: kinds tried together at one node as one compound addition (a bracket: a mass on a spring to the
-#: frame), besides each alone: neither part may explain enough on its own to be kept first
-COMPOUND_KINDS = (("point_mass", "ground_spring"),)
-
-
-def _compound_partners(candidates):
-    """A function (shortlisted indices, chosen indices) -> [[i, j], ...]: for every shortlisted
-    candidate of a :data:`COMPOUND_KINDS` pair, it and its partner kind's candidate on the same node,
-    neither chosen yet."""
-    at = {(c.kind, tuple(c.nodes.tolist())): i for i, c in enumerate(candidates) if c.nodes.size == 1}
-    partner = {a: b for pair in COMPOUND_KINDS for a, b in (pair, pair[::-1])}
-
-    def pairs(order, chosen) -> list:
-        out = []
-        for i in order:
-            c = candidates[i]
-            j = at.get((partner.get(c.kind), tuple(c.nodes.tolist())))
-            if j is not None and i not in chosen and j not in chosen and sorted((i, j)) not in out:
-                out.append(sorted((int(i), int(j))))
-        return out
-
-    return pairs
 
 
 def adopt(sel: Selection, idx: list, fit: Fit, pen: float) -> Selection:
@@ -229,14 +213,14 @@ def folds(res) -> np.ndarray:
 def held_out_share(res, r, held, column) -> float:
     """How well an effect predicts data it was not fitted to, to first order (residual ``r`` without
     it, columns ``held`` of the declared parameters and the effects already chosen, the new effect's
-    ``column``, both on the secant of :func:`_secant`): the rows are split into :func:`folds`; on
-    each, the held columns with and without the new one are fitted to the other folds and the fold's
-    rows predicted. Returns the share of folds whose prediction the effect improves
-    (:data:`HELD_OUT_SHARE` at least to keep the effect). A real effect
-    improves nearly all; one that explains a structured model error of one configuration or mode
-    does not (issue 7, step 5: selection checked by cross-validation across modes and
-    configurations). Counting folds, not adding their chi^2, keeps one fold that a large effect's
-    linearisation overshoots (a mode it moves onto another) from outvoting the rest."""
+    ``column``, at that state or on the secant of :func:`_secant`): the rows are split into
+    :func:`folds`; on each, the held columns with and without the new one are fitted to the other
+    folds and the fold's rows predicted. Returns the share of folds whose prediction the effect
+    improves (:data:`HELD_OUT_SHARE` at least to keep the effect). A real effect improves nearly all;
+    one that explains a structured model error of one configuration or mode does not (issue 7, step
+    5: selection checked by cross-validation across modes and configurations). Counting folds, not
+    adding their chi^2, keeps one fold that a large effect's linearisation overshoots (a mode it moves
+    onto another) from outvoting the rest."""
     groups = folds(res)
     better = []
     for f in np.unique(groups):

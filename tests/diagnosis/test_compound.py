@@ -6,14 +6,13 @@ free six-part card carrying
   162 mm), found as a ``stiffener`` whose section (aluminium, 4 mm high, :class:`RibSection`) makes
   its mass follow from its bending stiffness;
 - a bracket: a 15 g mass on a 1e5 N/m spring to the frame at one point, found as a mass and the
-  spring under it (tried together as one addition).
+  spring under it.
 
 Each: every part of the addition within 30 % and the max frequency error after <= 0.5 %.
 
-Both are found: the bar since the held-out check follows the secant of a large addition
-(:func:`pcbdyn.diagnosis.select.held_out_share`), the bracket since a mass and the spring under it are
-tried together (:data:`pcbdyn.diagnosis.select.COMPOUND_KINDS`). Not met yet (strict xfails, so that
-a fix shows): the max frequency error after stays near 0.6 % in both.
+The bar is found since the held-out check may also follow the secant of a large addition
+(:func:`pcbdyn.diagnosis.select._kept`); the error after stays at 0.61 %. The bracket is not found.
+Not met yet: strict xfails, so that a fix shows.
 """
 
 from __future__ import annotations
@@ -91,8 +90,11 @@ def bracket(tmp_path_factory):
 
 @pytest.mark.slow
 @pytest.mark.xdist_group("compound_bracket")
+@pytest.mark.xfail(strict=True, reason="nothing reported: neither a mass nor a spring alone is kept (the bracket's "
+                   "own mode, test mode 1, has no model partner and is left out; the paired modes keep 3.3 %). Tried "
+                   "together as one addition at each node they are found (13.0 g, 8.4e4 N/m, 4.4 mm off), but on the "
+                   "box the same pairing added a false spring beside a hidden mass: not landed")
 def test_bracket_found_as_a_mass_on_a_spring(bracket):
-    """Found since the mass and the spring under it are tried together (alone, neither was kept)."""
     data, truth = bracket
     for t in truth:
         e, d = match(data["effects"], t)
@@ -107,7 +109,7 @@ def test_bracket_found_as_a_mass_on_a_spring(bracket):
         strict=True, reason="0.61 % after (mode 1): the bar on the model's mesh (111.3 mm for 112) does not "
         "follow every mode of the finer truth")]),
     pytest.param("bracket", marks=[pytest.mark.xdist_group("compound_bracket"), pytest.mark.xfail(
-        strict=True, reason="0.60 % after (mode 7): the pair sits on the model's node 4.4 mm from the bracket")]),
+        strict=True, reason="the bracket is not found (3.3 % after the parameters)")]),
 ])
 def test_addition_leaves_at_most_half_a_percent(addition, request):
     data, _ = request.getfixturevalue(addition)
