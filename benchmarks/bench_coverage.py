@@ -33,6 +33,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from bench_diagnose import CASES, bc, hc, make_holdout, match, one  # noqa: E402
+from test_diagnose_bench import LOC_TOL_MM  # noqa: E402
 
 DEFAULT = "pm_transducer,gs_standoff,line_mass_free_edge"
 #: repeat r of a case uses the noise seed SEED_BASE + 100 * case seed + r (apart from the bench's own)
@@ -51,7 +52,7 @@ def repeat(case, r: int, out: Path) -> dict:
         if not t["required"]:
             continue
         e, d = match(data.get("effects", []), t)
-        if e is None or d > max(15.0, 1e3 * bc.MODEL_MESH):
+        if e is None or d > LOC_TOL_MM:
             z.append(np.inf)
         else:
             z.append(abs(e["magnitude"] - t["magnitude"]) / max(e["uncertainty"], 1e-300))
@@ -73,7 +74,7 @@ def calibrate(folder: Path, held_out: list) -> dict:
         data = json.loads(js.read_text())
         for t in truth["effects"]:
             e, d = match(data.get("effects", []), t)
-            if t.get("required", True) and e is not None and d <= max(15.0, 1e3 * bc.MODEL_MESH):
+            if t.get("required", True) and e is not None and d <= LOC_TOL_MM:
                 errors.setdefault(t["type"], []).append((name, e["magnitude"] / t["magnitude"] - 1.0))
     print(f"{'type':<18} {'cases':>5} {'|error| [%], sorted':<60} {'budget [%]':>10}")
     for kind, rows in sorted(errors.items()):

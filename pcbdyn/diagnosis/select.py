@@ -102,7 +102,7 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
         if not np.isfinite(fits[best].chi2):
             break
         idx = sel.chosen + [int(order[best])]
-        new = _kept(res, candidates, sel, fit, idx, fits[best], held, A[:, idx[-1:]], scale[idx], newton_steps,
+        new = _kept(res, candidates, sel, fit, idx, fits[best], held, A[:, idx[-1]], scale[idx], newton_steps,
                     bounds, pen, p0.size)
         if new is None:
             break
@@ -111,9 +111,9 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
     return sel
 
 
-def _kept(res, candidates, sel, fit, idx, trial, held, columns, scale, newton_steps, bounds, pen, n_params):
+def _kept(res, candidates, sel, fit, idx, trial, held, column, scale, newton_steps, bounds, pen, n_params):
     """The estimate of effects ``idx`` (the chosen ones and an addition, whose trial fit is ``trial``
-    and columns at the state without it ``columns``) when the addition is kept: its chi^2 drop is
+    and column at the state without it ``column``) when the addition is kept: its chi^2 drop is
     worth its penalty ``pen`` (:func:`worth`) and it predicts the held-out folds to first order
     (:func:`held_out_share`) from the state without it or along the secant to the state with it
     (:func:`_secant`); else None. Either first-order model can fail a real effect where the modes
@@ -123,22 +123,20 @@ def _kept(res, candidates, sel, fit, idx, trial, held, columns, scale, newton_st
     if not worth(sel.chi2[-1], new.chi2, res.n_rows, n_params + len(idx), pen):
         return None
     r = fit.state.r
-    if held_out_share(res, r, held, columns) >= HELD_OUT_SHARE:
+    if held_out_share(res, r, held, column) >= HELD_OUT_SHARE:
         return new
-    share = held_out_share(res, r, *_secant(res, held, columns, new, [candidates[i] for i in idx], scale))
+    share = held_out_share(res, r, *_secant(res, held, column, new, [candidates[i] for i in idx], scale))
     return new if share >= HELD_OUT_SHARE else None
 
 
-def _secant(res, held, columns, fit: Fit, effects: list, scale: np.ndarray) -> tuple:
-    """(held, columns) for :func:`held_out_share` on the secant from the state without the new effects
-    (their columns ``held`` and ``columns``, the new ones last in ``effects``) to the fitted state of
+def _secant(res, held, column, fit: Fit, effects: list, scale: np.ndarray) -> tuple:
+    """(held, column) for :func:`held_out_share` on the secant from the state without the new effect
+    (the columns ``held`` and its ``column``; it is the last of ``effects``) to the fitted state of
     ``fit``: the mean of the columns at both ends. A large addition (a bar across a card) moves the
     modes so far that a first-order prediction from the state without it misses the data; the mean of
     the two slopes follows the whole step, as the trapezoidal rule does."""
-    st = fit.state
-    m = columns.shape[1]
-    E = res.effect_columns(st, effects) * scale
-    return 0.5 * (held + np.hstack([res.param_columns(st), E[:, :-m]])), 0.5 * (columns + E[:, -m:])
+    E = res.effect_columns(fit.state, effects) * scale
+    return 0.5 * (held + np.hstack([res.param_columns(fit.state), E[:, :-1]])), 0.5 * (column + E[:, -1])
 
 
 def adopt(sel: Selection, idx: list, fit: Fit, pen: float) -> Selection:
@@ -210,6 +208,12 @@ def folds(res) -> np.ndarray:
     return cfg if np.unique(cfg).size > 1 else mode
 
 
+def fit_without(A, r, fold) -> np.ndarray:
+    """The least-squares fit of columns ``A`` to ``r`` on the rows outside ``fold`` (a mask), the
+    directions weaker than :data:`CV_RCOND` dropped."""
+    return np.linalg.lstsq(A[~fold], r[~fold], rcond=CV_RCOND)[0] if A.shape[1] else np.zeros(0)
+
+
 def held_out_share(res, r, held, column) -> float:
     """How well an effect predicts data it was not fitted to, to first order (residual ``r`` without
     it, columns ``held`` of the declared parameters and the effects already chosen, the new effect's
@@ -227,8 +231,7 @@ def held_out_share(res, r, held, column) -> float:
         test = groups == f
         err = []
         for A in (held, np.column_stack([held, column])):
-            d = np.linalg.lstsq(A[~test], r[~test], rcond=CV_RCOND)[0] if A.shape[1] else np.zeros(0)
-            e = r[test] - A[test] @ d
+            e = r[test] - A[test] @ fit_without(A, r, test)
             err.append(float(e @ e))
         better.append(err[1] < err[0] - 1.0)  # by more than a unit of chi^2: the noise's own scale
     return float(np.mean(better))

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .select import CV_RCOND, folds
+from .select import fit_without, folds
 
 #: the model-form budget: one standard deviation as a share of the magnitude, for every reported type.
 #: Calibrated with ``benchmarks/bench_coverage.py --calibrate`` on the bench and hold-out cases other
@@ -41,10 +41,7 @@ def jackknife_cov(res, state, effects, scale) -> np.ndarray:
     if k == 0 or values.size < 2:
         return np.zeros((k, k))
     J = np.hstack([res.param_columns(state), res.effect_columns(state, effects) * scale])
-    shifts = []
-    for f in values:
-        keep = groups != f
-        shifts.append(np.linalg.lstsq(J[keep], state.r[keep], rcond=CV_RCOND)[0][-k:] * scale)
+    shifts = [fit_without(J, state.r, groups == f)[-k:] * scale for f in values]
     d = np.array(shifts) - np.mean(shifts, axis=0)
     g = values.size
     return (g - 1) / g * d.T @ d
