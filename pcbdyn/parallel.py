@@ -4,13 +4,17 @@ in local worker processes, or on a Dask cluster when a scheduler address is give
 Each job is ``fn(*args, shared)``: ``shared`` (a case, a residual) is sent to every worker once (the
 process pool's initializer, Dask's scatter), the arguments per job. Results come back as they finish;
 callers that need an order sort them, and jobs are seeded by their own arguments, so the results do not
-depend on where they ran.
+depend on where they ran. Local workers are forked, inheriting this process's built models and caches,
+where that is safe (:func:`pcbdyn.fe.threads.openmp_capped`); otherwise they start from a fork server.
 """
 
 from __future__ import annotations
 
+import multiprocessing
 import os
 from concurrent.futures import ProcessPoolExecutor, as_completed
+
+from .fe.threads import openmp_capped
 
 _SHARED = None
 
@@ -40,7 +44,8 @@ def run_jobs(fn, jobs, shared, workers: int | None = None, scheduler: str | None
                 done(args)
             yield args, out
         return
-    with ProcessPoolExecutor(max_workers=min(workers, len(jobs)), initializer=_init, initargs=(shared,)) as pool:
+    context = multiprocessing.get_context("fork" if openmp_capped() else "forkserver")
+    with ProcessPoolExecutor(min(workers, len(jobs)), context, initializer=_init, initargs=(shared,)) as pool:
         futures = {pool.submit(_call, fn, args): args for args in jobs}
         for fut in as_completed(futures):
             if done:

@@ -32,6 +32,8 @@ from .common import done, folder_outputs, input_errors, library_option, measured
               help="a first look at a fraction of the cost: the mesh correction from one finer mesh (twice as fine) "
                    "instead of two, candidates on a grid half as fine (still walked to place), one trial fit per kind "
                    "in each scan instead of two, and the masses found not carried onto the finer meshes")
+@click.option("--workers", type=click.IntRange(min=1), default=None,
+              help="local processes for the finer-mesh solves and the trial fits (default: the cores; 1: this process)")
 @click.option("--scheduler", default=None,
               help="a Dask scheduler address (tcp://host:8786): the trial fits of the candidate scans run on that "
                    "cluster (the findings do not depend on where they run)")
@@ -39,7 +41,7 @@ from .common import done, folder_outputs, input_errors, library_option, measured
                 "write effects, before/after and statistics as JSON",
                 force="replace an earlier <board>.diagnosed.toml beside the board (default: a numbered name)")
 @library_option()
-def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size, quick, scheduler, out, force,
+def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size, quick, workers, scheduler, out, force,
             json_path):
     """Find the effects a board model lacks from modal tests: TEST_UFF (with mode shapes) of the base
     configuration and NAME=FILE for each perturbed configuration of board.toml (e.g. c2=test2.uff)."""
@@ -63,7 +65,7 @@ def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size,
         ms = to_si(mesh_size, "mm", "--mesh-size") if mesh_size else None
         t0 = step("diagnosing")
         d = diagnose(board, tests, freq_pct, shape_pct, mesh_size=ms, kinds=chosen, max_effects=max_effects,
-                     progress=lambda msg: click.echo(f"    {msg}", err=True), quick=quick, scheduler=scheduler)
+                     progress=lambda msg: click.echo(f"    {msg}", err=True), quick=quick, workers=workers, scheduler=scheduler)
         done(t0)
     click.echo(f"\n{board.name}: {d.message}\n")
     click.echo(rep.format_effects(d.effects))

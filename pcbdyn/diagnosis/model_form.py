@@ -11,8 +11,6 @@ from __future__ import annotations
 import numpy as np
 
 from ..correlation.mac import mac
-from ..fe.modal import solve_modes
-from ..fe.probe import model_probe
 from ..updating.solvers import covariance
 from .residual import paired_mac
 from .fitting import estimate
@@ -23,29 +21,25 @@ from .select import ALPHA, adopt, penalty, worth
 RESOLVED_SHAPE_CHANGE = 0.02
 #: how many times the mesh is halved at most to correct the model's frequencies for it
 MESH_LEVELS = 2
-#: the factor on the shells' transverse shear (``with_shear_factor`` of a structure's model) of the Kirchhoff limit:
-#: a shear this much stiffer is a Kirchhoff plate to within 0.1 % of the gap
-KIRCHHOFF_SHEAR = 1000.0
 
 
-def follow(model, ob, u_prev, k_prev):
-    """(frequencies, shapes at the points, mode indices, shape change sqrt(1 - MAC)) of ``model``'s
-    modes paired by MAC at the points with the shapes ``u_prev`` (by index ``k_prev`` when there
-    are no measured shapes: no change can be told, it is inf)."""
-    modes = solve_modes(model, n_modes=int(k_prev.max()) + 4)
+def pair(solved, ob, u_prev, k_prev):
+    """(frequencies, shapes at the points, mode indices, shape change sqrt(1 - MAC)) of the modes
+    ``solved`` (:class:`.finer.Solved`) paired by MAC at the points with the shapes ``u_prev`` (by
+    index ``k_prev`` when there are no measured shapes: no change can be told, it is inf)."""
     if ob.shapes is None:
-        k = np.minimum(k_prev, modes.frequencies.size - 1)
-        return modes.frequencies[k], None, k, np.full(k.size, np.inf)
-    U = np.asarray(model_probe(model, ob.modes.xyz, ob.modes.directions, tol=0.02).P @ modes.shapes)
-    k = mac(u_prev, U).argmax(axis=1)
-    U = U[:, k]
-    return modes.frequencies[k], U, k, np.sqrt(np.clip(1.0 - paired_mac(U, u_prev), 0.0, None))
+        k = np.minimum(k_prev, solved.f.size - 1)
+        return solved.f[k], None, k, np.full(k.size, np.inf)
+    k = mac(u_prev, solved.U).argmax(axis=1)
+    U = solved.U[:, k]
+    return solved.f[k], U, k, np.sqrt(np.clip(1.0 - paired_mac(U, u_prev), 0.0, None))
 
 
 def discretisation(finer, ob, coarse_state):
     """(frequency correction factor, its relative uncertainty, relative shape error, resolved) per
-    paired mode. ``finer``: the model meshed twice, four times, ... as fine, taken one after the
-    other while some mode is not yet resolved (modes paired by MAC at the points, level to level).
+    paired mode. ``finer``: the model's modes on meshes twice, four times, ... as fine
+    (:class:`.finer.Solved`), taken one after the other while some mode is not yet resolved (modes
+    paired by MAC at the points, level to level).
     A mode resolved between two levels (:data:`RESOLVED_SHAPE_CHANGE`) is corrected by Richardson
     extrapolation of an O(h^2) element from them, f_0 = f_fine + (f_fine - f_coarse) / 3, whose own
     error (a third of the step) stays as noise; a mode no level resolves (or with no shapes to
@@ -55,8 +49,8 @@ def discretisation(finer, ob, coarse_state):
     f_prev, u_prev, k_prev = f0, coarse_state.u, coarse_state.pairs
     scale, sigma = np.ones(f0.size), np.zeros(f0.size)
     resolved, todo, ds = np.zeros(f0.size, bool), np.ones(f0.size, bool), None
-    for model in finer:
-        f, U, k, change = follow(model, ob, u_prev, k_prev)
+    for solved in finer:
+        f, U, k, change = pair(solved, ob, u_prev, k_prev)
         ok = todo & (change <= RESOLVED_SHAPE_CHANGE)
         scale = np.where(ok, (f + (f - f_prev) / 3.0) / f0, np.where(todo, f / f0, scale))
         sigma = np.where(todo, np.abs(f - f_prev) / f0 / np.where(ok, 3.0, 1.0), sigma)
@@ -70,14 +64,15 @@ def discretisation(finer, ob, coarse_state):
     return scale, sigma, ds, resolved
 
 
-def kirchhoff_shift(fine_bm, ob, coarse_state) -> np.ndarray:
-    """Relative frequency change per paired mode when the shells' transverse shear of ``fine_bm``
-    (a structure's model on the finest mesh of :func:`discretisation`, with ``with_shear_factor``) is
-    made rigid: the Kirchhoff limit. The gap grows as the mesh resolves the shear boundary layer at free edges (about 1 %
-    on the twisting modes of a 2.8 mm card at a quarter of its model's mesh, half that at the
-    model's mesh), so it is measured where the frequencies are corrected to."""
-    f, U, k, _ = follow(fine_bm.model, ob, coarse_state.u, coarse_state.pairs)
-    fk, _, _, _ = follow(fine_bm.with_shear_factor(KIRCHHOFF_SHEAR).model, ob, coarse_state.u if U is None else U, k)
+def kirchhoff_shift(fine, limit, ob, coarse_state) -> np.ndarray:
+    """Relative frequency change per paired mode from ``fine`` (the modes on the finest mesh of
+    :func:`discretisation`) to ``limit`` (the same mesh with the shells' transverse shear made
+    rigid: the Kirchhoff limit, :data:`.finer.KIRCHHOFF_SHEAR`). The gap grows as the mesh resolves
+    the shear boundary layer at free edges (about 1 % on the twisting modes of a 2.8 mm card at a
+    quarter of its model's mesh, half that at the model's mesh), so it is measured where the
+    frequencies are corrected to."""
+    f, U, k, _ = pair(fine, ob, coarse_state.u, coarse_state.pairs)
+    fk, _, _, _ = pair(limit, ob, coarse_state.u if U is None else U, k)
     return fk / f - 1.0
 
 

@@ -41,8 +41,9 @@ from ..fe.modal import solve_modes
 from ..fe.probe import model_probe, segment_parameter
 from ..problems.models import StructureModels
 from .bodies import as_bodies
-from .catalogue import KINDS, add_effect, generate, kind, place, weighted_centre
+from .catalogue import KINDS, generate, kind, weighted_centre
 from .layout import from_structure
+from . import finer
 from .model_form import MESH_LEVELS, discretisation, fit_plate_share, kirchhoff_shift
 from .residual import ModalResidual, Observation
 from .fitting import estimate
@@ -112,80 +113,75 @@ def _observations(tests, models) -> list:
     return obs
 
 
-def _finer(structure, name, h, p: dict, levels: int = MESH_LEVELS, say=None) -> list:
-    """Built models of configuration ``name`` at parameters ``p`` on the meshes twice, four
-    times, ... as fine as ``h`` (``levels`` of them, :data:`.model_form.MESH_LEVELS`)."""
-    out = []
-    for j in range(1, levels + 1):
-        if say is not None:
-            say(f"  mesh level {j} of {levels} ({1e3 * h / 2**j:.3g} mm) of {name or 'base'}")
-        out.append(structure.build(name, h / 2**j, shared_mesh=True).with_parameters(p))
-    return out
+def _requests(ob, cs, h, levels: int, masses=(), kirchhoff: bool = False) -> list:
+    """The finer-mesh solves (:func:`.finer.solve`) of observation ``ob``, paired on the model's mesh
+    as ``cs``: the meshes twice, four times, ... as fine as ``h`` (``levels`` of them), carrying
+    ``masses``, and with ``kirchhoff`` the finest again as a Kirchhoff plate."""
+    points = None if ob.shapes is None else (ob.modes.xyz, ob.modes.directions)
+    n_modes = int(cs.pairs.max()) + finer.SPARE_MODES
+    out = [(ob.name, h / 2**j, False, tuple(masses), n_modes, points) for j in range(1, levels + 1)]
+    return out + [(ob.name, h / 2**levels, True, (), n_modes, points)] if kirchhoff else out
 
 
 @dataclass
 class _Form:
-    """What one observation's model form leaves: ``finer`` (:func:`_finer`, kept to measure the
-    correction again), ``shift`` (the Kirchhoff limit's relative change per mode), ``measured``
-    (the measurement's frequency sigmas), ``plain`` (with the mesh's uncertainty, without the
-    plate theory's gap) and ``resolved`` (the modes the mesh resolves)."""
+    """What one observation's model form leaves: ``shift`` (the Kirchhoff limit's relative change
+    per mode), ``measured`` (the measurement's frequency sigmas), ``plain`` (with the mesh's
+    uncertainty, without the plate theory's gap) and ``resolved`` (the modes the mesh resolves)."""
 
-    finer: list
     shift: np.ndarray
     measured: np.ndarray
     plain: np.ndarray = None
     resolved: list = None
 
 
-def _correct(ob, cs, models, form: _Form):
-    """Sets ``ob``'s frequency correction from ``models`` (the finer meshes,
+def _correct(ob, cs, solved, form: _Form):
+    """Sets ``ob``'s frequency correction from ``solved`` (the modes on the finer meshes,
     :func:`.model_form.discretisation`) and its frequency sigmas (measurement, the correction's
     uncertainty and the plate theory's gap in quadrature), and ``form``'s ``plain`` and
     ``resolved``; returns the shapes' relative error."""
-    ob.f_scale, df, ds, ok = discretisation(models, ob, cs)
+    ob.f_scale, df, ds, ok = discretisation(solved, ob, cs)
     form.plain, form.resolved = np.sqrt(form.measured**2 + df**2), ok.tolist()
     ob.sigma_f = np.sqrt(form.plain**2 + form.shift**2)
     return ds
 
 
-def _set_noise(structure, models, h, obs, state, freq_pct, shape_pct, levels: int = MESH_LEVELS, say=None) -> list:
+def _set_noise(structure, models, h, obs, state, freq_pct, shape_pct, levels: int, runner) -> list:
     """Each observation's discretisation correction of the model frequencies, and its sigmas:
     measurement noise, what remains of the discretisation error and the plate theory's gap, in
-    quadrature (:mod:`.model_form`), from ``levels`` finer meshes. Returns a :class:`_Form` per
-    observation."""
-    forms = []
-    p0 = dict(zip(models.names, models.p0.tolist()))
+    quadrature (:mod:`.model_form`), from ``levels`` finer meshes (solved where ``runner`` says).
+    Returns a :class:`_Form` per observation."""
+    sigmas = []
     for ob, cs in zip(obs, state.configs):
         basis = None
         if ob.shapes is not None:  # rigid-body modes first: a free board's shapes hold them at the points
             wide = solve_modes(cs.model, n_modes=ob.shapes.shape[0] // 2)
             basis = np.asarray(ob.read @ np.column_stack([wide.rigid_shapes, wide.shapes]))
-        sf, ss = _noise_sigmas(ob, freq_pct, shape_pct, basis)
-        finer = _finer(structure, ob.name, h, p0, levels, say)
-        forms.append(_Form(finer, kirchhoff_shift(finer[-1], ob, cs), sf))
-        ds = _correct(ob, cs, (bm.model for bm in finer), forms[-1])
+        sigmas.append(_noise_sigmas(ob, freq_pct, shape_pct, basis))
+    requests = [r for ob, cs in zip(obs, state.configs) for r in _requests(ob, cs, h, levels, kirchhoff=True)]
+    solved = iter(finer.solve(runner, structure, dict(zip(models.names, models.p0.tolist())), requests))
+    forms = []
+    for ob, cs, (sf, ss) in zip(obs, state.configs, sigmas):
+        meshes = [next(solved) for _ in range(levels)]
+        forms.append(_Form(kirchhoff_shift(meshes[-1], next(solved), ob, cs), sf))
+        ds = _correct(ob, cs, meshes, forms[-1])
         ob.sigma_s = None if ss is None else np.sqrt(ss**2 + ds**2)
     return forms
 
 
-def _with_masses(models, res, p, masses, forms) -> None:
+def _with_masses(structure, models, res, p, masses, forms, h, levels: int, runner) -> None:
     """The mesh correction measured again at the fitted parameters ``p`` on the model carrying the
     masses found (``masses``: [(candidate, value)], :data:`MASS_KINDS`), on its own mesh and placed
-    on the finer ones: a mass changes the shapes, and so what the mesh does to the frequencies, of
-    the modes it sits on (a connector along an edge: a third less on the modes it localises).
-    Masses only, as they are the same on any mesh; a stiffness effect found on the model's mesh is
-    partly its discretisation, and is left out on both sides of the comparison. Sets the
-    observations' ``f_scale`` and frequency sigmas and the ``forms``."""
+    on the ``levels`` finer ones: a mass changes the shapes, and so what the mesh does to the
+    frequencies, of the modes it sits on (a connector along an edge: a third less on the modes it
+    localises). Masses only, as they are the same on any mesh; a stiffness effect found on the
+    model's mesh is partly its discretisation, and is left out on both sides of the comparison.
+    Sets the observations' ``f_scale`` and frequency sigmas and the ``forms``."""
     ref = res.evaluate(p, [c for c, _ in masses], [v for _, v in masses])
-    at = dict(zip(models.names, np.asarray(p, float).tolist()))
+    requests = [r for ob, cs in zip(res.observations, ref.configs) for r in _requests(ob, cs, h, levels, masses)]
+    solved = iter(finer.solve(runner, structure, dict(zip(models.names, np.asarray(p, float).tolist())), requests))
     for ob, cs, form in zip(res.observations, ref.configs, forms):
-        carried = []
-        for bm in (b.with_parameters(at) for b in form.finer):
-            layout, model = from_structure(bm), bm.model
-            for c, v in masses:
-                model = add_effect(model, place(layout, c), v)
-            carried.append(model)
-        _correct(ob, cs, carried, form)
+        _correct(ob, cs, [next(solved) for _ in range(levels)], form)
 
 
 def _range_test(res, base, n_params, alpha) -> dict:
@@ -201,17 +197,17 @@ def _range_test(res, base, n_params, alpha) -> dict:
 
 
 def diagnose(structure, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_size=None, kinds=None,
-             max_effects: int = 3, alpha: float = ALPHA, progress=None, workers: int | None = 1,
+             max_effects: int = 3, alpha: float = ALPHA, progress=None, workers: int | None = None,
              scheduler=None, quick: bool = False) -> Diagnosis:
     """Diagnose ``structure`` (a board, or any structure of :mod:`pcbdyn.domain`) against ``tests`` =
     [(configuration name or None, :class:`pcbdyn.testdata.Modes`)]. ``workers`` local processes (None:
-    the cores) or the Dask cluster at ``scheduler`` run the independent fits of the candidate scans
-    (:mod:`.scan`); the results do not depend on where they ran. ``quick``: a first look that
-    costs a fraction of the run: the mesh correction from one finer mesh (twice as fine) instead of
-    :data:`.model_form.MESH_LEVELS`, the candidates on a grid half as fine
-    (:data:`QUICK_CANDIDATE_OPTIONS`, the local search still walks them to place), one trial per
-    kind in each scan instead of two, and the masses found not carried onto the finer meshes to
-    measure the correction again."""
+    the cores; 1: this process) or the Dask cluster at ``scheduler`` run the independent solves of
+    the finer meshes (:mod:`.finer`) and fits of the candidate scans (:mod:`.scan`); the results do
+    not depend on where they ran. ``quick``: a first look that costs a fraction of the run: the
+    mesh correction from one finer mesh (twice as fine) instead of :data:`.model_form.MESH_LEVELS`,
+    the candidates on a grid half as fine (:data:`QUICK_CANDIDATE_OPTIONS`, the local search still
+    walks them to place), one trial per kind in each scan instead of two, and the masses found not
+    carried onto the finer meshes to measure the correction again."""
     say = progress or (lambda msg: None)
     runner = Runner(workers, scheduler, lambda msg: say(f"  {msg}"))
     h = mesh_size or structure.mesh_size
@@ -229,8 +225,9 @@ def diagnose(structure, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_s
         res = ModalResidual.of_models(models, obs)
         before = res.evaluate(p0)
     say("estimating the noise and the model's discretisation error")
-    forms = _set_noise(structure, models, h, obs, before, freq_noise_pct, shape_noise_pct, 1 if quick else MESH_LEVELS,
-                       say)
+    levels = 1 if quick else MESH_LEVELS
+    say("  finer meshes: " + ", ".join(f"level {j} of {levels} ({1e3 * h / 2**j:.3g} mm)" for j in range(1, levels + 1)))
+    forms = _set_noise(structure, models, h, obs, before, freq_noise_pct, shape_noise_pct, levels, runner)
     before = res.evaluate(p0)
     say(f"fitting the {len(names)} declared parameter(s)" if names else "no declared parameters")
     base = estimate(res, p0, [], [], 10, models.bounds)
@@ -269,7 +266,7 @@ def diagnose(structure, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_s
     masses = [(cands[i], v) for i, v in zip(sel.chosen, sel.values) if cands[i].kind in MASS_KINDS]
     if masses and not quick:
         say("measuring the mesh correction again with the masses found on the finer meshes")
-        _with_masses(models, res, sel.p, masses, forms)
+        _with_masses(structure, models, res, sel.p, masses, forms, h, levels, runner)
         stats["mesh_resolved"] = [f.resolved for f in forms]
         stats["mesh_correction_pct"] = [np.round(100 * (o.f_scale - 1.0), 4).tolist() for o in obs]
         sel = adopt(sel, sel.chosen, estimate(res, sel.p, [cands[i] for i in sel.chosen], sel.values, 8, models.bounds),

@@ -59,7 +59,7 @@ def test_quick_finds_what_the_full_run_finds(case, default, tmp_path):
     data, output = _diagnose(case, tmp_path, "--quick")
     assert not judge(CASE, case[2], data)
     _same_findings(data, default, 0.10, 1e3 * bc.MODEL_MESH)
-    assert "mesh level 1 of 1" in output and "mesh level 2 of" not in output
+    assert "level 1 of 1" in output and "level 2 of" not in output
     assert data["statistics"]["quick"] and not default["statistics"]["quick"]
 
 

@@ -7,8 +7,10 @@ import numpy as np
 import pytest
 
 from pcbdyn.board import build_model, load_board
+from pcbdyn.diagnosis import finer
 from pcbdyn.diagnosis.model_form import discretisation
 from pcbdyn.diagnosis.residual import ModalResidual, Observation
+from pcbdyn.diagnosis.scan import Runner
 from pcbdyn.fe.modal import solve_modes
 from pcbdyn.fe.probe import model_probe
 from pcbdyn.problems import StructureModels
@@ -37,8 +39,8 @@ def correction(board, config, reference_mesh):
                      model_probe(models.models[0].model, xyz, dirs, tol=0.02).P, np.full(N_MODES, 0.01))
     state = ModalResidual.of_models(models, [ob]).evaluate(models.p0).configs[0]
     p = dict(zip(models.names, models.p0.tolist()))
-    fine = build_model(board, config, board.mesh_size / 2.0, shared_mesh=True).with_parameters(p).model
-    scale, sigma, _, resolved = discretisation([fine], ob, state)
+    fine = finer.solve(Runner(), board, p, [(config, board.mesh_size / 2.0, False, (), N_MODES + 2, (xyz, dirs))])
+    scale, sigma, _, resolved = discretisation(fine, ob, state)
     return state.f_a, scale, sigma, resolved, rm.frequencies
 
 

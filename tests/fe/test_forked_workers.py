@@ -1,0 +1,52 @@
+"""Local worker processes after this process has factorised with CHOLMOD (pcbdyn.parallel,
+pcbdyn.fe.threads): GNU OpenMP's idle threads do not survive a fork, and a forked worker waited for
+them forever at its first factorisation. pcbdyn caps OpenMP at one thread when imported, so that
+forking is safe; where a user chose more OpenMP threads, the workers start from a fork server."""
+
+import os
+import subprocess
+import sys
+
+import pytest
+
+SCRIPT = """
+import numpy as np
+import scipy.sparse as sp
+
+import pcbdyn  # caps OpenMP before CHOLMOD loads it (unless OMP_NUM_THREADS says otherwise)
+from pcbdyn.fe.linsolve import factorize
+from pcbdyn.fe.threads import openmp_capped
+from pcbdyn.parallel import run_jobs
+
+
+def job(i, A):
+    return float(factorize(A).solve(np.ones(A.shape[0]))[i])
+
+
+if __name__ == "__main__":
+    n = 200_000
+    T = sp.diags([np.full(n - 1, -1.0), np.full(n, 4.0), np.full(n - 1, -1.0)], [-1, 0, 1])
+    A = (sp.kron(sp.eye(3), T) + sp.eye(3 * n)).tocsc()
+    x = factorize(A).solve(np.ones(A.shape[0]))  # the parent's CHOLMOD (and OpenMP) first
+    out = dict(run_jobs(job, [(i,) for i in range(4)], A, workers=2))
+    print(openmp_capped(), max(abs(out[(i,)] - x[i]) for i in range(4)))
+"""
+
+
+@pytest.mark.parametrize("omp_threads,capped", [(None, True), ("2", False)])
+def test_workers_after_a_factorisation_finish_with_the_parent_s_answer(tmp_path, omp_threads, capped):
+    """Four jobs on two workers after the parent factorised: they finish (within 120 s; each takes
+    well under one) with the parent's solution, forked where OpenMP is capped, else from a server."""
+    script = tmp_path / "workers.py"
+    script.write_text(SCRIPT)
+    env = {k: v for k, v in os.environ.items() if k not in ("OMP_THREAD_LIMIT", "OMP_NUM_THREADS", "PCBDYN_BLAS_THREADS")}
+    if omp_threads:
+        env["OMP_NUM_THREADS"] = omp_threads
+    try:
+        run = subprocess.run([sys.executable, str(script)], env=env, capture_output=True, text=True, timeout=120)
+    except subprocess.TimeoutExpired:
+        pytest.fail("the worker processes hung")
+    assert run.returncode == 0, run.stderr
+    was_capped, error = run.stdout.split()
+    assert was_capped == str(capped)
+    assert float(error) < 1e-12
