@@ -35,8 +35,8 @@ from .common import done, folder_outputs, input_errors, library_option, measured
 @click.option("--workers", type=click.IntRange(min=1), default=None,
               help="local processes for the finer-mesh solves and the trial fits (default: the cores; 1: this process)")
 @click.option("--scheduler", default=None,
-              help="a Dask scheduler address (tcp://host:8786): the trial fits of the candidate scans run on that "
-                   "cluster (the findings do not depend on where they run)")
+              help="a Dask scheduler address (tcp://host:8786): the finer-mesh solves and the trial fits run on "
+                   "that cluster (the findings do not depend on where they run)")
 @folder_outputs("folder for the board with the effects declared, the evidence map and tables",
                 "write effects, before/after and statistics as JSON",
                 force="replace an earlier <board>.diagnosed.toml beside the board (default: a numbered name)")
@@ -65,7 +65,8 @@ def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size,
         ms = to_si(mesh_size, "mm", "--mesh-size") if mesh_size else None
         t0 = step("diagnosing")
         d = diagnose(board, tests, freq_pct, shape_pct, mesh_size=ms, kinds=chosen, max_effects=max_effects,
-                     progress=lambda msg: click.echo(f"    {msg}", err=True), quick=quick, workers=workers, scheduler=scheduler)
+                     progress=lambda msg: click.echo(f"    {msg}", err=True), quick=quick, workers=workers,
+                     scheduler=scheduler)
         done(t0)
     click.echo(f"\n{board.name}: {d.message}\n")
     click.echo(rep.format_effects(d.effects))
