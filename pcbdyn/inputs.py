@@ -26,6 +26,27 @@ RANGES = {
 #: largest input file read (bytes): a board.toml of MAX_ENTRIES parts is far smaller
 MAX_FILE_BYTES = 20_000_000
 
+#: the key that names an entry of a collection (default "name")
+NAME_FIELD = {"components": "ref"}
+#: prefix of the default name of an unnamed entry, by collection (the fixture's type for fixtures)
+DEFAULT_PREFIX = {"masses": "m", "line_masses": "line_mass", "stiffeners": "stiffener", "regions": "region",
+                  "plates": "plate", "ribs": "rib", "joints": "joint"}
+
+
+def entry_name(collection: str, entry: dict, index: int) -> str:
+    """The name of entry ``index`` (0-based) of ``collection``: its ``name`` (``ref`` for parts), else
+    its kind's prefix and 1-based position (a fixture: its type, e.g. ``wedge_lock2``)."""
+    key = NAME_FIELD.get(collection, "name")
+    if key in entry:
+        return str(entry[key])
+    prefix = str(entry.get("type", collection)) if collection == "fixtures" else DEFAULT_PREFIX.get(collection, collection)
+    return f"{prefix}{index + 1}"
+
+
+def check_name(name: str) -> str | None:
+    """Why ``name`` cannot name an entry that targets address (None when it can)."""
+    return f"'{name}' contains '.', which parameter targets use as a separator; rename it" if "." in name else None
+
 
 def check_file(path, error=StructureError, limit: int = MAX_FILE_BYTES) -> Path:
     """``path`` as a Path once it is known to be a file of at most ``limit`` bytes; ``error`` otherwise."""
@@ -121,10 +142,8 @@ class Reader:
         return value
 
     def name(self, collection: str, entry: dict, index: int, where: str) -> str:
-        """The name of entry ``index`` of ``collection`` (:func:`pcbdyn.targets.entry_name`): text of at
-        most :data:`MAX_NAME` printable characters without '.', which parameter targets use."""
-        from .targets import NAME_FIELD, check_name, entry_name
-
+        """The name of entry ``index`` of ``collection`` (:func:`entry_name`): text of at most
+        :data:`MAX_NAME` printable characters without '.', which parameter targets use."""
         self.table(entry, where)
         key = NAME_FIELD.get(collection, "name")
         if key in entry:

@@ -6,8 +6,8 @@ knows, for every target kind, its display unit, whether it is a spring stiffness
 scale: it spans decades), where its value sits in the TOML document and how it is written there; it
 validates a ``[[parameters]]`` entry against a structure (which says what value a target has, or that
 it has none) and writes updated values back into the user's file with its comments and layout kept
-(tomlkit). Entry names follow one rule everywhere (:func:`entry_name`): an entry without ``name``
-(``ref`` for parts) is called after its kind and position (``wedge_lock2``, ``m1``, ...).
+(tomlkit). Entry names follow one rule everywhere (:func:`pcbdyn.inputs.entry_name`): an entry
+without ``name`` (``ref`` for parts) is called after its kind and position (``wedge_lock2``, ``m1``).
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ from typing import Callable
 import tomlkit
 
 from .domain import StructureError
-from .inputs import MAX_NAME, Reader
+from .inputs import MAX_NAME, NAME_FIELD, Reader, entry_name
 from .units import UnitError, from_si, registry, shown, to_si
 
 
@@ -58,11 +58,6 @@ class Kind:
 
 #: collections that are one table (targets ``<table>.<attribute>``); the others are arrays of tables
 TABLES = ("board",)
-#: the key that names an entry of a collection (default "name")
-NAME_FIELD = {"components": "ref"}
-#: prefix of the default name of an unnamed entry, by collection (the fixture's type for fixtures)
-DEFAULT_PREFIX = {"masses": "m", "line_masses": "line_mass", "stiffeners": "stiffener", "regions": "region",
-                  "plates": "plate", "ribs": "rib", "joints": "joint"}
 
 KINDS = {(k.collection, k.attribute): k for k in (
     Kind("board", "E", "Pa", "Young's modulus of the board", path=("material", "E")),
@@ -125,16 +120,6 @@ def parse(text, collections=None) -> Target:
     raise TargetError(f"{shown(str(text))} is not a target of this structure; {hint}targets are {', '.join(patterns)}")
 
 
-def entry_name(collection: str, entry: dict, index: int) -> str:
-    """The name of entry ``index`` (0-based) of ``collection``: its ``name`` (``ref`` for parts), else
-    its kind's prefix and 1-based position (a fixture: its type, e.g. ``wedge_lock2``)."""
-    key = NAME_FIELD.get(collection, "name")
-    if key in entry:
-        return str(entry[key])
-    prefix = str(entry.get("type", collection)) if collection == "fixtures" else DEFAULT_PREFIX.get(collection, collection)
-    return f"{prefix}{index + 1}"
-
-
 def new_entry_name(text: str, used: set, fallback: str) -> str:
     """A name for a new entry made from ``text`` (a diagnosed effect's label): letters, digits, _ and -
     only (usable in targets), within the readers' length limit, and not in ``used`` (to which it is
@@ -145,11 +130,6 @@ def new_entry_name(text: str, used: set, fallback: str) -> str:
         out, k = f"{base}_{k}", k + 1
     used.add(out)
     return out
-
-
-def check_name(name: str) -> str | None:
-    """Why ``name`` cannot name an entry that targets address (None when it can)."""
-    return f"'{name}' contains '.', which parameter targets use as a separator; rename it" if "." in name else None
 
 
 # ------------------------------------------------------------------------------------ parameters

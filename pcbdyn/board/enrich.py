@@ -24,6 +24,7 @@ import shapely
 import tomlkit
 
 from .. import targets
+from ..inputs import entry_name
 from .entries import MIN_SEGMENT, BoardError
 
 TYPES = ("point_mass", "point_inertia", "ground_spring", "edge_stiffness", "line_mass", "stiffener",
@@ -58,7 +59,7 @@ class _Names:
     """Entry names usable in parameter targets (no '.'), unique per array of the document."""
 
     def __init__(self, doc):
-        self.used = {key: {targets.entry_name(key, e, i) for i, e in enumerate(doc.get(key, []))}
+        self.used = {key: {entry_name(key, e, i) for i, e in enumerate(doc.get(key, []))}
                      for key in ("fixtures", "masses", "line_masses", "stiffeners", "regions")}
 
     def __call__(self, key: str, name: str) -> str:

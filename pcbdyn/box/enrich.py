@@ -15,11 +15,12 @@ import numpy as np
 import tomlkit
 
 from .. import targets
+from ..inputs import entry_name
 from .entries import BoxError
 
 
 def _name(doc, base: str) -> str:
-    used = {targets.entry_name("masses", e, i) for i, e in enumerate(doc.get("masses", []))}
+    used = {entry_name("masses", e, i) for i, e in enumerate(doc.get("masses", []))}
     return targets.new_entry_name(base, used, "mass")
 
 
@@ -40,7 +41,7 @@ def enriched_text(box, text: str, effects) -> str:
             entry.comment(f"found by pcbdyn diagnose ({e['name']})")
             doc.setdefault("masses", tomlkit.aot()).append(entry)
         elif e["type"] == "region_stiffness":
-            i = next(k for k, p in enumerate(doc["plates"]) if targets.entry_name("plates", p, k) == plate.name)
+            i = next(k for k, p in enumerate(doc["plates"]) if entry_name("plates", p, k) == plate.name)
             factor = 1.0 + float(e["value"])
             E = plate.material.E
             doc["plates"][i]["E"] = ([targets.quantity(v * factor, "GPa") for v in E] if isinstance(E, tuple)
