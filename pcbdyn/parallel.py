@@ -5,7 +5,8 @@ Each job is ``fn(*args, shared)``: ``shared`` (a case, a residual) is sent to ev
 process pool's initializer, Dask's scatter), the arguments per job. Results come back as they finish;
 callers that need an order sort them, and jobs are seeded by their own arguments, so the results do not
 depend on where they ran. Local workers are forked, inheriting this process's built models and caches,
-where that is safe (:func:`pcbdyn.fe.threads.openmp_capped`); otherwise they start from a fork server.
+where that is safe (:func:`pcbdyn.fe.threads.openmp_capped`); otherwise they start from a fork server
+and ``shared`` goes to them by cloudpickle (as to Dask), which also carries closures plain pickle cannot.
 """
 
 from __future__ import annotations
@@ -19,9 +20,23 @@ from .fe.threads import openmp_capped
 _SHARED = None
 
 
+class _Pickled:
+    """``shared`` on its way to workers started from a fork server."""
+
+    def __init__(self, obj):
+        import cloudpickle
+
+        self.blob = cloudpickle.dumps(obj)
+
+    def load(self):
+        import cloudpickle
+
+        return cloudpickle.loads(self.blob)
+
+
 def _init(shared) -> None:
     global _SHARED
-    _SHARED = shared
+    _SHARED = shared.load() if isinstance(shared, _Pickled) else shared
 
 
 def _call(fn, args):
@@ -44,8 +59,10 @@ def run_jobs(fn, jobs, shared, workers: int | None = None, scheduler: str | None
                 done(args)
             yield args, out
         return
-    context = multiprocessing.get_context("fork" if openmp_capped() else "forkserver")
-    with ProcessPoolExecutor(min(workers, len(jobs)), context, initializer=_init, initargs=(shared,)) as pool:
+    fork = openmp_capped()
+    context = multiprocessing.get_context("fork" if fork else "forkserver")
+    with ProcessPoolExecutor(min(workers, len(jobs)), context, initializer=_init,
+                             initargs=(shared if fork else _Pickled(shared),)) as pool:
         futures = {pool.submit(_call, fn, args): args for args in jobs}
         for fut in as_completed(futures):
             if done:

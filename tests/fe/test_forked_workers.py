@@ -1,7 +1,8 @@
 """Local worker processes after this process has factorised with CHOLMOD (pcbdyn.parallel,
 pcbdyn.fe.threads): GNU OpenMP's idle threads do not survive a fork, and a forked worker waited for
 them forever at its first factorisation. pcbdyn caps OpenMP at one thread when imported, so that
-forking is safe; where a user chose more OpenMP threads, the workers start from a fork server."""
+forking is safe; where a user chose more OpenMP threads, the workers start from a fork server, and
+what they share (here with a closure, as a built model holds) goes to them by cloudpickle."""
 
 import os
 import subprocess
@@ -19,8 +20,9 @@ from pcbdyn.fe.threads import openmp_capped
 from pcbdyn.parallel import run_jobs
 
 
-def job(i, A):
-    return float(factorize(A).solve(np.ones(A.shape[0]))[i])
+def job(i, shared):
+    A, unit = shared  # unit: a closure, as built models hold (plain pickle cannot send it)
+    return unit(float(factorize(A).solve(np.ones(A.shape[0]))[i]))
 
 
 if __name__ == "__main__":
@@ -28,7 +30,8 @@ if __name__ == "__main__":
     T = sp.diags([np.full(n - 1, -1.0), np.full(n, 4.0), np.full(n - 1, -1.0)], [-1, 0, 1])
     A = (sp.kron(sp.eye(3), T) + sp.eye(3 * n)).tocsc()
     x = factorize(A).solve(np.ones(A.shape[0]))  # the parent's CHOLMOD (and OpenMP) first
-    out = dict(run_jobs(job, [(i,) for i in range(4)], A, workers=2))
+    scale = 1.0
+    out = dict(run_jobs(job, [(i,) for i in range(4)], (A, lambda v: scale * v), workers=2))
     print(openmp_capped(), max(abs(out[(i,)] - x[i]) for i in range(4)))
 """
 
