@@ -39,7 +39,7 @@ from scipy.stats import chi2 as chi2_dist
 
 from ..fe.modal import solve_modes
 from ..fe.probe import model_probe, segment_parameter
-from ..problems.models import StructureModels
+from ..problems.models import StructureModels, parameter_values
 from .bodies import as_bodies
 from .catalogue import KINDS, generate, kind, weighted_centre
 from .layout import from_structure
@@ -146,7 +146,7 @@ def _correct(ob, cs, solved, form: _Form):
     return ds
 
 
-def _set_noise(structure, models, h, obs, state, freq_pct, shape_pct, levels: int, runner) -> list:
+def _set_noise(models, h, obs, state, freq_pct, shape_pct, levels: int, runner) -> list:
     """Each observation's discretisation correction of the model frequencies, and its sigmas:
     measurement noise, what remains of the discretisation error and the plate theory's gap, in
     quadrature (:mod:`.model_form`), from ``levels`` finer meshes (solved where ``runner`` says).
@@ -159,7 +159,8 @@ def _set_noise(structure, models, h, obs, state, freq_pct, shape_pct, levels: in
             basis = np.asarray(ob.read @ np.column_stack([wide.rigid_shapes, wide.shapes]))
         sigmas.append(_noise_sigmas(ob, freq_pct, shape_pct, basis))
     requests = [r for ob, cs in zip(obs, state.configs) for r in _requests(ob, cs, h, levels, kirchhoff=True)]
-    solved = iter(finer.solve(runner, structure, dict(zip(models.names, models.p0.tolist())), requests))
+    p0 = parameter_values(models.models[0], models.names, models.p0)
+    solved = iter(finer.solve(runner, models.structure, p0, requests))
     forms = []
     for ob, cs, (sf, ss) in zip(obs, state.configs, sigmas):
         meshes = [next(solved) for _ in range(levels)]
@@ -169,7 +170,7 @@ def _set_noise(structure, models, h, obs, state, freq_pct, shape_pct, levels: in
     return forms
 
 
-def _with_masses(structure, models, res, p, masses, forms, h, levels: int, runner) -> None:
+def _with_masses(models, res, p, masses, forms, h, levels: int, runner) -> None:
     """The mesh correction measured again at the fitted parameters ``p`` on the model carrying the
     masses found (``masses``: [(candidate, value)], :data:`MASS_KINDS`), on its own mesh and placed
     on the ``levels`` finer ones: a mass changes the shapes, and so what the mesh does to the
@@ -179,7 +180,8 @@ def _with_masses(structure, models, res, p, masses, forms, h, levels: int, runne
     Sets the observations' ``f_scale`` and frequency sigmas and the ``forms``."""
     ref = res.evaluate(p, [c for c, _ in masses], [v for _, v in masses])
     requests = [r for ob, cs in zip(res.observations, ref.configs) for r in _requests(ob, cs, h, levels, masses)]
-    solved = iter(finer.solve(runner, structure, dict(zip(models.names, np.asarray(p, float).tolist())), requests))
+    at = parameter_values(models.models[0], models.names, p)
+    solved = iter(finer.solve(runner, models.structure, at, requests))
     for ob, cs, form in zip(res.observations, ref.configs, forms):
         _correct(ob, cs, [next(solved) for _ in range(levels)], form)
 
@@ -227,7 +229,7 @@ def diagnose(structure, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_s
     say("estimating the noise and the model's discretisation error")
     levels = 1 if quick else MESH_LEVELS
     say("  finer meshes: " + ", ".join(f"level {j} of {levels} ({1e3 * h / 2**j:.3g} mm)" for j in range(1, levels + 1)))
-    forms = _set_noise(structure, models, h, obs, before, freq_noise_pct, shape_noise_pct, levels, runner)
+    forms = _set_noise(models, h, obs, before, freq_noise_pct, shape_noise_pct, levels, runner)
     before = res.evaluate(p0)
     say(f"fitting the {len(names)} declared parameter(s)" if names else "no declared parameters")
     base = estimate(res, p0, [], [], 10, models.bounds)
@@ -266,7 +268,7 @@ def diagnose(structure, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_s
     masses = [(cands[i], v) for i, v in zip(sel.chosen, sel.values) if cands[i].kind in MASS_KINDS]
     if masses and not quick:
         say("measuring the mesh correction again with the masses found on the finer meshes")
-        _with_masses(structure, models, res, sel.p, masses, forms, h, levels, runner)
+        _with_masses(models, res, sel.p, masses, forms, h, levels, runner)
         stats["mesh_resolved"] = [f.resolved for f in forms]
         stats["mesh_correction_pct"] = [np.round(100 * (o.f_scale - 1.0), 4).tolist() for o in obs]
         sel = adopt(sel, sel.chosen, estimate(res, sel.p, [cands[i] for i in sel.chosen], sel.values, 8, models.bounds),
