@@ -12,7 +12,9 @@ A :class:`Layout`, cached by the nonzero pattern of K and M, keeps what does not
 (connected components), where each group's entries and their lower triangle sit (gather plans),
 and the order in which the groups' spectra started in the last solve (its exact lowest elastic
 eigenvalue per group, or a proven lower bound); CHOLMOD's symbolic analysis is kept by
-:mod:`.linsolve`. Only the first solve of a pattern estimates the order by block inverse iteration.
+:mod:`.linsolve`. Only the first solve of a pattern estimates the order by block inverse iteration,
+and not even that when the caller tells which group is the bending one (``solve_modes`` does, from
+the DOFs' directions).
 """
 
 from __future__ import annotations

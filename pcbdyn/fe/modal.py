@@ -270,19 +270,37 @@ class _Block:
 
 
 def solve_pencil(Kr, Mr, n_modes: int | None = None, f_max: float | None = None, free: bool = False,
-                 keep_factor: bool = False):
+                 keep_factor: bool = False, axes=None):
     """(lambda, vectors, rigid mask, ShiftedInverse or None) of the constrained pencil: the first
     ``n_modes`` elastic modes and/or all up to ``f_max`` [Hz], plus the rigid-body modes met on
     the way (up to six more are looked for when ``free``). Unsorted across groups; vectors are
     mass-normalised. ``keep_factor``: also return the groups' factorisations for reuse.
+    ``axes``: per constrained DOF, the axis (0-2) of a translation, -1 for a rotation; it names
+    the bending group of a flat structure, solved first (:func:`_bending_group`).
 
     With ``f_max`` every group is counted (Sturm) below the cut, so no request has to grow.
     """
     with limited():
-        return _solve_pencil(Kr, Mr, n_modes, f_max, free, keep_factor)
+        return _solve_pencil(Kr, Mr, n_modes, f_max, free, keep_factor, axes)
 
 
-def _solve_pencil(Kr, Mr, n_modes, f_max, free, keep_factor):
+def _bending_group(groups, dense, axes) -> int | None:
+    """The group that moves along one translation axis only, when exactly one of the large groups
+    does: the bending (out-of-plane) DOFs of a flat structure, whose spectrum starts far below
+    the membrane group's (which moves along two). Ordering by it instead of estimating each
+    group's first eigenvalue saves a factorisation and inverse iterations of the other group on
+    the first solve of a pattern (112k-DOF plate, 10 fresh processes: median 2.50 -> 2.04 s; 1M DOF:
+    34.5 -> 28.2 s, 5.6 -> 4.8 GB); a wrong guess costs only time,
+    since the other groups are then counted (Sturm) below the cut like any other."""
+    if axes is None:
+        return None
+    axes = np.asarray(axes)
+    single = [g for g, idx in enumerate(groups)
+              if not dense[g] and np.unique(axes[idx][axes[idx] >= 0]).size == 1]
+    return single[0] if len(single) == 1 else None
+
+
+def _solve_pencil(Kr, Mr, n_modes, f_max, free, keep_factor, axes):
     lay, K, M = layout(Kr, Mr)
     n = K.shape[0]
     extra = 6 if free else 0
@@ -293,7 +311,11 @@ def _solve_pencil(Kr, Mr, n_modes, f_max, free, keep_factor):
         blocks.append(_Block(idx, Kb, Mb, lambda g=g, Kb=Kb: lay.lower(g, Kb)))
     order = list(range(len(blocks)))
     if len(blocks) > 1:
-        start = lay.start if not np.isnan(lay.start).any() else [b.first_eigenvalue(extra) for b in blocks]
+        start = lay.start
+        if np.isnan(start).any():
+            bending = _bending_group(lay.groups, [b.dense for b in blocks], axes)
+            start = ([-np.inf if b.dense else 0.0 if g == bending else np.inf for g, b in enumerate(blocks)]
+                     if bending is not None else [b.first_eigenvalue(extra) for b in blocks])
         order.sort(key=lambda g: start[g])
     lams, vecs, rigids = [], [], []
     cap = None if n_modes is None else n_modes + extra
@@ -360,7 +382,8 @@ def solve_modes(model, n_modes: int | None = None, f_max: float | None = None, K
         raise ModelError("the model has no free DOF: every DOF is fixed or untouched by an element")
     if np.any(Mr.diagonal() < 0):
         raise ModelError("the mass matrix has negative diagonal terms: check densities and masses")
-    lam, vec, rigid, shifted = solve_pencil(Kr, Mr, n_modes, f_max, model.free, keep_factor)
+    axes = np.where(red.independent % NDOF < 3, red.independent % NDOF, -1)
+    lam, vec, rigid, shifted = solve_pencil(Kr, Mr, n_modes, f_max, model.free, keep_factor, axes)
     if rigid.any() and not model.free:
         raise ModelError(
             f"the model has {int(rigid.sum())} zero-frequency (rigid-body or mechanism) mode(s) but "

@@ -327,6 +327,36 @@ def test_clamped_block_with_nothing_below_the_cut_is_skipped(monkeypatch):
     assert asked == [8]
 
 
+@pytest.mark.parametrize("guess", ["bending", "membrane"])
+def test_first_solve_starts_with_the_group_moving_along_one_axis(monkeypatch, guess):
+    """The first solve of a flat plate's pattern starts with the group that translates along z only
+    (bending) without estimating each group's first eigenvalue; told the wrong group (the membrane
+    one labelled as moving along one axis), it does more work but finds the same modes: the other
+    group is counted below the cut either way. Both agree with a dense solve of the whole pencil."""
+    from pcbdyn.fe import blocks, modal
+
+    model = _square_plate(14, 0.0)
+    model.free = False
+    nodes = model.nodes
+    on_edge = np.isclose(nodes[:, :2], 0).any(axis=1) | np.isclose(nodes[:, :2], 0.2).any(axis=1)
+    model.fix(np.flatnonzero(on_edge), [0, 1, 2])
+    red, Kr, Mr = reduced_system(model)
+    lam = sla.eigh(Kr.toarray(), Mr.toarray(), eigvals_only=True)
+    axes = np.where(red.independent % 6 < 3, red.independent % 6, -1)
+    groups = uncoupled_blocks(Kr, Mr)
+    bending = next(g for g, idx in enumerate(groups) if np.all(axes[idx][axes[idx] >= 0] == 2))
+    assert modal._bending_group(groups, [False, False], axes) == bending
+    if guess == "membrane":
+        membrane = groups[1 - bending]
+        axes = axes.copy()
+        axes[membrane[axes[membrane] >= 0]] = 0
+    monkeypatch.setattr(blocks, "_layouts", type(blocks._layouts)())  # a first solve of the pattern
+    monkeypatch.setattr(modal._Block, "first_eigenvalue", lambda *a: pytest.fail("estimated the order"))
+    out, vec, rigid, _ = modal.solve_pencil(Kr, Mr, n_modes=8, axes=axes)
+    assert not rigid.any()
+    np.testing.assert_allclose(np.sort(out)[:8], lam[:8], rtol=1e-8)
+
+
 def test_assembly_equals_sum_of_element_matrices():
     """K and M of a mixed model (quads, beams, springs, masses) equal the plain sum of every element
     matrix at its DOFs (dense reference), with one shared sparsity pattern and int32 indices."""
