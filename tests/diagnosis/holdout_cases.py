@@ -30,12 +30,17 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import bench_cases as bc  # noqa: E402
 from bench_cases import C23, LOOSE, Case, Effect  # noqa: E402
 
+from pcbdyn.board.entries import RibSection  # noqa: E402
+
 HERE = Path(__file__).resolve().parent / "holdout"
 TRUTH_MESH = bc.MODEL_MESH / 4.0
 SHELL = "ShellDKGQ"
 CARD_HO = {"t_PGA": 3.8e-3, "t_JLCC": 3.35e-3, "t_CQFP": 4.05e-3, "E_board": 25.2e9}
 WEDGE_HO = {"k_guides": 4e4, "E_board": 27.3e9}
 LOOSE_HO = {"k_guides": 1.4e3, "E_board": 25.5e9}
+#: bending stiffness [N m^2] of an aluminium flat bar 10 mm wide, of the stiffener's default section
+#: (:class:`pcbdyn.board.entries.RibSection`, 4 mm high), whose mass then follows from it
+AL_BAR_EI = RibSection().E * 10e-3 * RibSection().h ** 3 / 12.0
 
 CASES = [
     Case("ho_noise_card", "card", true_values=CARD_HO, seed=101, note="no hidden effect"),
@@ -58,6 +63,11 @@ CASES = [
     Case("ho_region_wedge", "wedge", (Effect("region_stiffness", 2.0, polygon=((0.010, 0.100), (0.045, 0.100),
                                                                              (0.045, 0.135), (0.010, 0.135))),),
          true_values=WEDGE_HO, seed=110, note="a 35 mm square of the board 3 x stiffer (a bonded plate)"),
+    Case("ho_al_bar", "card", (Effect("stiffener", AL_BAR_EI, path=((0.0, 0.070), (0.162, 0.070))),),
+         true_values=CARD_HO, seed=111, note="an aluminium flat bar 10 x 4 mm glued across the card (its mass with it)"),
+    Case("ho_bracket", "card", (Effect("point_mass", 12e-3, at=(0.120, 0.150)),
+                                Effect("ground_spring", 1.5e5, at=(0.120, 0.150))),
+         true_values=CARD_HO, seed=112, note="a 12 g bracket on a 1.5e5 N/m spring to the frame"),
 ]
 CASES = [replace(c, truth_mesh=TRUTH_MESH) for c in CASES]
 BY_NAME = {c.name: c for c in CASES}

@@ -12,7 +12,8 @@ Each: every part of the addition within 30 % and the max frequency error after <
 
 The bar is found since the held-out check may also follow the secant of a large addition
 (:func:`pcbdyn.diagnosis.select._kept`); the error after stays at 0.61 %. The bracket is not found.
-Not met yet: strict xfails, so that a fix shows.
+Not met yet: strict xfails, so that a fix shows. The same two additions on data from another FE code
+are the hold-out cases ``ho_al_bar`` and ``ho_bracket`` (:mod:`holdout_cases`, :mod:`test_holdout`).
 """
 
 from __future__ import annotations
