@@ -30,6 +30,18 @@ def element_matrices(model, name: str, prop=None):
     return kernel(es.etype)(model.nodes[es.conn], es.prop if prop is None else prop)
 
 
+def _chunk_matrices(model, name: str, prop=None):
+    """(first cell, end cell, Ke, Me) of set ``name`` (its own property, or ``prop``), ``CHUNK_CELLS``
+    cells at a time: what bounds the memory of every assembly."""
+    es = model.sets[name]
+    prop = es.prop if prop is None else prop
+    conn = np.asarray(es.conn)
+    for a in range(0, conn.shape[0], CHUNK_CELLS):
+        b = min(a + CHUNK_CELLS, conn.shape[0])
+        part = prop.cells(a, b) if hasattr(prop, "cells") else prop  # per-cell data (EmbeddedBeamProperty)
+        yield (a, b, *kernel(es.etype)(model.nodes[conn[a:b]], part))
+
+
 def _node_pairs(conn: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(row node, column node) of every node block of every cell, cell-major, each (n_cells * npc^2,)."""
     conn = np.asarray(conn, dtype=np.int64)
@@ -147,14 +159,8 @@ def assemble(model, sets=None, props=None):
         pending.clear()
 
     for name, slot in zip(names, pattern.slot):
-        es = model.sets[name]
-        prop = es.prop if props.get(name) is None else props[name]
-        conn = np.asarray(es.conn)
-        npp = conn.shape[1] ** 2
-        for a in range(0, conn.shape[0], CHUNK_CELLS):
-            b = min(a + CHUNK_CELLS, conn.shape[0])
-            part = prop.cells(a, b) if hasattr(prop, "cells") else prop  # per-cell data (EmbeddedBeamProperty)
-            Ke, Me = kernel(es.etype)(model.nodes[conn[a:b]], part)
+        npp = np.asarray(model.sets[name].conn).shape[1] ** 2
+        for a, b, Ke, Me in _chunk_matrices(model, name, props.get(name)):
             pending.append((slot[a * npp:b * npp], _node_blocks(Ke), _node_blocks(Me)))
             size += (b - a) * npp
             if size >= CHUNK_CELLS * 16:
@@ -178,7 +184,8 @@ class SetAssembly:
         self.names = [nm for nm in model.sets if len(model.sets[nm].conn) > 0]
         self.pattern = _Pattern(model.n_dof // NDOF, [model.sets[nm].conn for nm in self.names])
         self.index = self.pattern.csr_index()
-        self._sums = {nm: _summing(self.pattern, slot) for nm, slot in zip(self.names, self.pattern.slot)}
+        self._sums = {nm: (pos, S.tocsc()) for nm, (pos, S) in
+                      ((nm, _summing(self.pattern, slot)) for nm, slot in zip(self.names, self.pattern.slot))}
 
     @property
     def nnz(self) -> int:
@@ -188,10 +195,16 @@ class SetAssembly:
         return self._sums[name][0]
 
     def values(self, name: str, prop=None) -> tuple[np.ndarray, np.ndarray]:
-        """(K values, M values) of set ``name`` at its :meth:`positions` (its own property by default)."""
-        Ke, Me = element_matrices(self.model, name, prop)
+        """(K values, M values) of set ``name`` at its :meth:`positions` (its own property by default),
+        summed chunk by chunk as :func:`assemble` does."""
         S = self._sums[name][1]
-        return (S @ _node_blocks(Ke)).ravel(), (S @ _node_blocks(Me)).ravel()
+        npp = np.asarray(self.model.sets[name].conn).shape[1] ** 2
+        K, M = np.zeros((S.shape[0], _NN)), np.zeros((S.shape[0], _NN))
+        for a, b, Ke, Me in _chunk_matrices(self.model, name, prop):
+            part = S if b * npp - a * npp == S.shape[1] else S[:, a * npp:b * npp]
+            K += part @ _node_blocks(Ke)
+            M += part @ _node_blocks(Me)
+        return K.ravel(), M.ravel()
 
     def matrix(self, data: np.ndarray) -> sp.csr_matrix:
         """The CSR matrix with values ``data`` (length :attr:`nnz`) on the pattern (shared index)."""

@@ -146,3 +146,23 @@ def test_the_rib_and_its_offset_matter(frequencies):
     offset is what makes the beam agree: a rib bending about the plate's mid-surface is far softer."""
     assert np.max(np.abs(frequencies["shell"] / frequencies["plate"] - 1)) > 0.2
     assert np.max(np.abs(frequencies["beam_no_offset"] / frequencies["shell"] - 1)) > 0.1
+
+
+def test_chunked_assembly_and_set_values_equal_one_piece(monkeypatch):
+    """Assembly and :class:`SetAssembly` values computed a few cells at a time (per-cell data of the
+    embedded rib sliced with them) equal the same sums made in one piece."""
+    from pcbdyn.fe import assembly
+
+    model = _embedded_rib_model()
+    K1, M1 = assembly.assemble(model)
+    one = assembly.SetAssembly(model)
+    whole = {nm: one.values(nm) for nm in one.names}
+    monkeypatch.setattr(assembly, "CHUNK_CELLS", 3)
+    assert all(len(model.sets[nm].conn) > 3 for nm in one.names)
+    K3, M3 = assembly.assemble(model)
+    for A, B in ((K1, K3), (M1, M3)):
+        np.testing.assert_allclose(B.toarray(), A.toarray(), rtol=0, atol=1e-12 * abs(A).max())
+    chunked = assembly.SetAssembly(model)
+    for nm in chunked.names:
+        for a, b in zip(whole[nm], chunked.values(nm)):
+            np.testing.assert_allclose(b, a, rtol=0, atol=1e-12 * np.abs(a).max())
