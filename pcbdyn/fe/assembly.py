@@ -184,8 +184,10 @@ class SetAssembly:
         self.names = [nm for nm in model.sets if len(model.sets[nm].conn) > 0]
         self.pattern = _Pattern(model.n_dof // NDOF, [model.sets[nm].conn for nm in self.names])
         self.index = self.pattern.csr_index()
-        self._sums = {nm: (pos, S.tocsc()) for nm, (pos, S) in
-                      ((nm, _summing(self.pattern, slot)) for nm, slot in zip(self.names, self.pattern.slot))}
+        self._sums = {}
+        for nm, slot in zip(self.names, self.pattern.slot):
+            pos, S = _summing(self.pattern, slot)
+            self._sums[nm] = (pos, S.tocsc())  # CSC: a chunk's columns are a cheap slice
 
     @property
     def nnz(self) -> int:
