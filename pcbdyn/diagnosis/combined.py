@@ -16,16 +16,11 @@ from collections import OrderedDict
 import numpy as np
 import scipy.sparse as sp
 
-from ..fe.sparsity import canonical_csr
+from ..fe.sparsity import UnionPattern, canonical_csr
 from .catalogue import BlockCache, derivatives, kind
 
 #: patterns of effect sets kept (least recently used dropped first)
 PLANS_KEPT = 64
-
-
-def _keys(A: sp.csr_matrix) -> np.ndarray:
-    n = A.shape[1]
-    return np.repeat(np.arange(A.shape[0], dtype=np.int64), np.diff(A.indptr)) * n + A.indices
 
 
 class EffectPlan:
@@ -33,26 +28,20 @@ class EffectPlan:
     of them sits in it (``base``: positions of the base entries, ``at[k]``: of effect k's)."""
 
     def __init__(self, base: sp.csr_matrix, parts: list):
-        union = sp.csr_matrix((np.ones(base.nnz), base.indices, base.indptr), shape=base.shape)
-        for dK, dM in parts:
-            union = union + abs(dK) + abs(dM)
-        union.sum_duplicates()
+        self.union = UnionPattern([A for pair in parts for A in pair], keep=base)
         self.of = base.indices  # held: the plan is found again by the identity of the base's index
-        self.indptr, self.indices, self.shape = union.indptr, union.indices, union.shape
-        where = _keys(union)
-        self.base = np.searchsorted(where, _keys(base))
-        self.at = [(np.searchsorted(where, _keys(dK)), np.searchsorted(where, _keys(dM))) for dK, dM in parts]
+        self.base = self.union.positions(base)
+        self.at = [(self.union.positions(dK), self.union.positions(dM)) for dK, dM in parts]
 
     def combine(self, K, M, parts, values) -> tuple[sp.csr_matrix, sp.csr_matrix]:
         """K + sum v_k dK_k and M + sum v_k dM_k on the union pattern (shared index arrays)."""
-        data = np.zeros((2, self.indices.size))
+        data = np.zeros((2, self.union.nnz))
         data[0, self.base] = K.data
         data[1, self.base] = M.data
         for (pk, pm), (dK, dM), v in zip(self.at, parts, values):  # positions are unique within each
             data[0, pk] += v * dK.data
             data[1, pm] += v * dM.data
-        return (sp.csr_matrix((data[0], self.indices, self.indptr), shape=self.shape, copy=False),
-                sp.csr_matrix((data[1], self.indices, self.indptr), shape=self.shape, copy=False))
+        return self.union.matrix(data[0]), self.union.matrix(data[1])
 
 
 class Effects:

@@ -94,6 +94,38 @@ def canonical_csr(A) -> sp.csr_matrix:
     return A
 
 
+def entry_keys(A) -> np.ndarray:
+    """row x n_columns + column of every stored entry of CSR ``A``: sorted when A is canonical."""
+    return np.repeat(np.arange(A.shape[0], dtype=np.int64), np.diff(A.indptr)) * A.shape[1] + A.indices
+
+
+class UnionPattern:
+    """The union of the nonzero patterns of CSR ``matrices`` and of every stored entry of ``keep``
+    (its explicit zeros too), and where a matrix's entries sit in it: found once per matrix
+    (:meth:`positions`), after which its values are placed by one scatter."""
+
+    def __init__(self, matrices, keep=None):
+        union = None if keep is None else sp.csr_matrix((np.ones(keep.nnz), keep.indices, keep.indptr), shape=keep.shape)
+        for A in matrices:
+            union = abs(A) if union is None else union + abs(A)
+        union = canonical_csr(union)
+        self.indptr, self.indices, self.shape = union.indptr, union.indices, union.shape
+        self._keys = entry_keys(union)
+
+    @property
+    def nnz(self) -> int:
+        return self.indices.size
+
+    def positions(self, A) -> np.ndarray:
+        """Where each stored entry of canonical CSR ``A`` sits in the union (an entry the union lacks,
+        an explicit zero of A, gets a meaningless position: place only nonzero values)."""
+        return np.searchsorted(self._keys, entry_keys(A))
+
+    def matrix(self, data: np.ndarray) -> sp.csr_matrix:
+        """The CSR matrix with values ``data`` on the union (index arrays shared, not copied)."""
+        return sp.csr_matrix((data, self.indices, self.indptr), shape=self.shape, copy=False)
+
+
 def common_pattern(K, M) -> tuple[sp.csr_matrix, sp.csr_matrix]:
     """K and M as canonical CSR on one pattern, index arrays shared. Assembled and reduced pairs
     already share theirs; otherwise the union of their nonzeros is taken (an entry zero in both
@@ -103,18 +135,12 @@ def common_pattern(K, M) -> tuple[sp.csr_matrix, sp.csr_matrix]:
         return K, M
     if _same(K.indptr, M.indptr) and _same(K.indices, M.indices):
         return K, sp.csr_matrix((M.data, K.indices, K.indptr), shape=M.shape, copy=False)
-    union = canonical_csr(abs(K) + abs(M))
-    n = K.shape[0]
-
-    def keys(A):
-        return np.repeat(np.arange(n, dtype=np.int64), np.diff(A.indptr)) * n + A.indices
-
-    where = keys(union)
+    union = UnionPattern([K, M])
 
     def place(A):
         data = np.zeros(union.nnz)
         nz = A.data != 0
-        data[np.searchsorted(where, keys(A)[nz])] = A.data[nz]
-        return sp.csr_matrix((data, union.indices, union.indptr), shape=A.shape, copy=False)
+        data[union.positions(A)[nz]] = A.data[nz]
+        return union.matrix(data)
 
     return place(K), place(M)
