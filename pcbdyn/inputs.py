@@ -160,9 +160,10 @@ class Reader:
                 self.fail(f"{where}[{i}].{key}", f"'{n}' is used twice; give each a different {key}")
             seen.add(n)
 
-    def q(self, value, unit, where, positive=False, nonneg=False):
+    def q(self, value, unit, where, positive=False, nonneg=False, limits=True):
         """``value`` in SI (:func:`pcbdyn.units.to_si`, expected ``unit``), within the :data:`RANGES` of
-        that unit: its magnitude at most the upper limit and, when ``positive``, at least the lower."""
+        that unit: its magnitude at most the upper limit and, when ``positive``, at least the lower
+        (``limits=False``: any finite value, for those pcbdyn wrote itself, such as a run's std)."""
         try:
             v = to_si(value, unit, f"{self.file}: {where}")
         except UnitError as exc:
@@ -171,7 +172,7 @@ class Reader:
             self.fail(where, f"must be positive, got {shown(value)}")
         if nonneg and v < 0:
             self.fail(where, f"must not be negative, got {shown(value)}")
-        lo, hi = RANGES.get(unit, (0.0, math.inf))
+        lo, hi = RANGES.get(unit, (0.0, math.inf)) if limits else (0.0, math.inf)
         if abs(v) > hi or (positive and v < lo):
             self.fail(where, f"{shown(value)} is out of range; give {'a value' if positive else 'a magnitude'} "
                              f"{f'from {from_si(lo, unit):.3g} ' if positive else ''}up to {from_si(hi, unit):.3g} {unit}")
@@ -190,19 +191,49 @@ class Reader:
         if "analysis" not in data:
             return Analysis()
         a = self.table(data["analysis"], "analysis", ["modes", "f_max"])
-        modes = a.get("modes", 12)
-        if isinstance(modes, bool) or not isinstance(modes, int) or modes < 1:
-            self.fail("analysis.modes", f"must be a positive whole number, got {shown(modes)}")
+        modes = self.whole(a.get("modes", 12), "analysis.modes")
         if modes > MAX_MODES:
             self.fail("analysis.modes", f"{modes} modes are more than the {MAX_MODES} pcbdyn solves for; ask for fewer "
                                         "(a modal test rarely measures more than 30) or bound them with f_max")
         return Analysis(modes, self.q(a["f_max"], "Hz", "analysis.f_max", positive=True) if "f_max" in a else None)
 
-    def number(self, value, where, lo=None, hi=None):
+    def number(self, value, where, lo=None, hi=None, note: str = ""):
+        """A finite number (not a boolean) strictly between ``lo`` and ``hi`` (None: no limit on that side);
+        ``note`` says in the message what the number means."""
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             self.fail(where, f"must be a number, got {shown(value)}")
         if not math.isfinite(value):
             self.fail(where, f"must be a finite number, got {value}")
         if (lo is not None and value <= lo) or (hi is not None and value >= hi):
-            self.fail(where, f"must lie between {lo} and {hi} (exclusive), got {value}")
+            bound = (f"must lie between {lo} and {hi} (exclusive)" if lo is not None and hi is not None
+                     else f"must be > {lo:g}" if lo is not None else f"must be < {hi:g}")
+            self.fail(where, f"{bound}{_note(note)}, got {value}")
         return float(value)
+
+    def number_in(self, value, where, lo: float, hi: float, note: str = "") -> float:
+        """A number (not a boolean) from ``lo`` to ``hi``, both included (a fraction, a share)."""
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not lo <= value <= hi:
+            self.fail(where, f"must be a number from {lo:g} to {hi:g}{_note(note)}, got {shown(value)}")
+        return float(value)
+
+    def whole(self, value, where, lo: int = 1, hi: int | None = None, note: str = "") -> int:
+        """A TOML integer (not a boolean, not 3.0) from ``lo`` to ``hi`` (None: no upper limit), both included."""
+        if isinstance(value, bool) or not isinstance(value, int) or value < lo or (hi is not None and value > hi):
+            span = f"from {lo} to {hi}" if hi is not None else f"of at least {lo}"
+            self.fail(where, f"must be a whole number {span}{_note(note)}, got {shown(value)}")
+        return value
+
+    def choice(self, value, where, options, what: str, explain: dict | None = None) -> str:
+        """``value`` once it is one of the texts ``options``; the message names it as an unknown ``what``,
+        the closest option and every option (with ``explain[option]``, what it means, where given)."""
+        if not isinstance(value, str) or value not in options:
+            close = difflib.get_close_matches(str(value)[:MAX_NAME], list(options), n=1)
+            hint = f" (did you mean '{close[0]}'?)" if close else ""
+            listing = ", ".join(f"{o}{_note((explain or {}).get(o, ''))}" for o in options)
+            self.fail(where, f"unknown {what} {shown(value)}{hint}; use one of {listing}")
+        return value
+
+
+def _note(text: str) -> str:
+    """`` (text)`` to follow a value or bound in a message; empty without text."""
+    return f" ({text})" if text else ""

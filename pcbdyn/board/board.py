@@ -13,7 +13,6 @@ from .. import targets
 from ..atomic import write_checked
 from ..domain import Configured
 from ..inputs import MAX_NAME, Reader, read_toml
-from ..units import shown
 from .entries import Analysis, BoardError, Component, Configuration, Outline
 from .laminate import Material
 from .enrich import enriched_text
@@ -171,10 +170,8 @@ def parse_board(data: dict, path: Path) -> Board:
         r.fail("board.thickness", f"{plate.t * 1e3:g} mm is as thick as the board is wide ({float(np.min(hi - lo)) * 1e3:g}"
                                   " mm); a board is a plate: check the units")
     mesh_size = r.q(b.get("mesh_size", "5 mm"), "mm", "board.mesh_size", positive=True)
-    smear = b.get("smear", "none")
-    if smear not in ("none", "global"):
-        r.fail("board.smear", f"{shown(smear)} is not 'none' or 'global' (global: spread every part's mass over the "
-                              "board)")
+    smear = r.choice(b.get("smear", "none"), "board.smear", ("none", "global"), "smearing",
+                     {"global": "spread every part's mass over the board"})
     shear = r.number(b.get("transverse_shear", 1.0), "board.transverse_shear", lo=0.0)
     board = Board(
         name=r.text(b["name"], "board.name", MAX_NAME) if "name" in b else Path(path).parent.name, path=Path(path), outline=outline, plate=plate,

@@ -84,11 +84,9 @@ def read_plate(r, b):
                 else:
                     r.fail(f"{where}.{key}", f"unknown material {shown(name)}; use one of {', '.join(MATERIALS)} "
                                              "or a table { E = ..., nu = ..., rho = ... }")
-            fill = L.get("fill", 1.0)
-            if isinstance(fill, bool) or not isinstance(fill, (int, float)) or not 0 <= fill <= 1:
-                r.fail(f"{where}.fill", f"must be a number from 0 to 1, got {shown(fill)}")
+            fill = r.number_in(L.get("fill", 1.0), f"{where}.fill", 0, 1, "the area fraction of material, the rest filler")
             layers.append(Layer(r.q(L["thickness"], "mm", f"{where}.thickness", positive=True), mats["material"],
-                                float(fill), mats["filler"]))
+                                fill, mats["filler"]))
         if not layers:
             r.fail("board.stackup", "is empty; list the layers bottom to top")
         return LaminateProperty(tuple(layers)), None

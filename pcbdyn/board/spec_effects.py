@@ -87,7 +87,5 @@ def read_region(r, e, where, board) -> Region:
         r.fail(f"{where}.polygon", why)
     if not all(on_board(board.outline, a, b) for a, b in zip(poly, np.roll(poly, -1, axis=0))):
         r.fail(f"{where}", "the region reaches off the board (or over a hole); keep it inside the outline")
-    factor = r.number(e["stiffness_factor"], f"{where}.stiffness_factor")
-    if not factor > 0:
-        r.fail(f"{where}.stiffness_factor", f"must be > 0 (1 leaves the stiffness unchanged), got {factor:g}")
+    factor = r.number(e["stiffness_factor"], f"{where}.stiffness_factor", lo=0, note="1 leaves the stiffness unchanged")
     return Region(name, poly, factor)

@@ -3,11 +3,8 @@ wedge-lock guides, standoffs, point and edge springs) and ``[[masses]]``."""
 
 from __future__ import annotations
 
-import difflib
-
 import numpy as np
 
-from ..inputs import MAX_NAME
 from ..units import shown
 from .entries import FIXTURE_TYPES, Fixture, PointMass
 from .geometry import circle, on_line
@@ -43,11 +40,7 @@ def _point_on_board(r, board, f, where, what: str):
 def read_fixture(r, f, where, board, i) -> Fixture:
     r.table(f, where, ["name", "type", "edge", "width", "k_rot", "at", "k", "diameter", "from", "to"],
             required=["type"])
-    typ = f["type"]
-    if not isinstance(typ, str) or typ not in FIXTURE_TYPES:
-        close = difflib.get_close_matches(str(typ)[:MAX_NAME], FIXTURE_TYPES, n=1)
-        hint = f" (did you mean '{close[0]}'?)" if close else ""
-        r.fail(f"{where}.type", f"unknown fixture type {shown(typ)}{hint}; use one of {', '.join(FIXTURE_TYPES)}")
+    typ = r.choice(f["type"], f"{where}.type", FIXTURE_TYPES, "fixture type")
     name = r.name("fixtures", f, i, where)
     if board.fixture(name) is not None:
         r.fail(f"{where}.name", f"'{name}' is used by another fixture; names must be unique")

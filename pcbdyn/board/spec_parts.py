@@ -6,7 +6,6 @@ from __future__ import annotations
 import difflib
 
 from ..inputs import MAX_NAME
-from ..units import shown
 from ..components.library import MODELS, LibraryError, Package, available, find_package
 from .entries import Component
 from .geometry import polys_overlap
@@ -45,11 +44,7 @@ def read_component(r, c, where, board) -> Component:
     mass = r.q(c["mass"], "g", f"{where}.mass", positive=True) if "mass" in c else (pkg.mass if pkg else 0.0)
     height = r.q(c["height"], "mm", f"{where}.height", positive=True) if "height" in c else (
         pkg.height if pkg else 0.0)
-    model = c.get("model", pkg.default_model if pkg else "lumped")
-    if not isinstance(model, str) or model not in MODELS:
-        close = difflib.get_close_matches(str(model), MODELS, n=1)
-        hint = f" (did you mean '{close[0]}'?)" if close else ""
-        r.fail(f"{where}.model", f"unknown part model {shown(model)}{hint}; use one of {', '.join(MODELS)}")
+    model = r.choice(c.get("model", pkg.default_model if pkg else "lumped"), f"{where}.model", MODELS, "part model")
     thickness = None
     if model == "equivalent_thickness":
         if "thickness" in c:

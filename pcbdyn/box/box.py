@@ -13,7 +13,6 @@ import numpy as np
 from .. import targets
 from ..atomic import write_checked
 from ..inputs import MAX_ENTRIES, MAX_NAME, Reader, read_toml
-from ..units import shown
 from ..domain import Analysis, Configured
 from .entries import MAX_PLATES, RIB_MODELS, BoxError
 from .enrich import enriched_text
@@ -147,9 +146,8 @@ def parse_box(data: dict, path: Path) -> Box:
     r.table(data, "top level", ["box", "materials", "plates", "ribs", "supports", "joints", "masses",
                                 "configurations", "parameters", "analysis"], required=["box", "plates"])
     b = r.table(data["box"], "box", ["name", "mesh_size", "rib_model"])
-    rib_model = b.get("rib_model", "beam")
-    if not isinstance(rib_model, str) or rib_model not in RIB_MODELS:
-        r.fail("box.rib_model", f"{shown(rib_model)} is not \"beam\" (eccentric beams) or \"shell\" (shell strips)")
+    rib_model = r.choice(b.get("rib_model", "beam"), "box.rib_model", RIB_MODELS, "rib model",
+                         {"beam": "eccentric beams", "shell": "shell strips"})
     materials = read_materials(r, data)
     plates = _named(r, data, "plates", read_plate, materials, limit=MAX_PLATES)
     if not plates:

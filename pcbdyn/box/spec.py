@@ -94,10 +94,8 @@ def read_rib(r, e, where, name, plates, materials) -> Rib:
     b = _on_plate(r, plate, r.point(e["to"], f"{where}.to"), f"{where}.to")
     if np.linalg.norm(plate.point(*a) - plate.point(*b)) < 1e-4:
         r.fail(f"{where}.to", "is where the rib starts; a rib needs a length")
-    side = e.get("side", "+n")
-    if not isinstance(side, str) or side not in RIB_SIDES:
-        r.fail(f"{where}.side", f"{shown(side)} is not \"+n\" or \"-n\" (the side of the plate the rib stands on, "
-                                "n = u x v)")
+    side = r.choice(e.get("side", "+n"), f"{where}.side", RIB_SIDES, "rib side",
+                    {"+n": "the rib stands on the side n = u x v points to", "-n": "on the other side"})
     mat = material_of(r, e["material"], f"{where}.material", materials) if "material" in e else plate.declared
     if mat.orthotropic:
         r.fail(f"{where}.material", f"a rib needs an isotropic material (one E), and plate '{plate.name}' has an "
@@ -109,13 +107,9 @@ def read_rib(r, e, where, name, plates, materials) -> Rib:
 def read_support(r, e, where, plates) -> Support:
     r.table(e, where, ["plate", "edge", "type"], required=["plate", "edge"])
     plate = _plate(r, plates, e["plate"], f"{where}.plate")
-    if not isinstance(e["edge"], str) or e["edge"] not in EDGES:
-        r.fail(f"{where}.edge", f"{shown(e['edge'])} is not an edge of a plate; use u0 (s = 0), u1 (s = 1), v0 (t = 0) or "
-                                "v1 (t = 1)")
-    typ = e.get("type", "clamped")
-    if not isinstance(typ, str) or typ not in SUPPORT_TYPES:
-        r.fail(f"{where}.type", f"{shown(typ)} is not one of {', '.join(SUPPORT_TYPES)}")
-    return Support(plate.name, str(e["edge"]), typ)
+    edge = r.choice(e["edge"], f"{where}.edge", EDGES, "plate edge", {k: f"{a} = {v:g}" for k, (a, v) in EDGES.items()})
+    typ = r.choice(e.get("type", "clamped"), f"{where}.type", SUPPORT_TYPES, "support type")
+    return Support(plate.name, edge, typ)
 
 
 def read_mass(r, e, where, name, plates) -> BoxMass:

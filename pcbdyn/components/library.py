@@ -101,9 +101,7 @@ def read_package(path: Path) -> Package:
     size = p["size"]
     if not (isinstance(size, list) and len(size) == 2):
         r.fail("package.size", f"must be two lengths, e.g. [\"40 mm\", \"40 mm\"], got {shown(size)}")
-    model = p["default_model"]
-    if not isinstance(model, str) or model not in MODELS:
-        r.fail("package.default_model", f"{shown(model)} is not one of {', '.join(MODELS)}")
+    model = r.choice(p["default_model"], "package.default_model", MODELS, "part model")
     return Package(
         name=r.text(p["name"], "package.name", MAX_NAME) if "name" in p else path.stem,
         size=tuple(r.q(s, "mm", f"package.size[{i}]", positive=True) for i, s in enumerate(size)),

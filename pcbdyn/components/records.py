@@ -27,7 +27,7 @@ import numpy as np
 import tomlkit
 
 from ..inputs import MAX_TEXT, Reader
-from ..units import UnitError, from_si, shown, to_si
+from ..units import from_si, shown
 from .library import LibraryError
 
 #: a run this many standard deviations from the pooled other runs is flagged (not averaged in)
@@ -82,51 +82,37 @@ EXTRA_KEYS = ("solver", "noise", "parts", "iterations", "converged")
 
 def read_records(path, data: dict) -> list:
     """The ``[[calibrations]]`` of a parsed library file ``data`` (read from ``path``) as Records; a
-    LibraryError names the record, the field and the fix."""
-    raw = data.get("calibrations", [])
-    if not isinstance(raw, list):
-        raise LibraryError(f"{path}: calibrations must be an array of tables ([[calibrations]] blocks)")
-    return [_record(path, i, r) for i, r in enumerate(raw)]
+    LibraryError names the file, the record, the field and the fix."""
+    r = Reader(path, LibraryError)
+    return [_record(r, i, rec) for i, rec in enumerate(r.list(data, "calibrations", limit=math.inf))]
 
 
-def _record(path, i, r) -> Record:
-    where = f"{path}: calibrations[{i}]"
-    if not isinstance(r, dict):
-        raise LibraryError(f"{where}: must be a table ([[calibrations]])")
-    unknown = [k for k in r if k not in KEYS + EXTRA_KEYS]
-    if unknown:
-        raise LibraryError(f"{where}: unknown field(s) {unknown}; a record has {', '.join(KEYS + EXTRA_KEYS)}")
+def _record(r: Reader, i: int, rec) -> Record:
+    where = f"calibrations[{i}]"
+    r.table(rec, where, KEYS + EXTRA_KEYS)
     for key in ("run", "date", "method", "value", "std", "before", "flagged"):
-        if key not in r:
-            raise LibraryError(f"{where}.{key}: missing; every record written by pcbdyn calibrate has it "
-                               "(restore it, or delete the whole record)")
-    if not isinstance(r["date"], datetime):
-        raise LibraryError(f"{where}.date: must be a TOML date-time such as 2026-11-25T10:00:00Z, got {r['date']!r}")
-    if not isinstance(r["flagged"], bool):
-        raise LibraryError(f"{where}.flagged: must be true or false, got {r['flagged']!r}")
-    try:
-        value, std, before = (to_si(r[k], "mm", f"{where}.{k}") for k in ("value", "std", "before"))
-        mesh = to_si(r.get("std_mesh", "0 mm"), "mm", f"{where}.std_mesh")
-    except UnitError as exc:
-        raise LibraryError(str(exc)) from None
+        if key not in rec:
+            r.fail(f"{where}.{key}", "missing; every record written by pcbdyn calibrate has it (restore it, or delete "
+                                     "the whole record)")
+    if not isinstance(rec["date"], datetime):
+        r.fail(f"{where}.date", f"must be a TOML date-time such as 2026-11-25T10:00:00Z, got {rec['date']!r}")
+    if not isinstance(rec["flagged"], bool):
+        r.fail(f"{where}.flagged", f"must be true or false, got {rec['flagged']!r}")
+    value, std, before = (r.q(rec[k], "mm", f"{where}.{k}", limits=False) for k in ("value", "std", "before"))
+    mesh = r.q(rec.get("std_mesh", "0 mm"), "mm", f"{where}.std_mesh", limits=False)
     if not (value > 0 and before > 0):
-        raise LibraryError(f"{where}: value and before must be positive lengths, got {r['value']!r}, {r['before']!r}")
+        r.fail(where, f"value and before must be positive lengths, got {rec['value']!r}, {rec['before']!r}")
     if not std > 0:
-        raise LibraryError(f"{where}.std: must be a positive length (a run always has a standard deviation), "
-                           f"got {r['std']!r}")
+        r.fail(f"{where}.std", f"must be a positive length (a run always has a standard deviation), got {rec['std']!r}")
     if not 0 <= mesh <= std:
-        raise LibraryError(f"{where}.std_mesh: the mesh's part of std must lie between 0 and std ({r['std']!r}), "
-                           f"got {r.get('std_mesh')!r}")
-    errors = [r.get(k, math.nan) for k in ("max_freq_error_before_pct", "max_freq_error_after_pct")]
-    if any(isinstance(e, bool) or not isinstance(e, (int, float)) or (k in r and not math.isfinite(e))
-           for k, e in zip(("max_freq_error_before_pct", "max_freq_error_after_pct"), errors)):
-        raise LibraryError(f"{where}: max_freq_error_before_pct/after_pct must be finite numbers (percent), got "
-                           f"{[shown(e) for e in errors]}")
-    text = Reader(path, LibraryError)
-    run, method, reason = (text.text(r.get(k, ""), f"calibrations[{i}].{k}", MAX_TEXT) for k in ("run", "method", "reason"))
-    files = {key: _files(text, r.get(key, []), f"calibrations[{i}].{key}") for key in ("boards", "tests")}
-    return Record(run, r["date"], method, value, std, before, files["boards"], files["tests"], float(errors[0]),
-                  float(errors[1]), r["flagged"], reason, {k: r[k] for k in EXTRA_KEYS if k in r}, mesh)
+        r.fail(f"{where}.std_mesh", f"the mesh's part of std must lie between 0 and std ({rec['std']!r}), got "
+                                    f"{rec.get('std_mesh')!r}")
+    errors = [r.number(rec[k], f"{where}.{k}", note="percent") if k in rec else math.nan
+              for k in ("max_freq_error_before_pct", "max_freq_error_after_pct")]
+    run, method, reason = (r.text(rec.get(k, ""), f"{where}.{k}", MAX_TEXT) for k in ("run", "method", "reason"))
+    files = {key: _files(r, rec.get(key, []), f"{where}.{key}") for key in ("boards", "tests")}
+    return Record(run, rec["date"], method, value, std, before, files["boards"], files["tests"], errors[0], errors[1],
+                  rec["flagged"], reason, {k: rec[k] for k in EXTRA_KEYS if k in rec}, mesh)
 
 
 def _files(r, items, where) -> tuple:

@@ -73,8 +73,8 @@ def read_map(path) -> PackageMap:
         for key, unit, positive in (("mass", "g", True), ("height", "mm", False), ("thickness", "mm", True)):
             if key in table:
                 r.q(table[key], unit, f"{where}.{key}", positive=positive, nonneg=True)
-        if "model" in table and (not isinstance(table["model"], str) or table["model"] not in MODELS):
-            r.fail(f"{where}.model", f"must be one of {', '.join(MODELS)}")
+        if "model" in table:
+            r.choice(table["model"], f"{where}.model", MODELS, "part model")
         entries.append((pattern, dict(table)))
     materials = r.table(data.get("materials", {}), "materials")
     for name, m in materials.items():

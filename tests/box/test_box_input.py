@@ -45,7 +45,7 @@ def test_a_rib_off_its_plate(tmp_path):
 
 
 @pytest.mark.parametrize("field, value, expected", [
-    ("edge", '"w0"', "supports[0].edge: 'w0' is not an edge of a plate; use u0 (s = 0)"),
+    ("edge", '"w0"', "supports[0].edge: unknown plate edge 'w0'; use one of u0 (s = 0), u1 (s = 1)"),
     ("plate", '"front"', "supports[0].plate: no plate is called 'front' (plates: left, right, back, upper)"),
 ])
 def test_a_support_on_an_edge_that_is_not_there(tmp_path, field, value, expected):
