@@ -152,6 +152,20 @@ def temporary_folder(prefix: str = "pcbdyn"):
         shutil.rmtree(folder, ignore_errors=True)
 
 
+def unwritable(path, folder: bool) -> str | None:
+    """Why ``path`` cannot be written as a file (``folder`` False) or a folder (None when it can): it is
+    one of the other kind, or an ancestor is a file."""
+    path = Path(path)
+    if folder and path.exists() and not path.is_dir():
+        return "is a file; give a folder (or a new name)"
+    if not folder and path.is_dir():
+        return "is a folder; give a file name"
+    for parent in path.resolve().parents:
+        if parent.exists():
+            return None if parent.is_dir() else f"{parent.name} is a file, not a folder; choose another place"
+    return None
+
+
 def write_checked(path, text: str, load, error=ValueError) -> Path:
     """Write ``text`` to ``path`` atomically after ``load(temporary file)`` accepted it (the file is read
     beside its destination, so relative paths in it resolve as they will); otherwise ``error`` says

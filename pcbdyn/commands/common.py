@@ -157,18 +157,12 @@ OPTION_NAMES = {"json_path": "--json", "out": "--out", "bdf": "--nastran", "char
 
 
 def check_writable(path: Path, option: str, folder: bool, shown=None) -> None:
-    """A UsageError when ``path`` cannot be written as a file (``folder`` False) or a folder: it is one
-    of the other kind, or an ancestor is a file. ``shown``: how the message names the path."""
-    shown = path if shown is None else shown
-    if folder and path.exists() and not path.is_dir():
-        raise click.UsageError(f"{option} {shown}: is a file; give a folder (or a new name)")
-    if not folder and path.is_dir():
-        raise click.UsageError(f"{option} {shown}: is a folder; give a file name")
-    for parent in path.resolve().parents:
-        if parent.exists():
-            if not parent.is_dir():
-                raise click.UsageError(f"{option} {shown}: {parent.name} is a file, not a folder; choose another place")
-            break
+    """A UsageError when ``path`` cannot be written as a file (``folder`` False) or a folder
+    (:func:`pcbdyn.atomic.unwritable`). ``shown``: how the message names the path."""
+    from ..atomic import unwritable
+
+    if (why := unwritable(path, folder)) is not None:
+        raise click.UsageError(f"{option} {path if shown is None else shown}: {why}")
 
 
 def checked_outputs(folders=("out",), files=("json_path",)):

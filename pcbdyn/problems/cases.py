@@ -5,17 +5,17 @@ the thesis' simulated free PCB and on any structure's file."""
 from __future__ import annotations
 
 from dataclasses import replace
+from typing import ClassVar
 
 import numpy as np
 
-from ..domain import StructureError
+from ..domain import MAX_MODES, StructureError
 from ..fe.assembly import element_matrices, scatter
 from ..fe.generate import rectangle
 from ..fe.model import Model
 from ..fe.properties import ShellProperty
 from ..fe.reduction import guyan
 from ..testdata import read_points_csv
-from ..units import to_si
 from ..updating import matching
 from ..updating.equations import fbm_equations, frequency_equations, frf_receptance_equations, qms_equations
 from ..updating.iteration import mac_matrix
@@ -24,7 +24,6 @@ from ..updating.sensitivity import frequencies_hz, solve_modes
 from ..updating.study import StudyCase, unit_weighted
 from ..updating.success import add_noise
 from ..updating.weighting import unit_row_weights
-from .load import load_structure
 from .problem import UpdateProblem
 
 class CaseError(StructureError):
@@ -64,6 +63,12 @@ class SimulatedFreePCB(StudyCase):
     """
 
     kinds = ("qms", "fbm", "frf", "frf+pbc")
+    #: the options a study file may set (:func:`.study_spec.read_spec` checks them): (kind, lower, upper)
+    #: of a number, "names" (a list of names) or "elements" (element number -> thickness [mm]); the node
+    #: options are thesis node numbers (n = 8 ix + iy + 1, Fig. 5.41)
+    options: ClassVar[dict] = {
+        "nu": (float, -0.99, 0.499), "n_modes": (int, 1, 50), "errors_mm": "elements", "excitation_node": (int, 1, 56),
+        "perturbation_node": (int, 1, 56), "perturbation_kg": (float, 1e-6, 1e3)}
 
     def __init__(self, nu: float = 0.35, n_modes: int = 7, errors_mm: dict | None = None,
                  excitation_node: int = 43, perturbation_node: int = 56, perturbation_kg: float = 0.01,
@@ -123,9 +128,6 @@ class SimulatedFreePCB(StudyCase):
             for de, out in ((dKe, self.dKs), (dMe, self.dMs)):
                 d = scatter(n_dof, self.conn[e:e + 1], de[e:e + 1])[bend][:, bend]
                 out.append(np.asarray(T.T @ (d @ T)))
-        for key, node in (("excitation_node", excitation_node), ("perturbation_node", perturbation_node)):
-            if not 1 <= int(node) <= nn:
-                raise CaseError(f"{key} = {node}: thesis node numbers run 1..{nn} (n = 8 ix + iy + 1, Fig. 5.41)")
         self.excitation = int(self.node_of[excitation_node - 1])
         dm = np.zeros(nn)
         dm[self.node_of[perturbation_node - 1]] = perturbation_kg
@@ -154,9 +156,7 @@ class SimulatedFreePCB(StudyCase):
         if kind in ("qms", "fbm"):
             c = self.configs[0]
             return add_noise(c["omega_x"], level_pct, rng), add_noise(c["phi_x"], level_pct, rng)
-        if kind in ("frf", "frf+pbc"):
-            return tuple(add_noise(c["H_x"], level_pct, rng) for c in self.configs[: 1 if kind == "frf" else 2])
-        raise CaseError(f"equation type {kind!r}: choose one of {', '.join(self.kinds)}")
+        return tuple(add_noise(c["H_x"], level_pct, rng) for c in self.configs[: 1 if kind == "frf" else 2])
 
     def build(self, kind: str, data: tuple):
         """Weighted (A, b) of equation type ``kind`` from test data (:meth:`measure`)."""
@@ -169,10 +169,10 @@ class SimulatedFreePCB(StudyCase):
 
 
 class StructureCase(StudyCase):
-    """A success-ratio case from any structure's file (board.toml, box.toml): its ``[[parameters]]`` (or
-    ``params``) at their values are the model, ``truth`` ({name: value, SI or a string with units}) the
-    simulated structure, measured at the points of ``points_csv`` (first ``n_modes`` elastic
-    modes, paired in order; checked by MAC).
+    """A success-ratio case from any structure (a loaded board.toml, box.toml): its ``[[parameters]]`` (or
+    ``params``) at their values are the model, ``truth`` ({parameter name: SI value}, as
+    :func:`.study_spec.read_spec` checks it) the simulated structure, measured at the points of
+    ``points_csv`` (first ``n_modes`` elastic modes, paired in order; checked by MAC).
 
     Like the thesis' reduced models, the model and its derivatives are condensed once onto the
     measured DOFs (:func:`~.matching.reduce_system`), so each noisy shot only rebuilds small
@@ -181,19 +181,16 @@ class StructureCase(StudyCase):
     """
 
     kinds = ("qms", "fbm", "freq")
+    #: the options a study file may set (see :attr:`SimulatedFreePCB.options`)
+    options: ClassVar[dict] = {"n_modes": (int, 1, MAX_MODES), "params": "names"}
 
-    def __init__(self, path, truth: dict, points_csv, n_modes: int = 6, params=None):
-        problem = UpdateProblem(load_structure(path), params)
+    def __init__(self, structure, truth: dict, points_csv, n_modes: int = 6, params=None):
+        problem = UpdateProblem(structure, params)
         self.parameter_names = list(problem.names)
         self.p_a = problem.p0.copy()
         self.p_x = self.p_a.copy()
-        if not truth:
-            raise CaseError("truth: give the true value of at least one parameter, e.g. t_U1 = \"4 mm\"")
         for name, value in truth.items():
-            if name not in self.parameter_names:
-                raise CaseError(f"truth: {name!r} is not a parameter (known: {', '.join(self.parameter_names)})")
-            i = self.parameter_names.index(name)
-            self.p_x[i] = to_si(value, problem.units[i], f"truth.{name}") if isinstance(value, str) else float(value)
+            self.p_x[self.parameter_names.index(name)] = float(value)
         self.true_errors = np.flatnonzero(np.abs(self.p_x / self.p_a - 1) > 1e-12)
         if self.true_errors.size == 0:
             raise CaseError("truth: every value equals the board's: nothing to localise")
@@ -219,8 +216,6 @@ class StructureCase(StudyCase):
     def measure(self, kind: str, level_pct: float, rng) -> tuple:
         """(omega,) or (omega, shapes) of the simulated test with ``level_pct`` % uniform noise
         (eqs. 5.72-5.73) drawn from ``rng``."""
-        if kind not in self.kinds:
-            raise CaseError(f"equation type {kind!r}: choose one of {', '.join(self.kinds)}")
         om = add_noise(self.omega_x, level_pct, rng)
         return (om,) if kind == "freq" else (om, add_noise(self.phi_x, level_pct, rng))
 

@@ -235,9 +235,9 @@ def kinds(folder: Path) -> list:
     """Every input kind, its mutants written into ``folder``."""
     from pcbdyn.board import load_board
     from pcbdyn.box import load_box
-    from pcbdyn.commands.study import read_spec
     from pcbdyn.ecad.packages import read_map
     from pcbdyn.problems.joint import read_joint
+    from pcbdyn.problems.study_spec import read_spec
     from pcbdyn.targets import parse
     from pcbdyn.testdata import read_points_csv
     from pcbdyn.testdata.measured import read_frequency_table

@@ -13,8 +13,8 @@ CORPUS = Path(__file__).resolve().parent / "corpus"
 
 def _reader(kind):
     from pcbdyn.board import load_board
-    from pcbdyn.commands.study import read_spec
     from pcbdyn.ecad.packages import read_map
+    from pcbdyn.problems.study_spec import read_spec
     from pcbdyn.testdata import read_points_csv
     from pcbdyn.testdata.measured import read_frequency_table
 
