@@ -108,7 +108,7 @@ def _split(value: str, unit: str, where: str) -> tuple:
         raise UnitError(f"{where}: {value!r} has a decimal comma; write a decimal point "
                         f"(\"{value.strip().replace(',', '.', 1)}\")")
     if rest and not rest[0].isspace() and not (rest[0].isalpha() or rest[0] in "%µμ°"):
-        raise UnitError(f"{where}: cannot read {value!r} as a quantity ('{rest.strip()[:20]}' after the number); "
+        raise UnitError(f"{where}: cannot read {value!r} as a quantity ({rest.strip()[:20]!r} after the number); "
                         f"write one number and a unit, {example}")
     number = float(m.group(1))
     return number, rest
