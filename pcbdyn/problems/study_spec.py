@@ -33,14 +33,14 @@ def read_spec(path: Path) -> dict:
         r.fail("study.case", f"{shown(case)} is not a case; choose one of {sorted(CASES)}")
     levels = _numbers(r, s.get("levels_pct", [0, 0.5, 1, 2]), "study.levels_pct", 0.0, 100.0,
                       "a list of noise levels in %, from 0 to 100, e.g. [0, 0.5, 1, 2]")
-    shots = _whole(r, s.get("shots", 20), "study.shots", 1, 100_000, "the thesis uses 20")
+    shots = r.whole(s.get("shots", 20), "study.shots", 1, 100_000, "the thesis uses 20")
     methods = _choices(r, s.get("methods", ["tls-qrf", "svd-qr", "min-norm"]), "study.methods", list(METHODS))
     equations = _choices(r, s.get("equations", ["qms"]), "study.equations", list(CASES[case].kinds))
     rank = s.get("rank")
     if rank is not None:
-        _whole(r, rank, "study.rank", -10_000, 10_000, "k, or -k for n_params - k; omit it for automatic")
-    seed = _whole(r, s.get("seed", 0), "study.seed", 0, 2**63 - 1, "any whole number from 0")
-    workers = None if s.get("workers") is None else _whole(r, s["workers"], "study.workers", 1, 1024, "e.g. 2")
+        r.whole(rank, "study.rank", -10_000, 10_000, "k, or -k for n_params - k; omit it for automatic")
+    seed = r.whole(s.get("seed", 0), "study.seed", 0, 2**63 - 1, "any whole number from 0")
+    workers = None if s.get("workers") is None else r.whole(s["workers"], "study.workers", 1, 1024, "e.g. 2")
     scheduler = None if s.get("scheduler") is None else r.text(s["scheduler"], "study.scheduler", 200)
     opts = _case_options(r, doc, CASES[case].options)
     if CASES[case] is StructureCase:
@@ -86,12 +86,9 @@ def _case_options(r, doc: dict, options: dict) -> dict:
                 r.fail(where, "keys are element numbers, e.g. { \"11\" = 3.2, \"13\" = 3.2 }")
             opts[key] = {int(k): r.number(v, f"{where}.{k}", 0.0, 1000.0) for k, v in table.items()}
         elif kind[0] is int:
-            opts[key] = _whole(r, opts[key], where, kind[1], kind[2], "")
+            opts[key] = r.whole(opts[key], where, kind[1], kind[2])
         else:
-            value = r.number(opts[key], where)
-            if not kind[1] <= value <= kind[2]:
-                r.fail(where, f"must lie from {kind[1]:g} to {kind[2]:g}, got {value:g}")
-            opts[key] = value
+            opts[key] = r.number_in(opts[key], where, kind[1], kind[2])
     return opts
 
 
@@ -120,12 +117,6 @@ def _truth(r, doc: dict, structure, opts: dict) -> dict:
         unit = params[k].unit
         out[k] = r.number(v, f"truth.{k}") if unit == "1" and not isinstance(v, str) else r.q(v, unit, f"truth.{k}")
     return out
-
-
-def _whole(r, value, where, lo, hi, example) -> int:
-    if isinstance(value, bool) or not isinstance(value, int) or not lo <= value <= hi:
-        r.fail(where, f"must be a whole number from {lo} to {hi}, got {shown(value)}" + (f" ({example})" if example else ""))
-    return value
 
 
 def _numbers(r, value, where, lo, hi, example) -> list:
