@@ -184,10 +184,7 @@ class SetAssembly:
         self.names = [nm for nm in model.sets if len(model.sets[nm].conn) > 0]
         self.pattern = _Pattern(model.n_dof // NDOF, [model.sets[nm].conn for nm in self.names])
         self.index = self.pattern.csr_index()
-        self._sums = {}
-        for nm, slot in zip(self.names, self.pattern.slot):
-            pos, S = _summing(self.pattern, slot)
-            self._sums[nm] = (pos, S.tocsc())  # CSC: a chunk's columns are a cheap slice
+        self._sums = {nm: _summing(self.pattern, slot) for nm, slot in zip(self.names, self.pattern.slot)}
 
     @property
     def nnz(self) -> int:
@@ -201,11 +198,11 @@ class SetAssembly:
         summed chunk by chunk as :func:`assemble` does."""
         S = self._sums[name][1]
         npp = np.asarray(self.model.sets[name].conn).shape[1] ** 2
-        K, M = np.zeros((S.shape[0], _NN)), np.zeros((S.shape[0], _NN))
+        K = M = None
         for a, b, Ke, Me in _chunk_matrices(self.model, name, prop):
-            part = S if b * npp - a * npp == S.shape[1] else S[:, a * npp:b * npp]
-            K += part @ _node_blocks(Ke)
-            M += part @ _node_blocks(Me)
+            part = S if (b - a) * npp == S.shape[1] else S[:, a * npp:b * npp]
+            dK, dM = part @ _node_blocks(Ke), part @ _node_blocks(Me)
+            K, M = (dK, dM) if K is None else (K + dK, M + dM)
         return K.ravel(), M.ravel()
 
     def matrix(self, data: np.ndarray) -> sp.csr_matrix:
