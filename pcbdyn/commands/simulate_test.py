@@ -54,7 +54,8 @@ def command(board_toml, points_csv, config, excite, excite_dir, noise, seed, f_r
     """Simulate a modal test on a board model: modes and FRFs at measurement points, with noise."""
     from ..problems import load_structure
     from ..report.files import write_json
-    from ..testdata import Noise, Points, read_points_csv, write_uff
+    from ..testdata import Noise, Points, TestDataError, read_points_csv, write_uff
+    from ..testdata.data import check_damping
     from ..testdata.simulate import frequency_axis, simulate_on_model
 
     xyz = (number_pair(excite, "--excite", "mm", counts=(2, 3)) + (0.0,))[:3]
@@ -65,8 +66,10 @@ def command(board_toml, points_csv, config, excite, excite_dir, noise, seed, f_r
         noise_levels = Noise.parse(noise)
     except ValueError as exc:
         raise click.BadParameter(str(exc), param_hint="--noise") from None
-    if not 0 <= damping < 1:
-        raise click.BadParameter(f"{damping} is not a damping ratio in [0, 1)", param_hint="--damping")
+    try:
+        check_damping([damping], 1, "")
+    except TestDataError as exc:
+        raise click.BadParameter(str(exc), param_hint="--damping") from None
     with input_errors():
         board = load_structure(board_toml)
         points, dofs = read_points_csv(points_csv)

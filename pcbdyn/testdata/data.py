@@ -131,6 +131,68 @@ def _code_vector(code):
     return np.sign(code) * np.array(AXES[abs(code)])
 
 
+#: the largest shape value of a measured mode: beyond it no scaling of a shape explains it (a misread file)
+MAX_SHAPE = 1e30
+
+
+def _at(where: str) -> str:
+    return f"{where}: " if where else ""
+
+
+def _which(i: int, n: int, numbers) -> str:
+    """' (mode k)' naming the i-th of ``n`` modes by its number, or nothing for a lone unnumbered mode."""
+    if numbers is None:
+        return "" if n == 1 else f" (mode {i + 1})"
+    return f" (mode {int(numbers[i])})"
+
+
+def check_frequencies(frequencies, where: str = "modes", numbers=None) -> np.ndarray:
+    """Measured natural frequencies [Hz] as floats: each a finite number above 0 (0 Hz or below is a rigid-body
+    mode or a mistyped value). The one home of this rule: :class:`Modes` and the readers (which give ``where``:
+    the file, dataset or table row) call it. ``numbers``: the modes' numbers, to name the one refused."""
+    f = np.asarray(frequencies, dtype=float).ravel()
+    bad = np.flatnonzero(~(np.isfinite(f) & (f > 0)))
+    if bad.size:
+        i = int(bad[0])
+        raise TestDataError(f"{_at(where)}frequency {f[i]:g} Hz{_which(i, f.size, numbers)}: a measured mode's "
+                            "frequency is a finite number above 0")
+    return f
+
+
+def check_damping(damping, n: int, where: str = "modes", numbers=None) -> np.ndarray:
+    """Measured viscous damping ratios as floats, one per mode (None: n zeros), each from 0 to below 1. A
+    negative ratio is an artefact of a curve fit (an unstable pole), not a measured property: it is refused
+    rather than passed on to correlation. The one home of this rule (see :func:`check_frequencies`)."""
+    z = np.zeros(n) if damping is None else np.asarray(damping, dtype=float).ravel()
+    if z.size != n:
+        raise TestDataError(f"{_at(where)}{z.size} damping ratios for {n} modes; give one per mode")
+    bad = np.flatnonzero(~((z >= 0) & (z < 1)))
+    if bad.size:
+        i = int(bad[0])
+        fit = "; a negative one is an artefact of the curve fit: refit the mode, or give 0" if z[i] < 0 else ""
+        raise TestDataError(f"{_at(where)}the damping ratio {z[i]:g}{_which(i, n, numbers)} is not from 0 to below "
+                            f"1 (a measured mode's viscous damping ratio, e.g. 0.02{fit})")
+    return z
+
+
+def check_shapes(shapes, where: str = "modes", numbers=None) -> None:
+    """Measured shapes (n_dof, n_modes), real or complex: every value a finite number at most MAX_SHAPE in size,
+    and no shape zero at every DOF (it pairs with nothing). The one home of this rule (see
+    :func:`check_frequencies`)."""
+    a = np.abs(np.asarray(shapes))
+    if not np.isfinite(a).all():
+        raise TestDataError(f"{_at(where)}a shape holds a value that is not a finite number (NaN or infinity); "
+                            "give every measured DOF a number")
+    if a.size and a.max() > MAX_SHAPE:
+        raise TestDataError(f"{_at(where)}a shape value of {a.max():.3g} is beyond any scaling of a mode shape (at "
+                            f"most {MAX_SHAPE:g}); check the shape's values")
+    zero = np.flatnonzero(~np.any(a != 0, axis=0)) if a.ndim == 2 and a.shape[0] else []
+    if len(zero):
+        i = int(zero[0])
+        raise TestDataError(f"{_at(where)}the mode shape{_which(i, a.shape[1], numbers)} is zero at every DOF; "
+                            "remove the mode or give its shape")
+
+
 @dataclass
 class Modes:
     """Measured (real, normal) modes: frequencies [Hz], viscous damping ratios, shapes (n_dof, n_modes)
@@ -153,26 +215,20 @@ class Modes:
     def __post_init__(self):
         self.frequencies = np.asarray(self.frequencies, dtype=float).ravel()
         n = self.frequencies.size
-        if not np.all(np.isfinite(self.frequencies)) or np.any(self.frequencies <= 0):
-            raise TestDataError(f"modes: frequencies must be positive and finite, got {self.frequencies.tolist()}")
+        self.numbers = np.arange(1, n + 1) if self.numbers is None else np.asarray(self.numbers, int).ravel()
+        if self.numbers.size != n:
+            raise TestDataError(f"modes: {n} frequencies but {self.numbers.size} mode numbers")
+        check_frequencies(self.frequencies, "modes", self.numbers)
         if self.shapes is not None:
             if self.dofs is None or self.points is None:
                 raise TestDataError("modes: measured shapes need the points and DOFs they were measured at")
             self.shapes = np.asarray(self.shapes, dtype=float).reshape(len(self.dofs), -1)
             if self.shapes.shape[1] != n:
                 raise TestDataError(f"modes: {n} frequencies but {self.shapes.shape[1]} shape columns")
-            if not np.isfinite(self.shapes).all():
-                raise TestDataError("modes: a shape holds a value that is not a finite number (NaN or infinity); "
-                                    "give every measured DOF a number")
+            check_shapes(self.shapes, "modes", self.numbers)
             self.points.index(np.unique(self.dofs.point_ids))
-        self.damping = np.zeros(n) if self.damping is None else np.asarray(self.damping, float).ravel()
-        if self.damping.size != n or not (np.all(np.isfinite(self.damping)) and np.all(np.abs(self.damping) < 1)):
-            raise TestDataError(f"modes: damping ratios must be finite and below 1 in size, one per mode, got "
-                                f"{self.damping.tolist()[:20]}")
+        self.damping = check_damping(self.damping, n, "modes", self.numbers)
         self.mpc = np.ones(n) if self.mpc is None else np.asarray(self.mpc, float).ravel()
-        self.numbers = np.arange(1, n + 1) if self.numbers is None else np.asarray(self.numbers, int).ravel()
-        if self.numbers.size != n:
-            raise TestDataError(f"modes: {n} frequencies but {self.numbers.size} mode numbers")
 
     @classmethod
     def frequencies_only(cls, frequencies, numbers=None) -> "Modes":

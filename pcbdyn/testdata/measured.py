@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .data import Modes, TestDataError
+from .data import Modes, TestDataError, check_frequencies
 from .uff import read_uff
 
 #: configuration names of a frequency table that mean the base configuration
@@ -71,8 +71,6 @@ def read_frequency_table(path, structure) -> list:
                                 f"{MAX_MODES}")
         if np.unique(nc).size < nc.size:
             raise TestDataError(f"{path.name}: configuration {name}: a mode number is given twice; give each mode once")
-        if not np.all(fc > 0):
-            raise TestDataError(f"{path.name}: configuration {name}: frequency {fc[fc <= 0][0]:g} Hz; measured "
-                                "frequencies are above 0")
+        check_frequencies(fc, f"{path.name}: configuration {name}", nc)
         out.append((cfg, Modes.frequencies_only(fc, nc)))
     return out

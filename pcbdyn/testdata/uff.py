@@ -29,15 +29,23 @@ import re
 
 import numpy as np
 
-from .data import Dofs, FRFs, Modes, Points, TestData, TestDataError
+from .data import (
+    Dofs,
+    FRFs,
+    Modes,
+    Points,
+    TestData,
+    TestDataError,
+    check_damping,
+    check_frequencies,
+    check_shapes,
+)
 from .uff_write import write_uff
 
 _NUM = re.compile(rb"[-+]?(?:(?:\d+\.\d*|\.\d+|\d+)(?:[ED][-+]?\d+)?|nan|inf(?:inity)?)", re.IGNORECASE)
 _SPEC_KIND = {8: "receptance", 11: "mobility", 12: "accelerance"}
 _G = 9.80665
 _TAG = b"    -1"
-#: largest magnitude of a mode shape value read (shapes are scaled as the test gave them)
-MAX_SHAPE = 1e30
 
 
 def _numbers(line: bytes, where: str, nan: bool = False) -> list:
@@ -238,19 +246,12 @@ def _mode_from55(d: dict):
         return None
     if d["values"].shape[1] < 3:
         raise TestDataError("a mode shape needs 3 values per node (x, y, z); this one has fewer")
-    if not freq > 0:
-        raise TestDataError(f"record 8: the mode's frequency is {freq:g} Hz; a measured mode has a frequency above 0")
-    if not 0 <= zeta < 1:
-        raise TestDataError(f"record 8: the damping ratio {zeta:g} is not from 0 to below 1 (a measured mode's "
-                            "viscous damping ratio, e.g. 0.02)")
+    check_frequencies([freq], "record 8")
+    check_damping([zeta], 1, "record 8")
     nodes, counts = np.unique(d["nodes"], return_counts=True)
     if (counts > 1).any():
         raise TestDataError(f"node {int(nodes[counts > 1][0])} is given twice; give each node's values once")
-    if not np.any(d["values"][:, :3] != 0):
-        raise TestDataError("the mode shape is zero at every node; remove the dataset or give the shape")
-    if np.abs(d["values"]).max() > MAX_SHAPE:
-        raise TestDataError(f"a shape value of {np.abs(d['values']).max():.3g} is beyond any scaling of a mode shape "
-                            f"(at most {MAX_SHAPE:g}); check record 10 of the dataset")
+    check_shapes(d["values"][:, :3].reshape(-1, 1), "record 10")
     return freq, zeta, d["nodes"], d["values"][:, :3]
 
 

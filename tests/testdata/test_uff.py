@@ -198,6 +198,27 @@ def test_malformed_files_fail_with_a_message_naming_the_file_and_dataset(tmp_pat
         read_uff(tmp_path / "nogeo2.uff")
 
 
+@pytest.mark.parametrize("freq, zeta", [(150.0, -0.02), (150.0, 1.0), (150.0, 1.5), (0.0, 0.01), (-150.0, 0.01),
+                                        (150.0, 0.0), (150.0, 0.99)])
+def test_a_uff_mode_obeys_the_rules_of_modes(tmp_path, freq, zeta):
+    """A dataset 55 is refused exactly when Modes refuses the same mode, in Modes' words after the dataset and
+    record: a frequency above 0, a damping ratio from 0 to below 1 (a negative one, a curve fit's artefact, too)."""
+    rec8 = f"{freq:13.5E}{0.0:13.5E}{zeta:13.5E}{0.0:13.5E}"
+    path = write_text(tmp_path / "one.uff", HEADER55.format(rec8=rec8) + "         1\n 1.0E+00 2.0E+00 3.0E+00\n    -1\n")
+    point = Points([1], np.zeros((1, 3)))
+    try:
+        Modes(point, Dofs.from_codes([1, 1, 1], [1, 2, 3]), [freq], [[1.0], [2.0], [3.0]], [zeta])
+    except TestDataError as exc:
+        rule = str(exc).removeprefix("modes: ").replace(" (mode 1)", "")  # the dataset names the mode
+        with pytest.raises(TestDataError) as uff_exc:
+            read_uff(path, points=point)
+        assert str(uff_exc.value) == f"{path}: dataset #1 (type 55): record 8: {rule}"
+        assert ("above 0" if freq <= 0 else "from 0 to below 1") in rule
+        assert ("artefact of the curve fit" in rule) == (freq > 0 and zeta < 0)
+    else:
+        assert read_uff(path, points=point).modes.damping.tolist() == [zeta]
+
+
 def test_a_failed_write_leaves_the_old_file_untouched(tmp_path, monkeypatch):
     from pcbdyn.testdata import uff_write
 
