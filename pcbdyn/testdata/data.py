@@ -175,10 +175,11 @@ def check_damping(damping, n: int, where: str = "modes", numbers=None) -> np.nda
     return z
 
 
-def check_shapes(shapes, where: str = "modes", numbers=None) -> None:
+def check_shapes(shapes, where: str = "modes", numbers=None, nonzero: bool = True) -> None:
     """Measured shapes (n_dof, n_modes), real or complex: every value a finite number at most MAX_SHAPE in size,
-    and no shape zero at every DOF (it pairs with nothing). The one home of this rule (see
-    :func:`check_frequencies`)."""
+    and (``nonzero``) no shape zero at every DOF (it pairs with nothing). The one home of this rule (see
+    :func:`check_frequencies`). :class:`Modes` itself admits a zero shape: a test simulated on a flat board's
+    model reads its in-plane modes as zero at out-of-plane DOFs; a file's record may not hold one."""
     a = np.abs(np.asarray(shapes))
     if not np.isfinite(a).all():
         raise TestDataError(f"{_at(where)}a shape holds a value that is not a finite number (NaN or infinity); "
@@ -186,7 +187,7 @@ def check_shapes(shapes, where: str = "modes", numbers=None) -> None:
     if a.size and a.max() > MAX_SHAPE:
         raise TestDataError(f"{_at(where)}a shape value of {a.max():.3g} is beyond any scaling of a mode shape (at "
                             f"most {MAX_SHAPE:g}); check the shape's values")
-    zero = np.flatnonzero(~np.any(a != 0, axis=0)) if a.ndim == 2 and a.shape[0] else []
+    zero = np.flatnonzero(~np.any(a != 0, axis=0)) if nonzero and a.ndim == 2 and a.shape[0] else []
     if len(zero):
         i = int(zero[0])
         raise TestDataError(f"{_at(where)}the mode shape{_which(i, a.shape[1], numbers)} is zero at every DOF; "
@@ -225,7 +226,7 @@ class Modes:
             self.shapes = np.asarray(self.shapes, dtype=float).reshape(len(self.dofs), -1)
             if self.shapes.shape[1] != n:
                 raise TestDataError(f"modes: {n} frequencies but {self.shapes.shape[1]} shape columns")
-            check_shapes(self.shapes, "modes", self.numbers)
+            check_shapes(self.shapes, "modes", self.numbers, nonzero=False)
             self.points.index(np.unique(self.dofs.point_ids))
         self.damping = check_damping(self.damping, n, "modes", self.numbers)
         self.mpc = np.ones(n) if self.mpc is None else np.asarray(self.mpc, float).ravel()

@@ -109,3 +109,13 @@ def test_simulated_test_matches_the_model_and_pairs_back_after_a_uff_round_trip(
                    modes.frequencies[moving])
     assert [q.test for q in p.pairs] == [q.model for q in p.pairs] == list(range(moving.sum()))
     assert np.allclose(back.frfs.H, noisy.frfs.H, rtol=1e-9)
+
+
+def test_a_mode_invisible_at_the_test_dofs_is_simulated_not_refused():
+    """A simulated test may read a mode as zero at every test DOF (a flat board's in-plane mode at
+    out-of-plane DOFs): Modes keeps it, while a file's record may not hold one (test_uff)."""
+    ids = np.arange(1, 4)
+    points = Points(ids, np.column_stack([np.arange(3.0), np.zeros(3), np.zeros(3)]))
+    dofs = Dofs(ids, np.tile([0.0, 0.0, 1.0], (3, 1)))
+    m = Modes(points, dofs, [100.0, 5000.0], np.array([[1.0, 0.0], [2.0, 0.0], [3.0, 0.0]]), [0.01, 0.01])
+    assert not m.shapes[:, 1].any()
