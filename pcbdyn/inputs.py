@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import difflib
 import math
+import re
 import tomllib
 from pathlib import Path
 
@@ -41,6 +42,18 @@ def entry_name(collection: str, entry: dict, index: int) -> str:
         return str(entry[key])
     prefix = str(entry.get("type", collection)) if collection == "fixtures" else DEFAULT_PREFIX.get(collection, collection)
     return f"{prefix}{index + 1}"
+
+
+def new_entry_name(text: str, used: set, fallback: str) -> str:
+    """A name for a new entry made from ``text`` (a diagnosed effect's label): letters, digits, _ and -
+    only (usable in targets), within the readers' length limit, and not in ``used`` (to which it is
+    added)."""
+    base = (re.sub(r"[^A-Za-z0-9_-]+", "_", text).strip("_") or fallback)[:MAX_NAME - 4]
+    out, k = base, 2
+    while out in used:
+        out, k = f"{base}_{k}", k + 1
+    used.add(out)
+    return out
 
 
 def check_name(name: str) -> str | None:

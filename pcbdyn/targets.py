@@ -6,8 +6,9 @@ knows, for every target kind, its display unit, whether it is a spring stiffness
 scale: it spans decades), where its value sits in the TOML document and how it is written there; it
 validates a ``[[parameters]]`` entry against a structure (which says what value a target has, or that
 it has none) and writes updated values back into the user's file with its comments and layout kept
-(tomlkit). Entry names follow one rule everywhere (:func:`pcbdyn.inputs.entry_name`): an entry
-without ``name`` (``ref`` for parts) is called after its kind and position (``wedge_lock2``, ``m1``).
+(tomlkit). Entry names follow one rule everywhere (:func:`pcbdyn.inputs.entry_name`; new ones:
+:func:`pcbdyn.inputs.new_entry_name`): an entry without ``name`` (``ref`` for parts) is called after
+its kind and position (``wedge_lock2``, ``m1``).
 """
 
 from __future__ import annotations
@@ -118,18 +119,6 @@ def parse(text, collections=None) -> Target:
                                                                   for p in patterns], n=1)
     hint = f"did you mean {close[0]}? " if close else ""
     raise TargetError(f"{shown(str(text))} is not a target of this structure; {hint}targets are {', '.join(patterns)}")
-
-
-def new_entry_name(text: str, used: set, fallback: str) -> str:
-    """A name for a new entry made from ``text`` (a diagnosed effect's label): letters, digits, _ and -
-    only (usable in targets), within the readers' length limit, and not in ``used`` (to which it is
-    added)."""
-    base = (re.sub(r"[^A-Za-z0-9_-]+", "_", text).strip("_") or fallback)[:MAX_NAME - 4]
-    out, k = base, 2
-    while out in used:
-        out, k = f"{base}_{k}", k + 1
-    used.add(out)
-    return out
 
 
 # ------------------------------------------------------------------------------------ parameters

@@ -24,7 +24,7 @@ import shapely
 import tomlkit
 
 from .. import targets
-from ..inputs import entry_name
+from ..inputs import entry_name, new_entry_name
 from .entries import MIN_SEGMENT, BoardError
 
 TYPES = ("point_mass", "point_inertia", "ground_spring", "edge_stiffness", "line_mass", "stiffener",
@@ -63,7 +63,7 @@ class _Names:
                      for key in ("fixtures", "masses", "line_masses", "stiffeners", "regions")}
 
     def __call__(self, key: str, name: str) -> str:
-        return targets.new_entry_name(name, self.used[key], key)
+        return new_entry_name(name, self.used[key], key)
 
 
 def _outline(polygon) -> np.ndarray:

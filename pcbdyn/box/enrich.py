@@ -15,13 +15,13 @@ import numpy as np
 import tomlkit
 
 from .. import targets
-from ..inputs import entry_name
+from ..inputs import entry_name, new_entry_name
 from .entries import BoxError
 
 
 def _name(doc, base: str) -> str:
     used = {entry_name("masses", e, i) for i, e in enumerate(doc.get("masses", []))}
-    return targets.new_entry_name(base, used, "mass")
+    return new_entry_name(base, used, "mass")
 
 
 def enriched_text(box, text: str, effects) -> str:
