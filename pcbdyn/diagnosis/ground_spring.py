@@ -2,7 +2,9 @@
 component touching the board). dK/dk has a single 1 on the node's uz; dM = 0, so
 d lambda_i / dk = phi_i(node, z)^2 (thesis eq. 3.11 with k = i). On a structure in 3-D (a box) the
 spring acts along the shells' normal n at the node (``data["normal"]``): dK/dk = n n^T on its
-translations."""
+translations. A spring at a point between nodes (:func:`at_point`: a support placed from a measured
+mode, :mod:`.support`) acts on the point that the shell cell's shape functions interpolate
+(``data["point_weights"]`` over its nodes): dK/dk = (w w^T) (x) n n^T, the same point on any mesh."""
 
 from __future__ import annotations
 
@@ -11,7 +13,8 @@ from dataclasses import replace
 import numpy as np
 
 from ..fe import SpringProperty
-from .catalogue import register, Blocks, copy_model, node_candidates, on_nearest_node
+from ..fe.probe import model_probe
+from .catalogue import register, Blocks, Candidate, copy_model, node_candidates, on_nearest_node
 
 
 class _GroundSpring:
@@ -27,21 +30,47 @@ class _GroundSpring:
         return out if layout.planar else [_normal(layout, c) for c in out]
 
     def place(self, layout, candidate):
+        if "point_weights" in candidate.data:
+            return at_point(layout, candidate.at)
         placed = on_nearest_node(layout, candidate)
         return placed if "normal" not in candidate.data else _normal(layout, placed)
 
     def blocks(self, model, candidates) -> list:
-        nodes = np.array([c.nodes[0] for c in candidates], dtype=np.int64)
-        Ke = np.zeros((nodes.size, 6, 6))
-        Ke[:, :3, :3] = [_unit(c) for c in candidates]
-        return [Blocks(nodes[:, None], Ke, np.zeros_like(Ke), np.arange(nodes.size))]
+        out = []
+        for group in ([k for k, c in enumerate(candidates) if "point_weights" not in c.data],
+                      [k for k, c in enumerate(candidates) if "point_weights" in c.data]):
+            if group:
+                conn = np.array([candidates[k].nodes for k in group], dtype=np.int64)
+                Ke = np.array([_matrix(candidates[k], 1.0) for k in group])
+                out.append(Blocks(conn, Ke, np.zeros_like(Ke), np.array(group)))
+        return out
 
     def apply(self, model, candidate, value: float):
         m = copy_model(model)
         k = np.zeros((6, 6))
         k[:3, :3] = value * _unit(candidate)
-        m.add(f"effects.{candidate.name}", "spring", [[int(candidate.nodes[0])]], SpringProperty(k=k))
+        w = candidate.data.get("point_weights")
+        m.add(f"effects.{candidate.name}", "spring", [candidate.nodes.tolist()],
+              SpringProperty(k=k, weights=None if w is None else tuple(w)))
         return m
+
+
+def at_point(layout, xy) -> Candidate:
+    """A spring to ground at the point ``xy`` [m] of a board (x, y), on the shell cell that holds it."""
+    z = float(layout.model.nodes[layout.shell_nodes()[0], 2])
+    loc = model_probe(layout.model, [[xy[0], xy[1], z]]).location
+    keep = loc.weights[0] != 0.0  # a triangle repeats its last node with weight 0
+    nodes, weights = loc.nodes[0][keep], loc.weights[0][keep]
+    return Candidate("ground_spring", f"ground_spring@x={1e3 * xy[0]:.4g}mm,y={1e3 * xy[1]:.4g}mm",
+                     (float(xy[0]), float(xy[1])), nodes.astype(np.int64), data={"point_weights": tuple(weights.tolist())})
+
+
+def _matrix(candidate, value: float) -> np.ndarray:
+    """dK/dk on the candidate's nodes' DOFs, times ``value``."""
+    k = np.zeros((6, 6))
+    k[:3, :3] = value * _unit(candidate)
+    w = np.asarray(candidate.data.get("point_weights", (1.0,)), float)
+    return np.kron(np.outer(w, w), k)
 
 
 def _unit(candidate) -> np.ndarray:

@@ -2,7 +2,9 @@
 whether what remains is noise, and otherwise find, place and size the effects the model lacks.
 
 1. One mesh for every configuration (:class:`pcbdyn.problems.StructureModels`, ``shared_mesh``), test modes paired by
-   MAC, residual rows in units of noise (:mod:`.residual`).
+   MAC, residual rows in units of noise (:mod:`.residual`). A free model's test mode of rigid-body
+   shape that no elastic mode resembles shows a support it lacks: a spring to ground is placed and
+   sized from it (:mod:`.support`) and held through the search.
 2. Noise: the stated levels (uniform bounds as in thesis eqs. 5.72-5.73, so a standard deviation
    of p / sqrt(3)), or, for shapes without a stated level, the part of each measured shape that no
    combination of the model's modes can represent (a measured shape projected on the span of as
@@ -31,14 +33,14 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import shapely
 from scipy.stats import chi2 as chi2_dist
 
 from ..fe.modal import solve_modes
-from ..fe.probe import model_probe, segment_parameter
+from ..fe.probe import ProbeError, model_probe, segment_parameter
 from ..problems.models import StructureModels, parameter_values
 from .bodies import as_bodies
 from .catalogue import KINDS, generate, kind, weighted_centre
@@ -49,6 +51,7 @@ from .residual import ModalResidual, Observation
 from .fitting import estimate
 from .scan import Runner
 from .select import ALPHA, adopt, penalty, refine, search, without_vanished
+from .support import supports
 from .uncertainty import jackknife_cov, parts
 
 #: kinds whose effects :func:`_with_masses` carries onto the finer meshes
@@ -116,11 +119,12 @@ def _observations(tests, models) -> list:
 def _requests(ob, cs, h, levels: int, masses=(), kirchhoff: bool = False) -> list:
     """The finer-mesh solves (:func:`.finer.solve`) of observation ``ob``, paired on the model's mesh
     as ``cs``: the meshes twice, four times, ... as fine as ``h`` (``levels`` of them), carrying
-    ``masses``, and with ``kirchhoff`` the finest again as a Kirchhoff plate."""
+    ``masses`` (effects that are the same on any mesh: [(candidate, value)]), and with
+    ``kirchhoff`` the finest again as a Kirchhoff plate."""
     points = None if ob.shapes is None else (ob.modes.xyz, ob.modes.directions)
     n_modes = int(cs.pairs.max()) + finer.SPARE_MODES
     out = [(ob.name, h / 2**j, False, tuple(masses), n_modes, points) for j in range(1, levels + 1)]
-    return out + [(ob.name, h / 2**levels, True, (), n_modes, points)] if kirchhoff else out
+    return out + [(ob.name, h / 2**levels, True, tuple(masses), n_modes, points)] if kirchhoff else out
 
 
 @dataclass
@@ -146,10 +150,11 @@ def _correct(ob, cs, solved, form: _Form):
     return ds
 
 
-def _set_noise(models, h, obs, state, freq_pct, shape_pct, levels: int, runner) -> list:
+def _set_noise(models, h, obs, state, freq_pct, shape_pct, levels: int, runner, support=()) -> list:
     """Each observation's discretisation correction of the model frequencies, and its sigmas:
     measurement noise, what remains of the discretisation error and the plate theory's gap, in
-    quadrature (:mod:`.model_form`), from ``levels`` finer meshes (solved where ``runner`` says).
+    quadrature (:mod:`.model_form`), from ``levels`` finer meshes (solved where ``runner`` says)
+    that carry the ``support`` springs of ``state`` ([(candidate, value)], :mod:`.support`).
     Returns a :class:`_Form` per observation."""
     sigmas = []
     for ob, cs in zip(obs, state.configs):
@@ -158,7 +163,7 @@ def _set_noise(models, h, obs, state, freq_pct, shape_pct, levels: int, runner) 
             wide = solve_modes(cs.model, n_modes=ob.shapes.shape[0] // 2)
             basis = np.asarray(ob.read @ np.column_stack([wide.rigid_shapes, wide.shapes]))
         sigmas.append(_noise_sigmas(ob, freq_pct, shape_pct, basis))
-    requests = [r for ob, cs in zip(obs, state.configs) for r in _requests(ob, cs, h, levels, kirchhoff=True)]
+    requests = [r for ob, cs in zip(obs, state.configs) for r in _requests(ob, cs, h, levels, support, kirchhoff=True)]
     p0 = parameter_values(models.models[0], models.names, models.p0)
     solved = iter(finer.solve(runner, models.structure, p0, requests))
     forms = []
@@ -175,8 +180,9 @@ def _with_masses(models, res, p, masses, forms, h, levels: int, runner) -> None:
     masses found (``masses``: [(candidate, value)], :data:`MASS_KINDS`), on its own mesh and placed
     on the ``levels`` finer ones: a mass changes the shapes, and so what the mesh does to the
     frequencies, of the modes it sits on (a connector along an edge: a third less on the modes it
-    localises). Masses only, as they are the same on any mesh; a stiffness effect found on the
-    model's mesh is partly its discretisation, and is left out on both sides of the comparison.
+    localises). Masses only, and springs at a point between nodes (a support), as they are the same on
+    any mesh; a stiffness effect found on the model's mesh is partly its discretisation, and is left
+    out on both sides of the comparison.
     Sets the observations' ``f_scale`` and frequency sigmas and the ``forms``."""
     ref = res.evaluate(p, [c for c, _ in masses], [v for _, v in masses])
     requests = [r for ob, cs in zip(res.observations, ref.configs) for r in _requests(ob, cs, h, levels, masses)]
@@ -184,6 +190,25 @@ def _with_masses(models, res, p, masses, forms, h, levels: int, runner) -> None:
     solved = iter(finer.solve(runner, models.structure, at, requests))
     for ob, cs, form in zip(res.observations, ref.configs, forms):
         _correct(ob, cs, [next(solved) for _ in range(levels)], form)
+
+
+def _supports(res, p0, before, models, kinds, say) -> tuple:
+    """(support springs [(candidate, value)], the state of ``res`` with them): the springs to ground
+    that measured modes of rigid-body shape demand of a free model (:func:`.support.supports`; none
+    where the kinds searched leave springs out)."""
+    if "ground_spring" not in (kinds or KINDS):
+        return [], before
+    layout = from_structure(models.models[0])
+    found, state = supports(res, p0, before, generate(layout, ["ground_spring"]), layout)
+    if found:
+        say("test modes of rigid-body shape: the model lacks a support; "
+            + ", ".join(f"{c.name} ({v:.3g} N/m)" for c, v in found))
+    return found, state
+
+
+def _at_point(cand) -> bool:
+    """A candidate at a point between nodes (a support, :mod:`.support`): the same on any mesh."""
+    return "point_weights" in cand.data
 
 
 def _range_test(res, base, n_params, alpha) -> dict:
@@ -221,25 +246,36 @@ def diagnose(structure, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_s
     say("solving the model as given")
     before = res.evaluate(p0)
     unmatched = {ob.name or "base": (np.flatnonzero(~cs.matched) + 1).tolist() for ob, cs in zip(obs, before.configs)}
+    support, shown, bounce = [], {}, [np.zeros(ob.f.size, bool) for ob in obs]
     if any(unmatched.values()):  # modes the model has no partner for (MAC < 0.3): local modes of what it lacks
-        say(f"test modes without a model partner, left out: {unmatched}")
-        obs = [ob.subset(cs.matched) for ob, cs in zip(obs, before.configs)]
+        support, paired = _supports(res, p0, before, models, kinds, say)
+        bounce = [cs.matched & ~c0.matched for cs, c0 in zip(paired.configs, before.configs)]
+        shown = {ob.name or "base": (np.flatnonzero(b) + 1).tolist() for ob, b in zip(obs, bounce)}
+        left = {ob.name or "base": (np.flatnonzero(~cs.matched) + 1).tolist() for ob, cs in zip(obs, paired.configs)}
+        if any(left.values()):
+            say(f"test modes without a model partner, left out: {left}")
+        obs = [ob.subset(cs.matched) for ob, cs in zip(obs, paired.configs)]
+        bounce = [b[cs.matched] for b, cs in zip(bounce, paired.configs)]
         res = ModalResidual.of_models(models, obs)
         before = res.evaluate(p0)
     say("estimating the noise and the model's discretisation error")
     levels = 1 if quick else MESH_LEVELS
     say("  finer meshes: " + ", ".join(f"level {j} of {levels} ({1e3 * h / 2**j:.3g} mm)" for j in range(1, levels + 1)))
-    forms = _set_noise(models, h, obs, before, freq_noise_pct, shape_noise_pct, levels, runner)
+    seed = res.evaluate(p0, [c for c, _ in support], [v for _, v in support]) if support else before
+    forms = _set_noise(models, h, obs, seed, freq_noise_pct, shape_noise_pct, levels, runner, support)
     before = res.evaluate(p0)
     say(f"fitting the {len(names)} declared parameter(s)" if names else "no declared parameters")
-    base = estimate(res, p0, [], [], 10, models.bounds)
-    stats = {"quick": quick, "unpaired_test_modes": unmatched, "chi2_before": before.chi2, **_range_test(res, base, len(names), alpha),
+    # the declared parameters alone, on the modes they can pair (a support's bounce has no partner without it)
+    plain = ModalResidual.of_models(models, [ob.subset(~b) for ob, b in zip(obs, bounce)]) if support else res
+    base = estimate(plain, p0, [], [], 10, models.bounds)
+    stats = {"quick": quick, "unpaired_test_modes": unmatched, "support_test_modes": shown, "chi2_before": before.chi2,
+             **_range_test(plain, base, len(names), alpha),
              "mesh_correction_pct": [np.round(100 * (o.f_scale - 1.0), 4).tolist() for o in obs],
              "mesh_resolved": [f.resolved for f in forms],
              "plate_theory_pct": [np.round(100 * f.shift, 4).tolist() for f in forms],
              "sigma_f_pct": [np.round(100 * o.sigma_f, 4).tolist() for o in obs],
              "sigma_shape_pct": [None if o.sigma_s is None else np.round(100 * o.sigma_s, 4).tolist() for o in obs]}
-    out = dict(before=before.summary(obs), parameters_only=base.state.summary(obs),
+    out = dict(before=before.summary(obs), parameters_only=(res.evaluate(base.p) if support else base.state).summary(obs),
                parameters={n: {"initial": float(a), "parameters_only": float(b)} for n, a, b in zip(names, p0, base.p)},
                statistics=stats)
     if stats["p_value_noise"] > alpha and not any(unmatched.values()):
@@ -255,8 +291,14 @@ def diagnose(structure, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_s
     layout = from_structure(models.models[0])
     cands = generate(layout, kinds, **options)
     say(f"searching {len(cands)} candidate effects")
+    cands += [c for c, _ in support]
+    held = list(range(len(cands) - len(support), len(cands)))
+    start = base
+    if held:
+        say("fitting the support with the declared parameters")
+        start = estimate(res, base.p, [cands[i] for i in held], [v for _, v in support], 10, models.bounds)
     sel = search(res, cands, p0, models.bounds, max_effects=max_effects, shortlist=1 if quick else 2, alpha=alpha,
-                 base=base, runner=runner)
+                 base=start, runner=runner, held=held)
     if any(_movable(cands[i]) for i in sel.chosen):
         say("refining where the effects along the sides begin and end, where stiffeners run and what regions cover")
         sel = refine(res, cands, sel, LocalMoves(layout, cands, h), models.bounds, alpha=alpha, runner=runner)
@@ -265,9 +307,9 @@ def diagnose(structure, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_s
         sel = as_bodies(res, cands, sel, _neighbours([cands[i] for i in sel.chosen], MERGE_REACH * h),
                         MERGE_REACH * h, models.bounds, alpha=alpha)
     sel = without_vanished(res, cands, sel, models.bounds, alpha=alpha)
-    masses = [(cands[i], v) for i, v in zip(sel.chosen, sel.values) if cands[i].kind in MASS_KINDS]
+    masses = [(cands[i], v) for i, v in zip(sel.chosen, sel.values) if cands[i].kind in MASS_KINDS or _at_point(cands[i])]
     if masses and not quick:
-        say("measuring the mesh correction again with the masses found on the finer meshes")
+        say("measuring the mesh correction again with the masses (and supports) found on the finer meshes")
         _with_masses(models, res, sel.p, masses, forms, h, levels, runner)
         stats["mesh_resolved"] = [f.resolved for f in forms]
         stats["mesh_correction_pct"] = [np.round(100 * (o.f_scale - 1.0), 4).tolist() for o in obs]
@@ -293,9 +335,13 @@ def diagnose(structure, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_s
         msg += (f"; the frequencies lie {100 * theta:.0f} +- {100 * theta_sigma:.0f} % of the way from the declared "
                 "Mindlin shells to the Kirchhoff limit (statistics.plate_theory_share): the board's transverse shear "
                 "is stiffer than declared (board.transverse_shear can be updated as a parameter)")
-    if any(unmatched.values()):
-        msg += f"; test modes with no model partner (MAC < 0.3), left out of the fit: {unmatched}"
-    return Diagnosis(effects, False, msg, after=sel.state.summary(obs), evidence=_evidence(res, base.state, cands),
+    if support:
+        msg += (f"; test modes of rigid-body shape {shown} show a support the free model lacks, placed and sized "
+                "from them (a spring to ground)")
+    left = {name: [m for m in modes if m not in shown.get(name, [])] for name, modes in unmatched.items()}
+    if any(left.values()):
+        msg += f"; test modes with no model partner (MAC < 0.3), left out of the fit: {left}"
+    return Diagnosis(effects, False, msg, after=sel.state.summary(obs), evidence=_evidence(plain, base.state, cands),
                      candidates=chosen, **out)
 
 
@@ -307,8 +353,8 @@ LINE = re.compile(r"^(?P<base>.+@[xy])=(?P<v>[-0-9.e]+)mm$")
 
 def _movable(cand) -> bool:
     """A candidate :class:`LocalMoves` can move (a run of pieces of a side, a stiffener line, a
-    rectangular region)."""
-    return bool(RUN.match(cand.name) or LINE.match(cand.name) or _rectangle(cand) is not None)
+    rectangular region, a point between nodes)."""
+    return bool(RUN.match(cand.name) or LINE.match(cand.name) or _rectangle(cand) is not None or _at_point(cand))
 
 
 def _rectangle(cand):
@@ -325,9 +371,10 @@ class LocalMoves:
     """neighbours(i) for :func:`.select.refine`: for a run of pieces of a side, the runs of the
     same kind and side that start and end at most one piece from its own; for a stiffener line,
     the lines a quarter element (:data:`LINE_STEP`) to either side; for a rectangular region, the
-    rectangles with one side moved by one element (:data:`RECT_STEP`) in or out. Lines and
-    rectangles are made on demand and appended to ``cands`` (the first grid places an effect
-    within a grid step; these walk it to where it is)."""
+    rectangles with one side moved by one element (:data:`RECT_STEP`) in or out; for a point
+    between nodes (a support, :mod:`.support`), the points a quarter element away along x and y.
+    Lines, rectangles and points are made on demand and appended to ``cands`` (the first grid
+    places an effect within a grid step; these walk it to where it is)."""
 
     def __init__(self, layout, cands: list, h: float):
         self.layout, self.cands, self.h = layout, cands, h
@@ -357,6 +404,14 @@ class LocalMoves:
                     if (a, b) != (i, j) and (a, b) in side]
         if LINE.match(c.name):
             return self._add(kind("stiffener").parallel(self.layout, c, LINE_STEP * self.h * np.array([-1.0, 1.0])))
+        if _at_point(c):
+            step, made = LINE_STEP * self.h, []
+            for d in ((step, 0.0), (-step, 0.0), (0.0, step), (0.0, -step)):
+                try:
+                    made.append(c.spec.place(self.layout, replace(c, at=(c.at[0] + d[0], c.at[1] + d[1]))))
+                except ProbeError:  # off the board
+                    continue
+            return self._add(made)
         if (box := _rectangle(c)) is not None:
             lo, hi, step, made = self.lo, self.hi, RECT_STEP * self.h, []
             for side in range(4):
@@ -369,7 +424,7 @@ class LocalMoves:
         return []
 
 
-#: [element sizes] how far a stiffener line moves in one step of the local search
+#: [element sizes] how far a stiffener line or a point between nodes moves in one step of the local search
 LINE_STEP = 0.25
 #: [element sizes] how far a side of a rectangular region moves in one step of the local search
 RECT_STEP = 1.0

@@ -129,17 +129,24 @@ class State:
         return float(r @ r)
 
     def summary(self, observations) -> dict:
-        """Max |frequency error| [%] and mean MAC over all configurations, and per configuration."""
+        """Max |frequency error| [%] and mean MAC over all configurations, and per configuration, of
+        the test modes paired with a model mode (``paired``; the others, with the nearest free
+        frequency standing in, are listed in ``unpaired_test_modes``: a support's bounce on a free
+        model that lacks it, :mod:`.support`)."""
         per = []
         for ob, c in zip(observations, self.configs):
             df = 100.0 * (c.f_a / ob.f - 1.0)
-            per.append({"configuration": ob.name or "base", "max_freq_error_pct": float(np.max(np.abs(df))),
-                        "mean_mac": float(np.mean(c.mac)) if ob.shapes is not None else None,
-                        "modes": [{"test_mode": int(ob.numbers[i]), "model_mode": int(c.pairs[i]) + 1,
-                                   "f_test_hz": float(ob.f[i]),
-                                   "f_model_hz": float(c.f_a[i]), "df_pct": float(df[i]),
-                                   "mac": float(c.mac[i]) if ob.shapes is not None else None}
-                                  for i in range(ob.f.size)]})
+            use = c.matched if c.matched.any() else np.ones(c.matched.size, bool)
+            entry = {"configuration": ob.name or "base", "max_freq_error_pct": float(np.max(np.abs(df[use]))),
+                     "mean_mac": float(np.mean(c.mac[use])) if ob.shapes is not None else None,
+                     "modes": [{"test_mode": int(ob.numbers[i]), "model_mode": int(c.pairs[i]) + 1,
+                                "f_test_hz": float(ob.f[i]),
+                                "f_model_hz": float(c.f_a[i]), "df_pct": float(df[i]),
+                                "mac": float(c.mac[i]) if ob.shapes is not None else None, "paired": bool(c.matched[i])}
+                               for i in range(ob.f.size)]}
+            if not c.matched.all():
+                entry["unpaired_test_modes"] = [int(n) for n in ob.numbers[~c.matched]]
+            per.append(entry)
         macs = [q["mean_mac"] for q in per if q["mean_mac"] is not None]
         return {"max_freq_error_pct": max(q["max_freq_error_pct"] for q in per),
                 "mean_mac": float(np.mean(macs)) if macs else None, "configurations": per}

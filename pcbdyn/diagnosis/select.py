@@ -65,20 +65,22 @@ def penalty(n_obs: int, n_candidates: int, alpha: float = ALPHA) -> float:
 
 
 def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_steps: int = 8, shortlist: int = 3,
-           alpha: float = ALPHA, base: Fit | None = None, runner: Runner | None = None) -> Selection:
+           alpha: float = ALPHA, base: Fit | None = None, runner: Runner | None = None, held=()) -> Selection:
     """Effects among ``candidates`` that explain the residual ``res`` (:class:`.residual.ModalResidual`)
-    beyond the declared parameters (initial values ``p0``, ``bounds``); ``base``: the fit of the
-    declared parameters alone when already made; ``runner``: where the shortlist's trial fits run
-    (:mod:`.scan`)."""
+    beyond the declared parameters (initial values ``p0``, ``bounds``) and the effects ``held``
+    (candidate indices the data demand before any search: a support, :mod:`.support`); ``base``:
+    the fit of the declared parameters and the held effects when already made; ``runner``: where
+    the shortlist's trial fits run (:mod:`.scan`). ``max_effects`` counts the held effects."""
     p0 = np.asarray(p0, float)
     n = res.n_rows
     pen = penalty(n, len(candidates), alpha)
-    fit = base or estimate(res, p0, [], [], newton_steps, bounds)
-    sel = Selection(p=fit.p, chi2=[fit.chi2], criterion=[fit.chi2], state=fit.state)
+    held = list(held)
+    fit = base or estimate(res, p0, [candidates[i] for i in held], np.zeros(len(held)), newton_steps, bounds)
+    sel = adopt(Selection(), held, fit, pen)
     kinds = np.array([c.kind for c in candidates])
     scale = np.array([c.spec.scale for c in candidates])
     lower = np.array([c.spec.lower for c in candidates])
-    for _ in range(max_effects):
+    for _ in range(max_effects - len(held)):
         if sel.chi2[-1] <= pen:  # chi^2 >= 0: one more effect cannot lower the criterion
             break
         st = fit.state

@@ -35,8 +35,12 @@ class ElementSet:
     def __post_init__(self):
         self.conn = np.atleast_2d(np.asarray(self.conn, dtype=np.int64))
         if self.etype == "spring":
-            if self.conn.shape[1] not in (1, 2):
-                raise ModelError(f"element set '{self.name}': a spring cell has 1 or 2 nodes")
+            weights = getattr(self.prop, "weights", None)
+            if weights is not None and self.conn.shape[1] != len(weights):
+                raise ModelError(f"element set '{self.name}': a spring at a point has one weight per node of its "
+                                 f"cells, got {len(weights)} weights for {self.conn.shape[1]} nodes")
+            if weights is None and self.conn.shape[1] not in (1, 2):
+                raise ModelError(f"element set '{self.name}': a spring cell has 1 or 2 nodes (more with weights)")
         elif self.etype == "mass":
             if self.conn.shape[1] == 2:
                 raise ModelError(f"element set '{self.name}': a mass cell has 1 node or a footprint of 3 or more")

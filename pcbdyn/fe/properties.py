@@ -129,10 +129,14 @@ class SpringProperty:
     """Discrete 6-DOF spring in global axes: ``k`` = (kx, ky, kz [N/m], krx, kry, krz [N m/rad]) on the
     diagonal, or a symmetric 6x6 matrix.
 
-    A set of 1-node cells connects each node to ground; 2-node cells connect node pairs.
+    A set of 1-node cells connects each node to ground; 2-node cells connect node pairs. With
+    ``weights`` (one per node of a cell, e.g. a shell cell's shape functions at a point), each
+    cell is one spring to ground at the point whose motion the weights interpolate from the
+    cell's nodes: K = (w w^T) (x) k, a support between nodes that stays where it is on any mesh.
     """
 
     k: tuple = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    weights: tuple | None = None
 
 
 @dataclass(frozen=True)

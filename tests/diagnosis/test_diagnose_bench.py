@@ -128,6 +128,10 @@ def judge(case, truth: dict, data: dict) -> list:
             bad.append(f"{t['type']} magnitude {e['magnitude']:.4g} {e.get('unit', '')} vs truth {t['magnitude']:.4g} "
                        f"({100 * rel:+.0f} %, tolerance {100 * MAG_TOL:g} %)")
     po, after = data["parameters_only"]["max_freq_error_pct"], data["after"]["max_freq_error_pct"]
+    unpaired = {c["configuration"]: c["unpaired_test_modes"] for c in data["after"]["configurations"]
+                if c.get("unpaired_test_modes")}
+    if unpaired:  # the max error is over the paired modes: one left without a partner fails the case
+        bad.append(f"test modes without a model partner after the effects: {unpaired}")
     if po > PARAMS_ONLY_MIN_PCT and not after < AFTER_MAX_PCT:
         bad.append(f"max frequency error after {after:.3f} % (parameters only {po:.3f} %), must be < {AFTER_MAX_PCT} %")
     return bad

@@ -69,8 +69,6 @@ KNOWN: dict = {
                          "effect, ho_noise_card_cfg)",
     "ho_al_bar": "bar found in place (0 mm) and size (EI -8 %, so its mass too); 0.69 % after: the codes' ribs differ "
                  "(see ho_rib_card)",
-    "ho_bracket": "nothing reported (17.1 % after the parameters): the card's bounce on the spring, test mode 1 "
-                  "(142 Hz), has no model partner and is left out, and no single candidate explains the rest",
 }
 
 

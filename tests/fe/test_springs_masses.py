@@ -131,6 +131,42 @@ def test_full_spring_matrix_in_a_rotated_frame():
     assert np.allclose(f[6:], np.sort(exact), rtol=1e-9)
 
 
+@pytest.mark.parametrize("at", [(0.0237, 0.0461), (0.05, 0.04), (0.0925, 0.0035)])
+def test_spring_at_a_point_between_nodes_carries_a_stiff_plate_as_a_rigid_body(at):
+    """A stiff free plate (steel, 100 x 80 x 5 mm) on one soft spring to ground at a point between
+    nodes (the shape functions of the cell holding it as weights): its one nonzero rigid-body
+    eigenvalue is k |u|^2 (less by the plate's elasticity), u the mass-normalised rigid-body modes'
+    deflection at the point itself (a node 1.2 mm away would change it by up to 5 %), and a rigid block's
+    k (1/m + dx^2 / I_y + dy^2 / I_x), I = m (side^2 + t^2) / 12, to within the plate's elasticity."""
+    from pcbdyn.fe.generate import rectangle
+    from pcbdyn.fe.probe import model_probe
+    from pcbdyn.fe.properties import ShellProperty
+
+    a, b, t, rho, k = 0.1, 0.08, 5e-3, 7800.0, 1e3
+    nodes, quads = rectangle(a, b, 8, 8)
+    model = Model(nodes)
+    model.add("plate", "quad4", quads, ShellProperty(t=t, E=2.1e11, nu=0.3, rho=rho))
+    model.free = True
+    probe = model_probe(model, [[at[0], at[1], 0.0]])
+    u = np.ravel(probe.P @ solve_modes(model, n_modes=1).rigid_shapes)
+    loc = probe.location
+    model.add("s", "spring", loc.nodes, SpringProperty(k=(0.0, 0.0, k, 0.0, 0.0, 0.0), weights=tuple(loc.weights[0])))
+    modes = solve_modes(model, n_modes=1)
+    m = rho * a * b * t
+    dx, dy = at[0] - a / 2, at[1] - b / 2
+    rigid_block = k * (1 / m + dx**2 / (m * (a**2 + t**2) / 12) + dy**2 / (m * (b**2 + t**2) / 12))
+    assert modes.n_rigid == 5
+    ritz = k * float(u @ u)  # the rigid-body modes alone: an upper bound, the plate's elasticity lowers it a little
+    assert ritz * (1 - 5e-4) <= modes.omega2[0] <= ritz * (1 + 1e-9)
+    assert modes.omega2[0] == pytest.approx(rigid_block, rel=3e-3)
+
+
+def test_spring_at_a_point_needs_a_weight_per_node():
+    model = Model([[0.0, 0.0, 0.0], [0.01, 0.0, 0.0], [0.0, 0.01, 0.0]])
+    with pytest.raises(ModelError, match="one weight per node"):
+        model.add("s", "spring", [[0, 1, 2]], SpringProperty(k=(0.0, 0.0, 1e3, 0.0, 0.0, 0.0), weights=(0.5, 0.5)))
+
+
 def test_spring_and_mass_bad_input():
     model = Model([[0.0, 0.0, 0.0]])
     asym = np.eye(6)

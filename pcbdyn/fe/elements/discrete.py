@@ -16,10 +16,14 @@ def spring_stiffness(k) -> np.ndarray:
 
 
 def spring_matrices(xyz: np.ndarray, prop):
-    """Springs in global axes; 1-node cells tie to ground, 2-node cells tie the nodes together."""
+    """Springs in global axes; 1-node cells tie to ground, 2-node cells tie the nodes together; with
+    ``prop.weights`` a cell ties to ground the point its nodes interpolate: (w w^T) (x) k."""
     n_cells, nn, _ = xyz.shape
     k = spring_stiffness(prop.k)
-    if nn == 1:
+    if prop.weights is not None:
+        w = np.asarray(prop.weights, float)
+        Ke = np.broadcast_to(np.kron(np.outer(w, w), k), (n_cells, 6 * nn, 6 * nn)).copy()
+    elif nn == 1:
         Ke = np.broadcast_to(k, (n_cells, 6, 6)).copy()
     else:
         Ke = np.broadcast_to(np.block([[k, -k], [-k, k]]), (n_cells, 12, 12)).copy()

@@ -1,0 +1,135 @@
+"""A support the model lacks, shown by a measured mode of rigid-body shape (issue 26: a bracket on a
+spring to the frame). A free model has its rigid-body modes at 0 Hz; a test mode whose shape at the
+points is mostly a rigid-body motion of the model, and which no elastic mode resembles, is the
+structure moving on something that holds it. Such a mode is the strongest evidence of a spring to
+ground, yet the pairing leaves it out (no elastic partner), and without it what is left of a
+bracket on the elastic modes is too small to be told from its mass alone.
+
+A lone spring of stiffness k along n at a point a changes the modes' pencil by k w w^T, w = Phi^T n_a
+(thesis eq. 3.11 with k = i for the eigenvalue derivative). In the basis of the model's modes
+[rigid, elastic] every mode of the supported model has its rigid part along w_r, the rigid rows of
+w (a mass at the same point keeps it so): the measured mode's rigid part at the points places the
+spring, on a board at the point itself, between nodes (a rigid-body deflection is affine in x, y,
+so the best match is a linear least-squares fit, the mode's elastic part fitted with it). Its
+stiffness is the one that puts the Rayleigh-Ritz mode most like the measured one (MAC at the
+points) at the measured frequency. Both are the start of the search, which then fits the spring
+with the declared parameters and whatever else the data show (and may walk it, :class:`LocalMoves`
+of :mod:`.pipeline`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..correlation.mac import mac
+from ..fe.probe import ProbeError
+from .catalogue import effect_forms
+from .ground_spring import at_point
+
+#: a test mode without a model partner is a support's when at least this share of its shape at
+#: the points lies in the span of the model's rigid-body modes there (a bracket's bounce: 0.99 on
+#: pcbdyn's own data, 0.65 on OpenSees', where the spring is stiff enough to bend the card; the
+#: elastic modes of the bench's cases: below 0.15)
+RIGID_SHARE_MIN = 0.5
+
+
+def rigid_share(ob, cs) -> np.ndarray:
+    """Per measured mode of observation ``ob``, the share of its shape at the points that lies in
+    the span of the rigid-body modes of the state ``cs`` there (zeros without shapes or rigid modes)."""
+    nr = cs.modes.n_rigid
+    if ob.shapes is None or nr == 0:
+        return np.zeros(ob.f.size)
+    R = cs.at_points(ob.read)[:, :nr]
+    U, s, _ = np.linalg.svd(R, full_matrices=False)
+    Q = U[:, s > 1e-8 * s[0]] if s.size and s[0] > 0 else U[:, :0]
+    x = ob.shapes
+    return np.sum((Q.T @ x) ** 2, axis=0) / np.sum(x**2, axis=0)
+
+
+def support_modes(ob, cs) -> np.ndarray:
+    """Mask of the measured modes of ``ob`` that show a support: no elastic partner in the state
+    ``cs`` and a rigid-body shape (:data:`RIGID_SHARE_MIN`)."""
+    return ~cs.matched & (rigid_share(ob, cs) >= RIGID_SHARE_MIN)
+
+
+def locate(ob, cs, i: int, springs: list, layout) -> tuple:
+    """(spring candidate, stiffness [N/m]): the spring to ground that explains measured mode ``i``
+    of ``ob`` in the state ``cs`` (module doc): the node of ``springs`` (``ground_spring``
+    candidates on the state's mesh, ``layout``) whose rigid-body part best matches the mode's; on a
+    board, the point itself (:func:`_between_nodes`)."""
+    nr = cs.modes.n_rigid
+    phi = np.column_stack([cs.modes.rigid_shapes, cs.modes.shapes])
+    points = cs.at_points(ob.read)
+    x = ob.shapes[:, i : i + 1]
+    W = _rows(cs.model, phi, springs)
+    best = springs[int(np.argmax(mac(points[:, :nr] @ W[:, :nr].T, x)[:, 0]))]
+    if layout.planar:
+        best = _between_nodes(layout, cs.modes.rigid_shapes, points, nr, x) or best
+    w = _rows(cs.model, phi, [best])[0]
+    lam = np.r_[np.zeros(nr), cs.modes.omega2]
+    target = (2.0 * np.pi * ob.f[i]) ** 2
+
+    def eigenvalue(k: float) -> float:  # of the Rayleigh-Ritz mode most like the measured one
+        val, vec = np.linalg.eigh(np.diag(lam) + k * np.outer(w, w))
+        return val[int(np.argmax(mac(points @ vec, x)[:, 0]))]
+
+    lo = target / max(w[:nr] @ w[:nr], 1e-300)  # the rigid modes alone: the elastic ones only lower it
+    hi = 1e3 * lo
+    if eigenvalue(hi) < target:
+        return best, hi
+    for _ in range(60):
+        mid = np.sqrt(lo * hi)
+        lo, hi = (mid, hi) if eigenvalue(mid) < target else (lo, mid)
+    return best, float(np.sqrt(lo * hi))
+
+
+def _rows(model, phi, springs) -> np.ndarray:
+    """(n_springs, n_basis): w = phi^T dK/dk's factor per spring (dK/dk = n n^T at its point: the
+    bilinear form phi^T dK phi is w w^T)."""
+    BK, _ = effect_forms(model, phi, phi, springs)
+    idx = np.arange(len(springs))
+    top = np.argmax(np.einsum("cii->ci", BK), axis=1)
+    return BK[idx, :, top] / np.sqrt(np.maximum(BK[idx, top, top], 1e-300))[:, None]
+
+
+def _between_nodes(layout, rigid, points, nr: int, x):
+    """The spring at the point of a board whose rigid-body deflection kernel best matches the
+    measured shape ``x`` at the points, its elastic part (on the state's elastic modes, ``points``:
+    the modes [rigid, elastic] there, ``nr`` rigid) fitted with it, or None where the best match
+    lies off the board or at infinity (a mode that only turns)."""
+    nodes = layout.shell_nodes()
+    X = np.column_stack([np.ones(nodes.size), layout.xy[nodes]])
+    A = np.linalg.lstsq(X, rigid[6 * nodes + 2], rcond=None)[0]  # (3, nr): w_r = [1, x, y] A
+    B = points[:, :nr] @ A.T  # the kernel's shape at the points, per [1, x, y]
+    c = np.linalg.lstsq(np.column_stack([B, points[:, nr:]]), x[:, 0], rcond=None)[0][:3]
+    if abs(c[0]) <= 1e-9 * np.abs(c).max():
+        return None
+    try:
+        return at_point(layout, c[1:] / c[0])
+    except ProbeError:
+        return None
+
+
+#: supports located at most (one spring per measured mode of rigid-body shape)
+MAX_SUPPORTS = 3
+
+
+def supports(res, p, state, springs: list, layout) -> tuple:
+    """([(spring candidate, stiffness [N/m])], the state of ``res`` at parameters ``p`` with them):
+    springs to ground located one after another (:func:`locate`) while some configuration of
+    ``state`` has a measured mode of rigid-body shape without a partner (:func:`support_modes`),
+    each kept only if that mode then has one. A configuration's test showing the same bounce
+    as another's is explained by the same spring."""
+    found = []
+    for _ in range(MAX_SUPPORTS):
+        todo = [(k, i) for k, (ob, cs) in enumerate(zip(res.observations, state.configs))
+                for i in np.flatnonzero(support_modes(ob, cs))]
+        if not todo:
+            break
+        k, i = todo[0]
+        trial = found + [locate(res.observations[k], state.configs[k], i, springs, layout)]
+        st = res.evaluate(p, [c for c, _ in trial], [v for _, v in trial])
+        if not st.configs[k].matched[i]:
+            break
+        found, state = trial, st
+    return found, state
