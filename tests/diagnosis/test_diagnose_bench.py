@@ -206,8 +206,12 @@ def test_judge_on_truth_itself():
                           "segment_mm": [[40.0, 178.0], [81.0, 178.0]], "required": True}]}
     ok = {"effects": [{"type": "line_mass", "parameter": "mass", "at_mm": [60.75, 178.0], "magnitude": 0.022,
                        "unit": "kg", "segment_mm": [[40.5, 178.0], [81.0, 178.0]]}],
-          "noise_only": False, "parameters_only": {"max_freq_error_pct": 3.0}, "after": {"max_freq_error_pct": 0.3}}
+          "noise_only": False, "parameters_only": {"max_freq_error_pct": 3.0},
+          "after": {"max_freq_error_pct": 0.3, "configurations": [{"configuration": "base"}]}}
     assert judge(case, truth, ok) == []
+    unpaired = json.loads(json.dumps(ok))
+    unpaired["after"]["configurations"][0]["unpaired_test_modes"] = [1]
+    assert judge(case, truth, unpaired) == ["test modes without a model partner after the effects: {'base': [1]}"]
     far = json.loads(json.dumps(ok))
     far["effects"][0].update(at_mm=[120.0, 178.0], segment_mm=[[100.0, 178.0], [140.0, 178.0]], magnitude=0.03)
     far["after"]["max_freq_error_pct"] = 0.8
