@@ -1,0 +1,61 @@
+"""A support the free model lacks, shown by a measured mode of rigid-body shape (:mod:`pcbdyn.diagnosis.support`):
+exact data of a free plate on one spring to ground at a point between nodes, with a mass beside it
+or not. The bounce is told from the elastic modes, the spring placed from its rigid-body part and
+sized from its frequency."""
+
+import numpy as np
+import pytest
+from diagnosis_plates import PLATE, measured
+
+import pcbdyn.diagnosis as dg
+from pcbdyn.diagnosis.ground_spring import at_point
+from pcbdyn.diagnosis.residual import ModalResidual, Observation
+from pcbdyn.diagnosis.support import locate, rigid_share, support_modes
+from pcbdyn.fe import MassProperty, Model
+from pcbdyn.fe.generate import rectangle
+from pcbdyn.fe.modal import solve_modes
+from pcbdyn.fe.probe import model_probe
+
+A, B = 0.16, 0.12
+
+
+def free_plate():
+    nodes, conn = rectangle(A, B, 16, 12)
+    m = Model(nodes)
+    m.add("plate", "quad4", conn, PLATE)
+    m.free = True
+    return m
+
+
+@pytest.mark.parametrize("at, k, mass", [((0.0537, 0.0711), 2e4, 0.0), ((0.1213, 0.0305), 3e4, 0.01)])
+def test_bounce_places_and_sizes_the_spring(at, k, mass):
+    """The test's first mode, the plate bouncing on the spring, is mostly rigid-body motion at the
+    points and resembles no elastic mode; its rigid part places the spring within 0.1 mm (the
+    mesh: 10 mm; exact data, and a mass at the same point keeps the rigid part along the spring's) and its
+    frequency sizes it within 5 % (Rayleigh-Ritz on the free model's first modes, an upper bound of
+    the bounce: the spring found is a little softer than the truth). A mass on it is not yet known:
+    the spring found then bounces the plate alone at that frequency, softer still (the search fits
+    both)."""
+    model = free_plate()
+    layout = dg.from_model(model)
+    point = at_point(layout, at)
+    truth = dg.add_effect(model, point, k)
+    if mass:  # a bracket's mass on the same point
+        truth.add("bracket", "mass", [point.nodes], MassProperty(mass, footprint=[point.data["point_weights"]]))
+    xy = np.stack(np.meshgrid(np.linspace(0.005, A - 0.005, 9), np.linspace(0.005, B - 0.005, 7)), -1).reshape(-1, 2)
+    xyz = np.column_stack([xy, np.zeros(len(xy))])
+    modes = solve_modes(truth, n_modes=5)
+    shapes = np.asarray(model_probe(truth, xyz).P @ modes.shapes)
+    ob = Observation(None, measured(modes.frequencies, shapes, xyz), np.full(5, 1e-3))
+    ob.read, ob.sigma_s = model_probe(model, xyz).P, np.full(5, 1e-2)
+    cs = ModalResidual([ob], lambda p: [model]).evaluate(np.zeros(0)).configs[0]
+
+    share = rigid_share(ob, cs)
+    assert share[0] > 0.5 and np.all(share[1:] < 0.2)  # 0.99 and 0.73: the stiffer spring bends the plate
+    assert support_modes(ob, cs).tolist() == [True, False, False, False, False]
+    spring, value = locate(ob, cs, 0, dg.generate(layout, ["ground_spring"]), layout)
+    assert np.hypot(*np.subtract(spring.at, at)) < 1e-4
+    if mass:  # not yet known: the spring found bounces the plate alone at the bounce's frequency
+        assert 0.6 * k < value < k
+    else:
+        assert 0.95 * k < value <= k
