@@ -246,7 +246,7 @@ def diagnose(structure, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_s
     say("solving the model as given")
     before = res.evaluate(p0)
     unmatched = {ob.name or "base": (np.flatnonzero(~cs.matched) + 1).tolist() for ob, cs in zip(obs, before.configs)}
-    support, shown, bounce = [], {}, [np.zeros(ob.f.size, bool) for ob in obs]
+    support, shown, left, bounce = [], {}, unmatched, [np.zeros(ob.f.size, bool) for ob in obs]
     if any(unmatched.values()):  # modes the model has no partner for (MAC < 0.3): local modes of what it lacks
         support, paired = _supports(res, p0, before, models, kinds, say)
         bounce = [cs.matched & ~c0.matched for cs, c0 in zip(paired.configs, before.configs)]
@@ -338,7 +338,6 @@ def diagnose(structure, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_s
     if support:
         msg += (f"; test modes of rigid-body shape {shown} show a support the free model lacks, placed and sized "
                 "from them (a spring to ground)")
-    left = {name: [m for m in modes if m not in shown.get(name, [])] for name, modes in unmatched.items()}
     if any(left.values()):
         msg += f"; test modes with no model partner (MAC < 0.3), left out of the fit: {left}"
     return Diagnosis(effects, False, msg, after=sel.state.summary(obs), evidence=_evidence(plain, base.state, cands),
