@@ -41,7 +41,7 @@ class _GroundSpring:
                       [k for k, c in enumerate(candidates) if "point_weights" in c.data]):
             if group:
                 conn = np.array([candidates[k].nodes for k in group], dtype=np.int64)
-                Ke = np.array([_matrix(candidates[k], 1.0) for k in group])
+                Ke = np.array([_derivative(candidates[k]) for k in group])
                 out.append(Blocks(conn, Ke, np.zeros_like(Ke), np.array(group)))
         return out
 
@@ -65,10 +65,10 @@ def at_point(layout, xy) -> Candidate:
                      (float(xy[0]), float(xy[1])), nodes.astype(np.int64), data={"point_weights": tuple(weights.tolist())})
 
 
-def _matrix(candidate, value: float) -> np.ndarray:
-    """dK/dk on the candidate's nodes' DOFs, times ``value``."""
+def _derivative(candidate) -> np.ndarray:
+    """dK/dk on the candidate's nodes' DOFs."""
     k = np.zeros((6, 6))
-    k[:3, :3] = value * _unit(candidate)
+    k[:3, :3] = _unit(candidate)
     w = np.asarray(candidate.data.get("point_weights", (1.0,)), float)
     return np.kron(np.outer(w, w), k)
 
