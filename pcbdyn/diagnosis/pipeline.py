@@ -88,7 +88,8 @@ class Diagnosis:
 
 
 def _noise_sigmas(ob: Observation, freq_pct, shape_pct, basis_shapes):
-    """Per-mode relative standard deviations of the frequencies and of a shape component."""
+    """Per-mode relative standard deviations of the frequencies and of a shape component
+    (``basis_shapes``: the model's modes at the points, needed only where the shape noise is not stated)."""
     m = ob.f.size
     sf = np.full(m, (0.2 if freq_pct is None else freq_pct) / 100.0 / np.sqrt(3.0))
     if ob.shapes is None:
@@ -159,7 +160,7 @@ def _set_noise(models, h, obs, state, freq_pct, shape_pct, levels: int, runner, 
     sigmas = []
     for ob, cs in zip(obs, state.configs):
         basis = None
-        if ob.shapes is not None:  # rigid-body modes first: a free board's shapes hold them at the points
+        if ob.shapes is not None and shape_pct is None:  # rigid-body modes first: a free board's shapes hold them
             wide = solve_modes(cs.model, n_modes=ob.shapes.shape[0] // 2)
             basis = np.asarray(ob.read @ np.column_stack([wide.rigid_shapes, wide.shapes]))
         sigmas.append(_noise_sigmas(ob, freq_pct, shape_pct, basis))
