@@ -81,6 +81,12 @@ class Candidate:
     def nominal(self) -> float:
         return 0.0
 
+    @property
+    def between_nodes(self) -> bool:
+        """Placed at a point, not on nodes: ``data["point_weights"]`` interpolate it from ``nodes``
+        (a support, :mod:`.support`), so it is the same effect on any mesh."""
+        return "point_weights" in self.data
+
     def describe(self) -> dict:
         """JSON-ready description in mm (the shape of diagnose's ``effects`` entries)."""
         d = {"type": self.spec.report_as, "name": self.name, "parameter": self.spec.param,

@@ -30,15 +30,15 @@ class _GroundSpring:
         return out if layout.planar else [_normal(layout, c) for c in out]
 
     def place(self, layout, candidate):
-        if "point_weights" in candidate.data:
+        if candidate.between_nodes:
             return at_point(layout, candidate.at)
         placed = on_nearest_node(layout, candidate)
         return placed if "normal" not in candidate.data else _normal(layout, placed)
 
     def blocks(self, model, candidates) -> list:
         out = []
-        for group in ([k for k, c in enumerate(candidates) if "point_weights" not in c.data],
-                      [k for k, c in enumerate(candidates) if "point_weights" in c.data]):
+        for group in ([k for k, c in enumerate(candidates) if not c.between_nodes],
+                      [k for k, c in enumerate(candidates) if c.between_nodes]):
             if group:
                 conn = np.array([candidates[k].nodes for k in group], dtype=np.int64)
                 Ke = np.array([_derivative(candidates[k]) for k in group])
@@ -47,11 +47,9 @@ class _GroundSpring:
 
     def apply(self, model, candidate, value: float):
         m = copy_model(model)
-        k = np.zeros((6, 6))
-        k[:3, :3] = value * _unit(candidate)
         w = candidate.data.get("point_weights")
         m.add(f"effects.{candidate.name}", "spring", [candidate.nodes.tolist()],
-              SpringProperty(k=k, weights=None if w is None else tuple(w)))
+              SpringProperty(k=value * _spring(candidate), weights=None if w is None else tuple(w)))
         return m
 
 
@@ -66,17 +64,17 @@ def at_point(layout, xy) -> Candidate:
 
 
 def _derivative(candidate) -> np.ndarray:
-    """dK/dk on the candidate's nodes' DOFs."""
-    k = np.zeros((6, 6))
-    k[:3, :3] = _unit(candidate)
+    """dK/dk on the candidate's nodes' DOFs: the spring's 6x6 at one node, (w w^T) (x) it at a point."""
     w = np.asarray(candidate.data.get("point_weights", (1.0,)), float)
-    return np.kron(np.outer(w, w), k)
+    return np.kron(np.outer(w, w), _spring(candidate))
 
 
-def _unit(candidate) -> np.ndarray:
-    """dK/dk on the translations: n n^T (z z^T on a board)."""
+def _spring(candidate) -> np.ndarray:
+    """The 6x6 spring matrix per unit k: n n^T on the translations (z z^T on a board)."""
     n = np.asarray(candidate.data.get("normal", (0.0, 0.0, 1.0)), float)
-    return np.outer(n, n)
+    k = np.zeros((6, 6))
+    k[:3, :3] = np.outer(n, n)
+    return k
 
 
 def _normal(layout, candidate):

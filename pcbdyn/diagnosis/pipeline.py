@@ -23,8 +23,8 @@ whether what remains is noise, and otherwise find, place and size the effects th
    also predicts data it was not fitted to; runs along the sides, stiffener lines and
    rectangular regions are walked to where they fit best (:func:`.select.refine`,
    :class:`LocalMoves`) and a mass with an inertia beside it refitted as one body
-   (:mod:`.bodies`). The masses found are then put on the finer meshes and the mesh correction
-   measured again (:func:`_with_masses`: they change the shapes it depends on). Last, the plate
+   (:mod:`.bodies`). The masses (and supports) found are then put on the finer meshes and the mesh
+   correction measured again (:func:`_with_carried`: they change the shapes it depends on). Last, the plate
    theory's share is fitted with the effects found (:func:`.model_form.fit_plate_share`; kept
    only where significant).
 """
@@ -54,7 +54,7 @@ from .select import ALPHA, adopt, penalty, refine, search, without_vanished
 from .support import supports
 from .uncertainty import jackknife_cov, parts
 
-#: kinds whose effects :func:`_with_masses` carries onto the finer meshes
+#: kinds whose effects :func:`_with_carried` carries onto the finer meshes
 MASS_KINDS = ("point_mass", "point_inertia", "line_mass")
 
 #: where candidates go: sides cut into 16 pieces (every run of consecutive pieces is a candidate);
@@ -117,15 +117,15 @@ def _observations(tests, models) -> list:
     return obs
 
 
-def _requests(ob, cs, h, levels: int, masses=(), kirchhoff: bool = False) -> list:
+def _requests(ob, cs, h, levels: int, carried=(), kirchhoff: bool = False) -> list:
     """The finer-mesh solves (:func:`.finer.solve`) of observation ``ob``, paired on the model's mesh
     as ``cs``: the meshes twice, four times, ... as fine as ``h`` (``levels`` of them), carrying
-    ``masses`` (effects that are the same on any mesh: [(candidate, value)]), and with
+    ``carried`` (effects that are the same on any mesh: [(candidate, value)]), and with
     ``kirchhoff`` the finest again as a Kirchhoff plate."""
     points = None if ob.shapes is None else (ob.modes.xyz, ob.modes.directions)
     n_modes = int(cs.pairs.max()) + finer.SPARE_MODES
-    out = [(ob.name, h / 2**j, False, tuple(masses), n_modes, points) for j in range(1, levels + 1)]
-    return out + [(ob.name, h / 2**levels, True, tuple(masses), n_modes, points)] if kirchhoff else out
+    out = [(ob.name, h / 2**j, False, tuple(carried), n_modes, points) for j in range(1, levels + 1)]
+    return out + [(ob.name, h / 2**levels, True, tuple(carried), n_modes, points)] if kirchhoff else out
 
 
 @dataclass
@@ -176,17 +176,18 @@ def _set_noise(models, h, obs, state, freq_pct, shape_pct, levels: int, runner, 
     return forms
 
 
-def _with_masses(models, res, p, masses, forms, h, levels: int, runner) -> None:
+def _with_carried(models, res, p, carried, forms, h, levels: int, runner) -> None:
     """The mesh correction measured again at the fitted parameters ``p`` on the model carrying the
-    masses found (``masses``: [(candidate, value)], :data:`MASS_KINDS`), on its own mesh and placed
-    on the ``levels`` finer ones: a mass changes the shapes, and so what the mesh does to the
+    masses and supports found (``carried``: [(candidate, value)], of :data:`MASS_KINDS` or between
+    nodes), on its own mesh and placed on the ``levels`` finer ones: a mass changes the shapes, and
+    so what the mesh does to the
     frequencies, of the modes it sits on (a connector along an edge: a third less on the modes it
     localises). Masses only, and springs at a point between nodes (a support), as they are the same on
     any mesh; a stiffness effect found on the model's mesh is partly its discretisation, and is left
     out on both sides of the comparison.
     Sets the observations' ``f_scale`` and frequency sigmas and the ``forms``."""
-    ref = res.evaluate(p, [c for c, _ in masses], [v for _, v in masses])
-    requests = [r for ob, cs in zip(res.observations, ref.configs) for r in _requests(ob, cs, h, levels, masses)]
+    ref = res.evaluate(p, [c for c, _ in carried], [v for _, v in carried])
+    requests = [r for ob, cs in zip(res.observations, ref.configs) for r in _requests(ob, cs, h, levels, carried)]
     at = parameter_values(models.models[0], models.names, p)
     solved = iter(finer.solve(runner, models.structure, at, requests))
     for ob, cs, form in zip(res.observations, ref.configs, forms):
@@ -205,11 +206,6 @@ def _supports(res, p0, before, models, kinds, say) -> tuple:
         say("test modes of rigid-body shape: the model lacks a support; "
             + ", ".join(f"{c.name} ({v:.3g} N/m)" for c, v in found))
     return found, state
-
-
-def _at_point(cand) -> bool:
-    """A candidate at a point between nodes (a support, :mod:`.support`): the same on any mesh."""
-    return "point_weights" in cand.data
 
 
 def _range_test(res, base, n_params, alpha) -> dict:
@@ -308,10 +304,10 @@ def diagnose(structure, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_s
         sel = as_bodies(res, cands, sel, _neighbours([cands[i] for i in sel.chosen], MERGE_REACH * h),
                         MERGE_REACH * h, models.bounds, alpha=alpha)
     sel = without_vanished(res, cands, sel, models.bounds, alpha=alpha)
-    masses = [(cands[i], v) for i, v in zip(sel.chosen, sel.values) if cands[i].kind in MASS_KINDS or _at_point(cands[i])]
-    if masses and not quick:
+    carried = [(cands[i], v) for i, v in zip(sel.chosen, sel.values) if cands[i].kind in MASS_KINDS or cands[i].between_nodes]
+    if carried and not quick:
         say("measuring the mesh correction again with the masses (and supports) found on the finer meshes")
-        _with_masses(models, res, sel.p, masses, forms, h, levels, runner)
+        _with_carried(models, res, sel.p, carried, forms, h, levels, runner)
         stats["mesh_resolved"] = [f.resolved for f in forms]
         stats["mesh_correction_pct"] = [np.round(100 * (o.f_scale - 1.0), 4).tolist() for o in obs]
         sel = adopt(sel, sel.chosen, estimate(res, sel.p, [cands[i] for i in sel.chosen], sel.values, 8, models.bounds),
@@ -354,7 +350,7 @@ LINE = re.compile(r"^(?P<base>.+@[xy])=(?P<v>[-0-9.e]+)mm$")
 def _movable(cand) -> bool:
     """A candidate :class:`LocalMoves` can move (a run of pieces of a side, a stiffener line, a
     rectangular region, a point between nodes)."""
-    return bool(RUN.match(cand.name) or LINE.match(cand.name) or _rectangle(cand) is not None or _at_point(cand))
+    return bool(RUN.match(cand.name) or LINE.match(cand.name) or _rectangle(cand) is not None or cand.between_nodes)
 
 
 def _rectangle(cand):
@@ -404,7 +400,7 @@ class LocalMoves:
                     if (a, b) != (i, j) and (a, b) in side]
         if LINE.match(c.name):
             return self._add(kind("stiffener").parallel(self.layout, c, LINE_STEP * self.h * np.array([-1.0, 1.0])))
-        if _at_point(c):
+        if c.between_nodes:
             step, made = LINE_STEP * self.h, []
             for d in ((step, 0.0), (-step, 0.0), (0.0, step), (0.0, -step)):
                 try:

@@ -87,7 +87,7 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
         A = res.effect_columns(st, candidates) * scale
         P = res.param_columns(st)
         held = np.hstack([P, res.effect_columns(st, [candidates[i] for i in sel.chosen]) * scale[sel.chosen]])
-        Q = _orth(held)
+        Q = orth(held)
         A_p, r_p = A - Q @ (Q.T @ A), st.r - Q @ (Q.T @ st.r)
         norm2 = np.einsum("ij,ij->j", A_p, A_p)
         ok = norm2 > 1e-12 * norm2.max()
@@ -249,7 +249,9 @@ HELD_OUT_SHARE = 0.75
 CV_RCOND = 1e-3
 
 
-def _orth(A):
+def orth(A):
+    """An orthonormal basis of the span of ``A``'s columns (directions weaker than 1e-10 of the
+    strongest dropped)."""
     if A.shape[1] == 0:
         return np.zeros((A.shape[0], 0))
     U, s, _ = np.linalg.svd(A, full_matrices=False)

@@ -25,6 +25,7 @@ from ..correlation.mac import mac
 from ..fe.probe import ProbeError
 from .catalogue import effect_forms
 from .ground_spring import at_point
+from .select import orth
 
 #: a test mode without a model partner is a support's when at least this share of its shape at
 #: the points lies in the span of the model's rigid-body modes there (a bracket's bounce: 0.99 on
@@ -39,9 +40,7 @@ def rigid_share(ob, cs) -> np.ndarray:
     nr = cs.modes.n_rigid
     if ob.shapes is None or nr == 0:
         return np.zeros(ob.f.size)
-    R = cs.at_points(ob.read)[:, :nr]
-    U, s, _ = np.linalg.svd(R, full_matrices=False)
-    Q = U[:, s > 1e-8 * s[0]] if s.size and s[0] > 0 else U[:, :0]
+    Q = orth(cs.at_points(ob.read)[:, :nr])
     x = ob.shapes
     return np.sum((Q.T @ x) ** 2, axis=0) / np.sum(x**2, axis=0)
 
