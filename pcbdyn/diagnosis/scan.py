@@ -6,13 +6,15 @@ effects already chosen and the declared parameters for a few Gauss-Newton steps;
 state, so each is first fitted on that state's reanalysis (:mod:`.reanalysis`: no sparse solve),
 and only the :data:`FULL_RANK` best of those, with the trials a reanalysis cannot follow (adding or
 removing a rib changes the modes beyond a first-order basis: kinds with ``reanalysed = False``),
-are fitted again with full re-solves, which decide. Those full fits are independent jobs: they run
-in local worker processes or on a Dask cluster (:func:`pcbdyn.parallel.run_jobs`) when a
-:class:`Runner` says so, with the same results as in this process.
+are fitted again with full re-solves, which decide. Both kinds of fits are independent jobs: they
+run in local worker processes (the quick ones always there) or on a Dask cluster
+(:func:`pcbdyn.parallel.run_jobs`) when a :class:`Runner` says so, with the same results as in
+this process.
 """
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,6 +24,8 @@ from .catalogue import kind
 from .reanalysis import Reanalysis
 from .fitting import RANK_STEPS, Fit, estimate
 
+#: a scan tells its progress at most this often [s] (and when it ends): quick fits take 40 ms
+PROGRESS_EVERY = 0.5
 #: the quick fits' best this many are fitted again with full re-solves
 FULL_RANK = 3
 #: a quick fit's chi^2 is trusted to this share of the solved state's (a reanalysis is first order
@@ -31,8 +35,9 @@ SCREEN_MARGIN = 0.05
 
 @dataclass
 class Runner:
-    """Where full trial fits run: ``workers`` local processes (1: this process; None: the cores) or
-    the Dask cluster at ``scheduler``; ``progress(msg)`` is told how many of a scan are done."""
+    """Where trial fits run: ``workers`` local processes (1: this process; None: the cores) or
+    the Dask cluster at ``scheduler``; ``progress(msg)`` is told how many of a scan are done
+    (:data:`PROGRESS_EVERY`)."""
 
     workers: int | None = 1
     scheduler: object = None
@@ -42,11 +47,13 @@ class Runner:
         """``fn(*job, shared)`` for every job, results in the jobs' order."""
         if not jobs:
             return []
-        count = [0]
+        count, told = [0], [time.monotonic()]
 
         def done(_):
             count[0] += 1
-            if self.progress is not None:
+            now = time.monotonic()
+            if self.progress is not None and (count[0] == len(jobs) or now - told[0] >= PROGRESS_EVERY):
+                told[0] = now
                 self.progress(f"{count[0]} of {len(jobs)} {what}")
 
         out = sorted(run_jobs(fn, [(k, *job) for k, job in enumerate(jobs)], shared, self.workers, self.scheduler, done),
@@ -69,26 +76,39 @@ def _followed(state, cands) -> bool:
     return all(getattr(kind(c.kind), "reanalysed", True) for c in changed)
 
 
-def worth_full(res, state, trials: list, p, bounds, limit: float, steps: int = RANK_STEPS) -> list:
+def worth_full(res, state, trials: list, p, bounds, limit: float, steps: int = RANK_STEPS,
+               runner: Runner | None = None) -> list:
     """For each of ``trials`` = [(candidates, initial magnitudes)] from the solved ``state``: False
     where its quick fit on the state's reanalysis leaves chi^2 above ``limit`` by more than the
     reanalysis can be off (:data:`SCREEN_MARGIN` of the state's chi^2), so that no full fit could
     reach it; True otherwise (and for the trials a reanalysis cannot follow). ``steps``: Gauss-Newton
     steps of the quick fits (as many as the full fits they stand for, so that only the reanalysis
-    differs)."""
+    differs); ``runner``: where they run."""
     idx = [k for k, (cands, _) in enumerate(trials) if _followed(state, cands)]
-    chi2 = _screen(res, state, [trials[k] for k in idx], p, bounds, res.param_columns(state) if idx else None, steps)
+    chi2 = _screen(res, state, [trials[k] for k in idx], p, bounds, res.param_columns(state) if idx else None, steps,
+                   runner)
     out = [True] * len(trials)
     for k, c in zip(idx, chi2):
         out[k] = bool(c <= limit + SCREEN_MARGIN * state.chi2)
     return out
 
 
-def _screen(res, state, trials: list, p, bounds, P, steps: int) -> list:
+def _screen(res, state, trials: list, p, bounds, P, steps: int, runner: Runner | None = None) -> list:
     """chi^2 of each of ``trials`` fitted on the reanalysis of ``state`` (``P``: the declared
-    parameters' columns, held: a reanalysed state has no full modes)."""
-    rx = Reanalysis(res, state) if trials else None
-    return [estimate(res, p, cands, v0, steps, bounds, param_columns=P, reduced=rx).chi2 for cands, v0 in trials]
+    parameters' columns, held: a reanalysed state has no full modes). The quick fits are
+    independent jobs too, run in ``runner``'s local processes even where it names a cluster: each
+    takes ~40 ms, and what they share is the whole solved state."""
+    if not trials:
+        return []
+    local = Runner() if runner is None else Runner(runner.workers, None, runner.progress)
+    shared = (res, Reanalysis(res, state), p, bounds, P, steps)
+    return local.map(_quick_fit, trials, shared, "trials screened on the reanalysis")
+
+
+def _quick_fit(k, cands, v0, shared):
+    """One trial fit on the reanalysis (a job): its chi^2."""
+    res, rx, p, bounds, P, steps = shared
+    return estimate(res, p, cands, v0, steps, bounds, param_columns=P, reduced=rx).chi2
 
 
 def rank(res, state, trials: list, p, bounds, P, runner: Runner | None = None) -> list:
@@ -99,10 +119,8 @@ def rank(res, state, trials: list, p, bounds, P, runner: Runner | None = None) -
     quick = [k for k, (cands, _) in enumerate(trials) if _followed(state, cands)]
     full = [k for k in range(len(trials)) if k not in quick]
     if len(quick) > FULL_RANK:
-        chi2 = _screen(res, state, [trials[k] for k in quick], p, bounds, P, RANK_STEPS)
+        chi2 = _screen(res, state, [trials[k] for k in quick], p, bounds, P, RANK_STEPS, runner)
         quick = [quick[i] for i in np.argsort(chi2, kind="stable")[:FULL_RANK]]
-        if runner.progress is not None:
-            runner.progress(f"{len(chi2)} of {len(trials)} trials screened on the reanalysis")
     chosen = sorted(quick + full)
     done = runner.map(_full_fit, [(trials[k][0], trials[k][1], p) for k in chosen], (res, bounds, P), "trial fits")
     out: list = [None] * len(trials)

@@ -108,7 +108,7 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
                     bounds, pen, p0.size)
         if new is None:
             break
-        idx, fit = _prune(res, candidates, idx, new, newton_steps, bounds, pen, p0.size)
+        idx, fit = _prune(res, candidates, idx, new, newton_steps, bounds, pen, p0.size, runner)
         adopt(sel, idx, fit, pen)
     return sel
 
@@ -194,7 +194,7 @@ def refine(res, candidates, sel: Selection, neighbours, bounds=None, newton_step
                 idx, fit, improved = best[0], new, True
     if idx == list(sel.chosen):
         return sel
-    return adopt(sel, *_prune(res, candidates, idx, fit, newton_steps, bounds, pen, n_par), pen)
+    return adopt(sel, *_prune(res, candidates, idx, fit, newton_steps, bounds, pen, n_par, runner), pen)
 
 
 def worth(chi2_before, chi2_after, n, k, pen) -> bool:
@@ -276,16 +276,17 @@ def _shortlist(gain, kinds, per_kind: int) -> np.ndarray:
     return np.concatenate(out) if out else np.zeros(0, dtype=np.int64)
 
 
-def _prune(res, candidates, idx, fit, steps, bounds, pen, n_params):
+def _prune(res, candidates, idx, fit, steps, bounds, pen, n_params, runner: Runner | None = None):
     """Backward check after each addition: drop an earlier effect whenever the others, re-estimated
     without it, reach a lower criterion (greedy choices made before the right effect was in); the
-    drops a quick fit shows to be far worse are not re-estimated (:func:`.scan.worth_full`)."""
+    drops a quick fit shows to be far worse are not re-estimated (:func:`.scan.worth_full`, its
+    quick fits run where ``runner`` says)."""
     while len(idx) > 1:
         best = None
         keeps = [[i for t, i in enumerate(idx) if t != drop] for drop in range(len(idx) - 1)]
         trials = [([candidates[i] for i in keep], np.delete(fit.values, drop)) for drop, keep in enumerate(keeps)]
         for drop, (keep, full) in enumerate(zip(keeps, worth_full(res, fit.state, trials, fit.p, bounds,
-                                                                   fit.chi2 + pen, steps))):
+                                                                   fit.chi2 + pen, steps, runner))):
             if not full:
                 continue
             trial = estimate(res, fit.p, trials[drop][0], trials[drop][1], steps, bounds)
