@@ -21,8 +21,8 @@ import numpy as np
 
 from ..parallel import run_jobs
 from .catalogue import kind
-from .reanalysis import Reanalysis
 from .fitting import RANK_STEPS, Fit, estimate
+from .reanalysis import Reanalysis
 
 #: a scan tells its progress at most this often [s] (and when it ends): quick fits take 40 ms
 PROGRESS_EVERY = 0.5
