@@ -1,6 +1,6 @@
-"""``pcbdyn diagnose --quick`` and ``--scheduler`` (issue 26) on a bench case (a standoff under the
-free card, :mod:`bench_cases`): a first look finds what the full run finds, and trial fits run on a
-Dask cluster give the full run's findings to rounding."""
+"""``pcbdyn diagnose --quick``, ``--workers`` and ``--scheduler`` (issue 26) on a bench case (a standoff
+under the free card, :mod:`bench_cases`): a first look finds what the full run finds, and trial fits run
+in this process, in worker processes or on a Dask cluster give the same findings to rounding."""
 
 from __future__ import annotations
 
@@ -72,3 +72,13 @@ def test_scheduler_gives_the_same_findings(case, default, tmp_path):
     _same_findings(data, default, 1e-6, 1e-3)
     assert data["after"]["max_freq_error_pct"] == pytest.approx(default["after"]["max_freq_error_pct"], rel=1e-6)
     assert np.isfinite(data["effects"][0]["uncertainty"])
+
+
+def test_worker_processes_give_the_findings_of_one_process(case, default, tmp_path):
+    """The quick fits that screen each scan and the full trial fits run in two local worker processes
+    by default and all in this process with ``--workers 1``: the same findings (to round-off), so
+    where a job ran never changes an answer."""
+    data, output = _diagnose(case, tmp_path, "--workers", "1")
+    assert "trials screened on the reanalysis" in output
+    _same_findings(data, default, 1e-9, 1e-6)
+    assert data["after"]["max_freq_error_pct"] == pytest.approx(default["after"]["max_freq_error_pct"], rel=1e-9)
