@@ -1,5 +1,6 @@
 """Running independent jobs (the shots of a study, the candidates of a diagnosis scan) in this process,
-in local worker processes, or on a Dask cluster when a scheduler address is given.
+in local worker processes, or on a Dask cluster when a scheduler address is given; and, within
+:func:`spare_cores`, single jobs beside this process's own work (:func:`beside`).
 
 Each job is ``fn(*args, shared)``: ``shared`` (a case, a residual) is sent to every worker once (the
 process pool's initializer, Dask's scatter), the arguments per job. Results come back as they finish;
@@ -14,10 +15,13 @@ from __future__ import annotations
 import multiprocessing
 import os
 from concurrent.futures import ProcessPoolExecutor, as_completed
+from contextlib import contextmanager
 
 from .fe.threads import openmp_capped
 
 _SHARED = None
+#: the process pool of :func:`spare_cores` and the process that made it: (pid, size, pool or None)
+_SPARE = None
 
 
 class _Pickled:
@@ -86,3 +90,37 @@ def _on_dask(fn, jobs, shared, scheduler, done):
     finally:
         if client is not scheduler:
             client.close()
+
+
+@contextmanager
+def spare_cores(workers: int | None = None):
+    """Within this block, :func:`beside` runs jobs on ``workers - 1`` more local processes (None: the
+    cores), started when first needed and stopped at its end. Made for work this process would
+    otherwise do one piece after another on one core while the others idle (the configurations of a
+    re-solve); only this process uses them, never a worker forked from it."""
+    global _SPARE
+    workers = (os.cpu_count() or 1) if workers is None else int(workers)
+    outer, _SPARE = _SPARE, (os.getpid(), max(workers - 1, 0), None)
+    try:
+        yield
+    finally:
+        pool, _SPARE = _SPARE[2], outer
+        if pool is not None:
+            pool.shutdown(cancel_futures=True)
+
+
+def spare() -> int:
+    """How many processes :func:`beside` has for this process now (0 outside :func:`spare_cores`)."""
+    return _SPARE[1] if _SPARE is not None and _SPARE[0] == os.getpid() else 0
+
+
+def beside(fn, *args):
+    """A future of ``fn(*args)`` run on a spare process (see :func:`spare`, which must be > 0); the
+    arguments go by pickle."""
+    global _SPARE
+    pid, n, pool = _SPARE
+    if pool is None:
+        context = multiprocessing.get_context("fork" if openmp_capped() else "forkserver")
+        pool = ProcessPoolExecutor(n, context)
+        _SPARE = (pid, n, pool)
+    return pool.submit(fn, *args)

@@ -41,6 +41,7 @@ from scipy.stats import chi2 as chi2_dist
 
 from ..fe.modal import solve_modes
 from ..fe.probe import ProbeError, model_probe, segment_parameter
+from ..parallel import spare_cores
 from ..problems.models import StructureModels, parameter_values
 from .bodies import as_bodies
 from .catalogue import KINDS, generate, kind, weighted_centre
@@ -231,7 +232,15 @@ def diagnose(structure, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_s
     mesh correction from one finer mesh (twice as fine) instead of :data:`.model_form.MESH_LEVELS`,
     the candidates on a grid half as fine (:data:`QUICK_CANDIDATE_OPTIONS`, the local search still
     walks them to place), one trial per kind in each scan instead of two, and the masses found not
-    carried onto the finer meshes to measure the correction again."""
+    carried onto the finer meshes to measure the correction again. The configurations of each
+    re-solve share the local cores (:func:`pcbdyn.parallel.spare_cores`)."""
+    with spare_cores(workers):
+        return _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kinds, max_effects, alpha,
+                         progress, workers, scheduler, quick)
+
+
+def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kinds, max_effects, alpha, progress,
+              workers, scheduler, quick) -> Diagnosis:
     say = progress or (lambda msg: None)
     runner = Runner(workers, scheduler, lambda msg: say(f"  {msg}"))
     h = mesh_size or structure.mesh_size

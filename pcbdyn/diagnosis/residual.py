@@ -20,6 +20,7 @@ approximate; every fit is confirmed on full re-solves.
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -28,6 +29,7 @@ from ..correlation.mac import mac
 from ..correlation.pairing import pair_modes
 from ..fe.assembly import assemble
 from ..fe.modal import solve_modes
+from ..parallel import beside, spare
 from ..testdata import Modes
 from ..updating.sensitivity import bilinear_forms, eigen_derivatives
 from .catalogue import effect_forms
@@ -214,6 +216,7 @@ class ModalResidual:
         self.n_rows = sum(o.n_rows for o in self.observations)
         self.effects = Effects()
         self._at = (None, None)  # last p, its [(model, K, M)]
+        self._seconds: dict = {}  # per configuration, how long its last solve took
 
     def row_groups(self) -> tuple:
         """(configuration index, mode index) of every row: the blocks cross-validation leaves out."""
@@ -240,15 +243,31 @@ class ModalResidual:
         configuration states keep the model without them."""
         p = np.asarray(p, float)
         st = State(p, list(candidates), np.asarray(values, float))
-        for k, (ob, (model, K, M)) in enumerate(zip(self.observations, self._assembled(p))):
-            K, M = self.effects.combine(k, model, K, M, p, candidates, st.values)
-            st.configs.append(self._config(ob, model, K, M))
+        systems = [(ob, model, *self.effects.combine(k, model, K, M, p, candidates, st.values))
+                   for k, (ob, (model, K, M)) in enumerate(zip(self.observations, self._assembled(p)))]
+        for (ob, model, K, M), modes in zip(systems, self._solved(systems)):
+            U = None if ob.shapes is None else np.asarray(ob.read @ modes.shapes)
+            st.configs.append(paired_state(ob, model, K, M, modes, U))
         return st
 
-    def _config(self, ob: Observation, model, K, M) -> ConfigState:
-        modes = solve_modes(model, n_modes=self.n_modes(ob), K=K, M=M)
-        U = None if ob.shapes is None else np.asarray(ob.read @ modes.shapes)
-        return paired_state(ob, model, K, M, modes, U)
+    def _solved(self, systems) -> list:
+        """The modes of every configuration's (model, K, M). With spare cores
+        (:func:`pcbdyn.parallel.spare_cores`) the configurations are shared out by their last solve's
+        time, the longest first, each to the least loaded process, this one first among equals (a
+        declared mass off the board's plane couples its bending and membrane DOFs, and that
+        configuration's solve takes twice the others')."""
+        loads = [0.0] * (spare() + 1)
+        where = {}
+        for k in sorted(range(len(systems)), key=lambda k: -self._seconds.get(k, 0.0)):
+            where[k] = int(np.argmin(loads))
+            loads[where[k]] += self._seconds.get(k, 1.0)
+        away = {k: beside(_timed_modes, model, self.n_modes(ob), K, M)
+                for k, (ob, model, K, M) in enumerate(systems) if where[k]}
+        done = {k: _timed_modes(model, self.n_modes(ob), K, M)
+                for k, (ob, model, K, M) in enumerate(systems) if not where[k]}
+        done.update((k, f.result()) for k, f in away.items())
+        self._seconds.update((k, t) for k, (_, t) in done.items())
+        return [done[k][0] for k in range(len(systems))]
 
     @staticmethod
     def n_modes(ob: Observation) -> int:
@@ -309,6 +328,14 @@ class ModalResidual:
                     -1, lam.size, len(pairs))
             out.append(self._columns(ob, cs, BK, BM, static) * st.p[None, :])
         return np.vstack(out)
+
+
+def _timed_modes(model, n_modes: int, K, M) -> tuple:
+    """(the first ``n_modes`` modes of ``model`` with matrices K, M, the seconds the solve took): a
+    job :meth:`ModalResidual._solved` may send to a spare process."""
+    t = time.perf_counter()
+    modes = solve_modes(model, n_modes=n_modes, K=K, M=M)
+    return modes, time.perf_counter() - t
 
 
 def beyond_basis(cs: ConfigState, basis, F) -> np.ndarray:

@@ -1,5 +1,6 @@
 """The diagnosis residual (frequencies and MAC-paired shapes in noise units): its sensitivity columns
-against finite differences of full re-solves, and the shape-noise estimate against the noise put in."""
+against finite differences of full re-solves, the shape-noise estimate against the noise put in, and
+configurations re-solved on a spare process against the same solves in this process."""
 
 import numpy as np
 import pytest
@@ -8,11 +9,12 @@ import scipy.sparse as sp
 from pcbdyn import diagnosis as dg
 from pcbdyn.diagnosis.pipeline import _noise_sigmas
 from pcbdyn.diagnosis.residual import ModalResidual, Observation
-from pcbdyn.fe import EdgeSpringProperty, Model, ShellProperty
+from pcbdyn.fe import EdgeSpringProperty, MassProperty, Model, ShellProperty
 from pcbdyn.fe.assembly import assemble
 from pcbdyn.fe.generate import nodes_where, rectangle
 from pcbdyn.fe.modal import solve_modes
 from pcbdyn.fe.probe import model_probe
+from pcbdyn.parallel import spare, spare_cores
 from pcbdyn.testdata.noise import noisy_shapes
 
 from diagnosis_plates import measured
@@ -107,3 +109,33 @@ def test_shape_noise_estimate(plate, pct):
     noisy = Observation(None, measured(ob.f, noisy_shapes(phi, pct, seed=4)), ob.sigma_f, read, None)
     _, ss = _noise_sigmas(noisy, 0.2, None, basis)
     assert np.mean(ss) == pytest.approx(pct / 100 / np.sqrt(3), rel=0.25)
+
+
+def test_configurations_solved_beside_give_the_same_state(plate):
+    """Three configurations (the plate, with a 20 g mass, and with a mass whose inertia couples its
+    bending and membrane DOFs, so that it solves as one group) re-solved with a spare process give
+    the residual of the same solves in this process, bit for bit, whichever process solved which."""
+    res, cands, ob, _, _ = plate
+    inertias = (None, (1e-6, 1e-6, 1e-6), ((2e-6, 0.0, 1e-6), (0.0, 2e-6, 0.0), (1e-6, 0.0, 2e-6)))
+
+    def build(p):
+        out = []
+        for J in inertias:
+            m = res.build(p)[0]
+            if J is not None:
+                m.add("mass", "mass", [[40]], MassProperty(0.02, J))
+            out.append(m)
+        return out
+
+    def residual():
+        return ModalResidual([ob] * 3, build, res.derivatives, n_params=1)
+
+    alone = residual()
+    states = [alone.evaluate([24e9], cands[:1], [0.01]).r for _ in range(2)]
+    with spare_cores(2):
+        assert spare() == 1
+        beside = residual()
+        states += [beside.evaluate([24e9], cands[:1], [0.01]).r for _ in range(3)]  # the 2nd on measured times
+    assert spare() == 0
+    for r in states[1:]:
+        np.testing.assert_array_equal(r, states[0])

@@ -2,7 +2,8 @@
 pcbdyn.fe.threads): GNU OpenMP's idle threads do not survive a fork, and a forked worker waited for
 them forever at its first factorisation. pcbdyn caps OpenMP at one thread when imported, so that
 forking is safe; where a user chose more OpenMP threads, the workers start from a fork server, and
-what they share (here with a closure, as a built model holds) goes to them by cloudpickle."""
+what they share (here with a closure, as a built model holds) goes to them by cloudpickle. The spare
+processes of ``spare_cores`` serve only the process that made them."""
 
 import os
 import subprocess
@@ -53,3 +54,25 @@ def test_workers_after_a_factorisation_finish_with_the_parent_s_answer(tmp_path,
     was_capped, error = run.stdout.split()
     assert was_capped == str(capped)
     assert float(error) < 1e-12
+
+
+def _spare_in_job(i, shared):
+    from pcbdyn.parallel import spare
+
+    return spare()
+
+
+def test_spare_cores_serve_only_the_process_that_made_them():
+    """Within ``spare_cores(2)`` this process has one spare process, whose jobs run elsewhere (another
+    pid) and return their value; a worker forked by ``run_jobs`` meanwhile has none (it would wait on
+    a pool it does not own); after the block, none is left."""
+    from pcbdyn.parallel import beside, run_jobs, spare, spare_cores
+
+    with spare_cores(2):
+        assert spare() == 1
+        assert beside(os.getpid).result() != os.getpid()
+        assert beside(pow, 3, 4).result() == 81
+        assert dict(run_jobs(_spare_in_job, [(0,), (1,)], None, workers=2)) == {(0,): 0, (1,): 0}
+    assert spare() == 0
+    with spare_cores(1):
+        assert spare() == 0
