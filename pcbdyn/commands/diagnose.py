@@ -33,10 +33,11 @@ from .common import done, folder_outputs, input_errors, library_option, measured
                    "instead of two, candidates on a grid half as fine (still walked to place), one trial fit per kind "
                    "in each scan instead of two, and the masses found not carried onto the finer meshes")
 @click.option("--workers", type=click.IntRange(min=1), default=None,
-              help="local processes for the finer-mesh solves and the trial fits (default: the cores; 1: this process)")
+              help="local processes for the finer-mesh solves, the trial fits and the configurations of each "
+                   "re-solve (default: the cores; 1: this process)")
 @click.option("--scheduler", default=None,
-              help="a Dask scheduler address (tcp://host:8786): the finer-mesh solves and the trial fits run on "
-                   "that cluster (the findings do not depend on where they run)")
+              help="a Dask scheduler address (tcp://host:8786): the finer-mesh solves and the full trial fits run "
+                   "on that cluster, the rest on local processes (the findings do not depend on where they run)")
 @folder_outputs("folder for the board with the effects declared, the evidence map and tables",
                 "write effects, before/after and statistics as JSON",
                 force="replace an earlier <board>.diagnosed.toml beside the board (default: a numbered name)")
