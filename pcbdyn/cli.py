@@ -15,6 +15,7 @@ import click
 
 from .commands import (build, calibrate, correlate, diagnose, export, identify, import_kicad, library, localize,
                        simulate_test, study, update, vibe, wedgelock)
+from .fe.memory import plain_pages
 from .fe.threads import limit_process
 
 
@@ -43,6 +44,7 @@ def main():
     """Vibration of electronic equipment: build FE models of boards and housings, correlate them with
     modal tests, update them and find what they lack."""
     limit_process()  # one BLAS and OpenMP thread unless PCBDYN_BLAS_THREADS or the environment say otherwise
+    plain_pages()  # no huge-page advice on numpy's arrays (pcbdyn.fe.memory)
 
 
 for _module in (build, simulate_test, correlate, update, wedgelock, localize, study, diagnose, vibe, identify,
