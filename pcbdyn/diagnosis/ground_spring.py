@@ -13,6 +13,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..fe import SpringProperty
+from ..fe.elements.discrete import point_spring
 from ..fe.probe import model_probe
 from .catalogue import register, Blocks, Candidate, copy_model, node_candidates, on_nearest_node
 
@@ -64,9 +65,9 @@ def at_point(layout, xy) -> Candidate:
 
 
 def _derivative(candidate) -> np.ndarray:
-    """dK/dk on the candidate's nodes' DOFs: the spring's 6x6 at one node, (w w^T) (x) it at a point."""
-    w = np.asarray(candidate.data.get("point_weights", (1.0,)), float)
-    return np.kron(np.outer(w, w), _spring(candidate))
+    """dK/dk on the candidate's nodes' DOFs: the spring's 6x6 at one node, (w w^T) (x) it at a point
+    (the element's own matrix, :func:`pcbdyn.fe.elements.discrete.point_spring`)."""
+    return point_spring(candidate.data.get("point_weights", (1.0,)), _spring(candidate))
 
 
 def _spring(candidate) -> np.ndarray:

@@ -22,6 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..correlation.mac import mac
+from ..fe.mesh import DOF_NAMES, NDOF
 from ..fe.probe import ProbeError
 from .catalogue import effect_forms
 from .ground_spring import at_point
@@ -98,7 +99,7 @@ def _between_nodes(layout, rigid, points, nr: int, x):
     lies off the board or at infinity (a mode that only turns)."""
     nodes = layout.shell_nodes()
     X = np.column_stack([np.ones(nodes.size), layout.xy[nodes]])
-    A = np.linalg.lstsq(X, rigid[6 * nodes + 2], rcond=None)[0]  # (3, nr): w_r = [1, x, y] A
+    A = np.linalg.lstsq(X, rigid[NDOF * nodes + DOF_NAMES.index("uz")], rcond=None)[0]  # (3, nr): w_r = [1, x, y] A
     B = points[:, :nr] @ A.T  # the kernel's shape at the points, per [1, x, y]
     c = np.linalg.lstsq(np.column_stack([B, points[:, nr:]]), x[:, 0], rcond=None)[0][:3]
     if abs(c[0]) <= 1e-9 * np.abs(c).max():

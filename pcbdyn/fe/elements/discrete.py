@@ -15,14 +15,20 @@ def spring_stiffness(k) -> np.ndarray:
     return k
 
 
+def point_spring(weights, k) -> np.ndarray:
+    """The stiffness on a cell's nodes of a spring ``k`` (6x6) to ground at the point whose motion
+    ``weights`` (one per node) interpolate: (w w^T) (x) k (one node, weight 1: k itself)."""
+    w = np.asarray(weights, float)
+    return np.kron(np.outer(w, w), k)
+
+
 def spring_matrices(xyz: np.ndarray, prop):
     """Springs in global axes; 1-node cells tie to ground, 2-node cells tie the nodes together; with
     ``prop.weights`` a cell ties to ground the point its nodes interpolate: (w w^T) (x) k."""
     n_cells, nn, _ = xyz.shape
     k = spring_stiffness(prop.k)
     if prop.weights is not None:
-        w = np.asarray(prop.weights, float)
-        Ke = np.broadcast_to(np.kron(np.outer(w, w), k), (n_cells, 6 * nn, 6 * nn)).copy()
+        Ke = np.broadcast_to(point_spring(prop.weights, k), (n_cells, 6 * nn, 6 * nn)).copy()
     elif nn == 1:
         Ke = np.broadcast_to(k, (n_cells, 6, 6)).copy()
     else:
