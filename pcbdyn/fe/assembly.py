@@ -19,8 +19,10 @@ import scipy.sparse as sp
 from .elements import kernel
 from .mesh import NDOF
 
-#: element matrices are computed and summed this many cells at a time (bounds the peak memory)
-CHUNK_CELLS = 4096
+#: element matrices are computed and summed this many cells at a time: it bounds the peak memory,
+#: and the temporaries of 1024 quads (4.7 MB per array of 24 x 24 matrices) stay in cache where
+#: 4096 did not (112k-DOF plate: assembly 0.82 -> 0.68 s)
+CHUNK_CELLS = 1024
 _NN = NDOF * NDOF
 
 
