@@ -10,7 +10,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .model import ModelError
-from .sparsity import Gather, canonical_csr, selection
+from .sparsity import Gather, canonical_csr, row_counts, same_array, selection
 
 
 @dataclass
@@ -61,9 +61,13 @@ def build_reduction(model, K=None, M=None) -> Reduction:
     untouched = np.zeros(n, dtype=bool)
     if K is not None and M is not None:
         touched = np.zeros(n, dtype=bool)
-        for A in (K, M):  # symmetric: a DOF with a nonzero in its row has one in its column
-            A = A.tocsr()
-            touched[A.indices[A.data != 0]] = True
+        K, M = K.tocsr(), M.tocsr()
+        if same_array(K.indptr, M.indptr) and same_array(K.indices, M.indices):  # an assembled pair
+            held = [(K.indptr, (K.data != 0) | (M.data != 0))]
+        else:
+            held = [(A.indptr, A.data != 0) for A in (K, M)]
+        for indptr, nonzero in held:  # symmetric: a DOF with a nonzero in its column has one in its row
+            touched |= row_counts(indptr, nonzero) > 0
         for s, terms in slaves.items():  # a slave's stiffness reaches its masters
             if touched[s]:
                 for m, _ in terms:

@@ -25,6 +25,18 @@ def _same(a: np.ndarray, b: np.ndarray) -> bool:
     return same_array(a, b) or (a.shape == b.shape and np.array_equal(a, b))
 
 
+def row_counts(indptr: np.ndarray, mask: np.ndarray, rows: np.ndarray | None = None) -> np.ndarray:
+    """How many entries of each row ``rows`` (default: all) of a compressed pattern ``indptr`` have
+    ``mask`` (one bool per entry) set."""
+    starts = indptr[:-1] if rows is None else indptr[rows]
+    ends = indptr[1:] if rows is None else indptr[rows + 1]
+    padded = np.zeros(mask.size + 1, dtype=bool)  # a False past the end: reduceat may index it
+    padded[:-1] = mask
+    counts = np.add.reduceat(padded, starts, dtype=np.int32)
+    counts[starts == ends] = 0  # reduceat gives an empty row its next entry
+    return counts
+
+
 @dataclass
 class Gather:
     """The entries of a source pattern (``indptr``, ``indices``) where ``mask`` is set, forming a
@@ -45,10 +57,7 @@ class Gather:
         """The plan keeping the entries of CSR ``A`` where ``keep`` (one bool per entry, False in
         every row not in ``rows``) is set, the rows ``rows`` (sorted) of A becoming the new rows and
         ``cols`` (one per entry of A) giving the new column numbers."""
-        padded = np.zeros(keep.size + 1, dtype=bool)  # a False past the end: reduceat may index it
-        padded[:-1] = keep
-        counts = np.add.reduceat(padded, A.indptr[rows], dtype=np.int32)
-        counts[A.indptr[rows] == A.indptr[rows + 1]] = 0  # reduceat gives an empty row its next entry
+        counts = row_counts(A.indptr, keep, rows)
         sub_indptr = np.zeros(rows.size + 1, dtype=A.indices.dtype)
         np.cumsum(counts, out=sub_indptr[1:])
         return cls(A.indptr, A.indices, keep, sub_indptr, cols[keep], shape, fmt)
