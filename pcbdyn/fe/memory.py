@@ -17,7 +17,8 @@ glibc gives every block of 128 kB and more (32 MB once it has seen such blocks f
 too: each of a solve's many large temporaries (element matrices by chunk, gather masks, CSR value
 arrays, Lanczos blocks) then costs fresh zeroed pages, a fault per 4 kB. :func:`reuse_freed_memory`
 keeps freed memory in the process for the next arrays: the 112k-DOF plate 2.29-2.77 s against
-1.97-2.07 s (fresh processes alternated, three each), peak memory the same (588 MB).
+1.97-2.07 s (fresh processes alternated, three each), peak memory the same (588 MB); the 1M-DOF
+plate 28.7 -> 25.0 s, peak 4.92 -> 4.98 GB (tilted: 46.8 s, 6.75 GB).
 """
 
 from __future__ import annotations
@@ -41,7 +42,6 @@ def plain_pages() -> None:
     setter = getattr(getattr(core, "multiarray", None), "_set_madvise_hugepage", None)
     if setter is not None:
         setter(False)
-
 
 
 def reuse_freed_memory() -> None:

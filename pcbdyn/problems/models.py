@@ -15,7 +15,9 @@ def parameter_values(pm, names, p) -> dict:
 
 def parameter_derivatives(pm, names) -> list:
     """[(dK/dp, dM/dp)] (full size, before constraints) of each parameter of ``names`` at ``pm``'s
-    values; zero for a parameter ``pm`` does not have."""
+    values; zero for a parameter ``pm`` does not have. Central differences of the sets each touches:
+    for a one-off derivative (a library's frequency scatter); fits, which move ``p``, take theirs
+    from :class:`pcbdyn.fe.parametric_matrices.ParametricMatrices`."""
     n = pm.model.n_dof
     zero = sp.csr_matrix((n, n))
     return [pm.parameters[name].derivatives(pm) if name in pm.parameters else (zero, zero) for name in names]

@@ -9,11 +9,11 @@ import scipy.sparse as sp
 
 from ..correlation.pairing import pair_modes
 from ..domain import StructureError
-from ..fe.assembly import assemble
 from ..fe.constraints import build_reduction
+from ..fe.parametric_matrices import ParametricMatrices
 from ..fe.probe import model_probe
 from ..updating.matching import dynamic_basis
-from .models import parameter_derivatives, parameter_values
+from .models import parameter_values
 
 
 class ProblemError(StructureError):
@@ -23,13 +23,15 @@ class ProblemError(StructureError):
 
 class ConfigSystem:
     """``model(p)`` returns (K, M, dKs, dMs) reduced to the independent DOFs (CSC), one derivative pair per
-    parameter of ``names`` (zero for those the built model ``pm`` lacks), from the elements each
-    parameter touches (:meth:`pcbdyn.fe.parametric.Parameter.derivatives`). The last evaluation is
-    cached (the driver and its line search ask for the same p more than once)."""
+    parameter of ``names`` (zero for those the built model ``pm`` lacks), from the model's
+    :class:`pcbdyn.fe.parametric_matrices.ParametricMatrices`, as the diagnosis residual takes them
+    (:class:`pcbdyn.problems.StructureModels`): no element matrix is recomputed as ``p`` moves. The last
+    evaluation is cached (the driver and its line search ask for the same p more than once)."""
 
     def __init__(self, pm, names, label: str = "base"):
         self.pm, self.names, self.label = pm, list(names), label
-        K, M = assemble(pm.model)
+        self.parametric = ParametricMatrices(pm, self.names)
+        K, M = self.parametric.matrices([pm.parameters[n].value if n in pm.parameters else 0.0 for n in self.names])
         self.reduction = build_reduction(pm.model, K, M)
         self.n_rigid = 6 if pm.model.free else 0
         self._cache = (None, None)
@@ -40,10 +42,9 @@ class ConfigSystem:
         p = np.asarray(p, float)
         if self._cache[0] is not None and np.array_equal(self._cache[0], p):
             return self._cache[1]
-        pm = self.at(p)
         red = self.reduction.reduce
-        K, M = assemble(pm.model)
-        pairs = parameter_derivatives(pm, self.names)
+        K, M = self.parametric.matrices(p)
+        pairs = self.parametric.derivatives(p)
         out = (red(K), red(M), [red(dK) for dK, _ in pairs], [red(dM) for _, dM in pairs])
         self._cache = (p.copy(), out)
         return out
