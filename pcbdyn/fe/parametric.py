@@ -52,10 +52,14 @@ class Parameter:
     def quantities(self, value: float) -> dict:
         return {t: float(value) for t in self.targets}
 
+    def step(self, value: float, rel_step: float = 1e-4) -> float:
+        """The step of a central difference at ``value``: relative to it, or to the bounds at zero."""
+        return rel_step * (abs(value) if value != 0 else max(abs(self.bounds[0]), abs(self.bounds[1]), 1.0))
+
     def derivatives(self, pm: "ParametricModel", rel_step: float = 1e-4):
         """(dK/dp, dM/dp) at ``pm``'s value as full-size sparse matrices (before constraints)."""
         p = pm.quantities[self.targets[0]]
-        h = rel_step * (abs(p) if p != 0 else max(abs(self.bounds[0]), abs(self.bounds[1]), 1.0))
+        h = self.step(p, rel_step)
         sets = list(self.sets)
         Kp, Mp = assemble(pm.model, sets=sets, props=pm.properties(self.quantities(p + h)))
         Km, Mm = assemble(pm.model, sets=sets, props=pm.properties(self.quantities(p - h)))

@@ -9,7 +9,8 @@ sums of coefficient arrays times monomials: no element matrix is recomputed whil
 parameters (a fit of the six-part card's four parameters re-solves it hundreds of times). A set
 that fails the check (a quantity entering otherwise, such as a Timoshenko beam's shear term) or
 depends on more than :data:`MAX_PARAMS` parameters is made again from its property at each call,
-its derivatives by central differences as :meth:`.parametric.Parameter.derivatives` takes them.
+its derivatives by central differences with :meth:`.parametric.Parameter.step`, as
+:meth:`.parametric.Parameter.derivatives` takes them.
 
 All the matrices share one index (the model's assembled pattern, :class:`.assembly.SetAssembly`),
 so the solvers' caches keyed by pattern (symbolic factorisations, DOF groups and their order) hit.
@@ -165,7 +166,7 @@ class ParametricMatrices:
                 if s.coef is not None:
                     data[:, s.pos] += s.values(x, d=j) / self.half[j]
                 else:
-                    h = REL_STEP * (abs(p[j]) if p[j] != 0 else self.half[j])
+                    h = self.pm.parameters[self.names[j]].step(p[j], REL_STEP)
                     up, down = p.copy(), p.copy()
                     up[j], down[j] = p[j] + h, p[j] - h
                     data[:, s.pos] += (self._direct(s.name, up) - self._direct(s.name, down)) / (2 * h)
