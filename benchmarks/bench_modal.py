@@ -65,14 +65,11 @@ def plate(n: int, tilted: bool, support: str):
 
 def run_pcbdyn(n: int, tilted: bool, support: str, eigsh: bool) -> dict:
     """One size, measured in this (fresh) process."""
+    from pcbdyn.process import process_settings
     from pcbdyn.fe.assembly import assemble
-    from pcbdyn.fe.memory import plain_pages, reuse_freed_memory
     from pcbdyn.fe.modal import reduced_system, solve_modes
-    from pcbdyn.fe.threads import limit_process
 
-    limit_process()  # as the command line does: the BLAS/OpenMP limit for the whole run
-    plain_pages()  # and no huge-page advice on numpy's arrays
-    reuse_freed_memory()  # and freed memory kept for the next arrays
+    process_settings()  # as the command line does: thread limits, memory pages
     model, *_ = plate(n, tilted, support)
     t0, c0 = time.perf_counter(), time.process_time()
     K, M = assemble(model)

@@ -15,8 +15,7 @@ import click
 
 from .commands import (build, calibrate, correlate, diagnose, export, identify, import_kicad, library, localize,
                        simulate_test, study, update, vibe, wedgelock)
-from .fe.memory import plain_pages, reuse_freed_memory
-from .fe.threads import limit_process
+from .process import process_settings
 
 
 def _warning(message, category, filename, lineno, file=None, line=None):
@@ -43,9 +42,7 @@ class _Group(click.Group):
 def main():
     """Vibration of electronic equipment: build FE models of boards and housings, correlate them with
     modal tests, update them and find what they lack."""
-    limit_process()  # one BLAS and OpenMP thread unless PCBDYN_BLAS_THREADS or the environment say otherwise
-    plain_pages()  # no huge-page advice on numpy's arrays (pcbdyn.fe.memory)
-    reuse_freed_memory()  # and freed memory kept for the next arrays
+    process_settings()
 
 
 for _module in (build, simulate_test, correlate, update, wedgelock, localize, study, diagnose, vibe, identify,

@@ -38,6 +38,12 @@ class _Pickled:
         return cloudpickle.loads(self.blob)
 
 
+def _context():
+    """How worker processes start: forked where OpenMP is capped at one thread (forking is safe
+    then, :func:`pcbdyn.fe.threads.openmp_capped`), else from a fork server."""
+    return multiprocessing.get_context("fork" if openmp_capped() else "forkserver")
+
+
 def _init(shared) -> None:
     global _SHARED
     _SHARED = shared.load() if isinstance(shared, _Pickled) else shared
@@ -64,8 +70,7 @@ def run_jobs(fn, jobs, shared, workers: int | None = None, scheduler: str | None
             yield args, out
         return
     fork = openmp_capped()
-    context = multiprocessing.get_context("fork" if fork else "forkserver")
-    with ProcessPoolExecutor(min(workers, len(jobs)), context, initializer=_init,
+    with ProcessPoolExecutor(min(workers, len(jobs)), _context(), initializer=_init,
                              initargs=(shared if fork else _Pickled(shared),)) as pool:
         futures = {pool.submit(_call, fn, args): args for args in jobs}
         for fut in as_completed(futures):
@@ -120,7 +125,6 @@ def beside(fn, *args):
     global _SPARE
     pid, n, pool = _SPARE
     if pool is None:
-        context = multiprocessing.get_context("fork" if openmp_capped() else "forkserver")
-        pool = ProcessPoolExecutor(n, context)
+        pool = ProcessPoolExecutor(n, _context())
         _SPARE = (pid, n, pool)
     return pool.submit(fn, *args)
