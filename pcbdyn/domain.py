@@ -18,7 +18,9 @@ A structure has a ``name``, the ``path`` of its file, its ``parameters``
   their targets, the user's comments and layout kept; returns the path written;
 - ``write_enriched(effects, dst)``: its file with the effects a diagnosis found declared in it (the
   user's comments and layout kept); returns the path written;
-- ``outlines(config=None)``: what a mode-shape picture outlines (plain data: kind, label, points).
+- ``outlines(config=None)``: what a mode-shape picture outlines (plain data: kind, label, points);
+- a plate in one plane (on which a diagnosis looks for stiffeners) also has ``following(lines)``: a
+  copy whose meshes' element edges follow ``lines`` (polylines (m, 2) [m]) as well.
 
 A built model (:class:`pcbdyn.fe.parametric.ParametricModel`) adds what a diagnosis asks of it:
 ``layout_hints()`` (prime suspects, footprints, plate thickness) and ``with_shear_factor(f)``.

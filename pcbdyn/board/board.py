@@ -4,7 +4,7 @@ configuration, measurement points on the board, and the updated board.toml."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -51,6 +51,7 @@ class Board(Configured):
     stiffeners: list = field(default_factory=list)
     regions: list = field(default_factory=list)
     transverse_shear: float = 1.0  # factor on every shell's transverse shear stiffness
+    guides: list = field(default_factory=list)  # lines (m, 2) [m] element edges follow with nothing on them
 
     @property
     def thickness(self) -> float:
@@ -123,6 +124,11 @@ class Board(Configured):
     def outlines(self, config: str | None = None) -> list:
         """What a mode-shape picture outlines, as plain data (:func:`.outlines.board_outlines`)."""
         return board_outlines(self, config)
+
+    def following(self, lines) -> "Board":
+        """This board meshed so that element edges also follow ``lines`` (polylines (m, 2) [m]) with
+        nothing declared on them: where a diagnosis found stiffeners (:mod:`pcbdyn.diagnosis.conforming`)."""
+        return replace(self, guides=[np.asarray(line, float) for line in lines])
 
     def write_enriched(self, effects, dst, date: str | None = None) -> Path:
         """``dst``: this board.toml with the effects a diagnosis found declared (:mod:`.enrich`), written

@@ -68,11 +68,12 @@ def mesh_points(board, config, shared: bool = False) -> list:
 
 
 def mesh_lines(board) -> list:
-    """Polylines element edges must follow: edge springs, line masses and stiffener paths."""
+    """Polylines element edges must follow: edge springs, line masses, stiffener paths and the
+    board's guides (:meth:`.board.Board.following`)."""
     lines = [np.array(f.segment) for f in board.fixtures if f.type == "edge_spring"]
     lines += [np.array(e.segment) for e in board.line_masses]
     lines += [np.array(e.path) for e in board.stiffeners]
-    return lines
+    return lines + list(board.guides)
 
 
 def build_model(board, config: str | None = None, mesh_size: float | None = None,
