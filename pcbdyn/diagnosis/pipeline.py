@@ -391,7 +391,7 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
         _with_carried(models, res, sel.p, carried, forms, h, levels, runner)
         sel = adopt(sel, sel.chosen, estimate(res, sel.p, [cands[i] for i in sel.chosen], sel.values, 8, models.bounds),
                     penalty(res.n_rows, len(cands), alpha))
-    if lined is not None or carried and not quick:
+    if lined is not None or (carried and not quick):
         stats["mesh_resolved"] = [f.resolved for f in forms]
         stats["mesh_correction_pct"] = [np.round(100 * (o.f_scale - 1.0), 4).tolist() for o in obs]
         stats["plate_theory_pct"] = [np.round(100 * f.shift, 4).tolist() for f in forms]
