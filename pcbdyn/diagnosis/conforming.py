@@ -18,17 +18,15 @@ on OpenSees' data (``ho_al_bar``) at 69.7 mm for 70, 0.28 % after (0.69 %), for 
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 import numpy as np
 
 from ..domain import StructureError
-from ..fe.probe import model_probe
 from ..problems.models import StructureModels
 from .catalogue import kind, place
 from .fitting import Fit, estimate
 from .layout import from_structure
 from .residual import ModalResidual
+from .stiffener import line_axis
 
 #: [element sizes] the spacing of the three places of a stiffener's line whose chi^2 the parabola
 #: goes through (the search leaves a line within a quarter element of its best embedded place, and
@@ -55,29 +53,18 @@ def remeshed(structure, configs, names, h: float, observations, chosen: list) ->
     lines of the stiffeners among ``chosen`` (the observations re-read on it, their noise kept)."""
     lines = [np.asarray(c.geometry["path"], float) for c in chosen if c.kind == "stiffener"]
     models = StructureModels(structure.following(lines), configs, names, mesh_size=h, shared_mesh=True)
-    obs = [replace(ob, read=None if ob.shapes is None else
-                   model_probe(pm.model, ob.modes.xyz, ob.modes.directions, tol=0.02).P,
-                   sigma_f=ob.sigma_f.copy(), f_scale=ob.f_scale.copy())
-           for ob, pm in zip(observations, models.models)]
+    obs = [ob.read_on(pm.model) for ob, pm in zip(observations, models.models)]
     layout = from_structure(models.models[0])
     return models, ModalResidual.of_models(models, obs), [place(layout, c) for c in chosen]
-
-
-def along(c, path):
-    """Stiffener ``c`` on the straight line ``path`` (2, 2) [m] instead, named for it (a row
-    ``y=...`` or a column ``x=...``)."""
-    path = np.asarray(path, float)
-    (x0, y0), (x1, y1) = path
-    label = f"x={1e3 * x0:.4g}mm" if abs(x1 - x0) < abs(y1 - y0) else f"y={1e3 * y0:.4g}mm"
-    return replace(c, name=f"{kind('stiffener').name}@{label}", at=tuple(path.mean(axis=0)), geometry={**c.geometry, "path": path})
 
 
 def moved(chosen: list, j: int, offset: float) -> list:
     """``chosen`` with the stiffener at ``j`` moved across its line by ``offset`` [m]."""
     path = np.asarray(chosen[j].geometry["path"], float)[[0, -1]]
-    (x0, y0), (x1, y1) = path
+    shift = np.zeros(2)
+    shift[line_axis(path)] = offset
     out = list(chosen)
-    out[j] = along(chosen[j], path + ([offset, 0.0] if abs(x1 - x0) < abs(y1 - y0) else [0.0, offset]))
+    out[j] = kind("stiffener").along(chosen[j], path + shift)
     return out
 
 

@@ -43,7 +43,7 @@ from scipy.stats import chi2 as chi2_dist
 
 from ..domain import StructureError
 from ..fe.modal import solve_modes
-from ..fe.probe import ProbeError, model_probe, segment_parameter
+from ..fe.probe import ProbeError, segment_parameter
 from ..parallel import spare_cores
 from ..problems.models import StructureModels, parameter_values
 from .bodies import as_bodies
@@ -51,7 +51,7 @@ from .catalogue import KINDS, generate, kind, weighted_centre
 from .layout import from_structure
 from . import conforming, finer
 from .model_form import MESH_LEVELS, discretisation, fit_plate_share, kirchhoff_shift
-from .residual import ModalResidual, Observation
+from .residual import ModalResidual, Observation, reading
 from .fitting import estimate
 from .scan import Runner
 from .select import ALPHA, adopt, penalty, refine, search, without_vanished
@@ -115,7 +115,7 @@ def _observations(tests, models) -> list:
     for (c, mm), pm in zip(tests, models):
         ob = Observation(c, mm, np.ones(mm.n_modes))
         if mm.shapes is not None:
-            ob.read = model_probe(pm.model, mm.xyz, mm.directions, tol=0.02).P
+            ob.read = reading(pm.model, mm.xyz, mm.directions)
             ob.sigma_s = np.ones(mm.n_modes)  # until the noise is known
         obs.append(ob)
     return obs
@@ -217,7 +217,7 @@ def _on_lines(models, res, cands, sel, forms, h, levels: int, runner, alpha, say
     keep = []
     for g in _neighbours(chosen, MERGE_REACH * h):
         if len(g) > 1 and all(chosen[k].kind == "stiffener" for k in g):
-            chosen[g[0]] = conforming.along(chosen[g[0]], _mean_path([chosen[k] for k in g], values[g]))
+            chosen[g[0]] = kind("stiffener").along(chosen[g[0]], _mean_path([chosen[k] for k in g], values[g]))
             values[g[0]] = values[g].sum()
             g = g[:1]
         keep += g

@@ -21,7 +21,7 @@ approximate; every fit is confirmed on full re-solves.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -29,11 +29,23 @@ from ..correlation.mac import mac
 from ..correlation.pairing import pair_modes
 from ..fe.assembly import assemble
 from ..fe.modal import solve_modes
+from ..fe.probe import model_probe
 from ..parallel import beside, spare
 from ..testdata import Modes
 from ..updating.sensitivity import bilinear_forms, eigen_derivatives
 from .catalogue import effect_forms
 from .combined import Effects
+
+
+#: [m] farthest a test point may lie from the model's surface and still be read (a point on a
+#: coarse mesh's chord of a curved outline)
+READ_TOL = 0.02
+
+
+def reading(model, xyz, directions):
+    """The matrix (points x DOFs) that reads ``model``'s displacements at test points ``xyz`` [m]
+    along ``directions``, through the shell shape functions."""
+    return model_probe(model, xyz, directions, tol=READ_TOL).P
 
 
 @dataclass
@@ -68,6 +80,11 @@ class Observation:
     @property
     def numbers(self) -> np.ndarray:
         return self.modes.numbers
+
+    def read_on(self, model) -> "Observation":
+        """This observation (noise and correction kept) read on ``model``'s mesh."""
+        return replace(self, read=None if self.shapes is None else reading(model, self.modes.xyz, self.modes.directions),
+                       sigma_f=self.sigma_f.copy(), f_scale=self.f_scale.copy())
 
     def subset(self, keep) -> "Observation":
         """The observation of the measured modes ``keep`` (a boolean mask or indices)."""

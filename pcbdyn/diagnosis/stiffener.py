@@ -14,6 +14,8 @@ proportional to b, hence to EI. Defaults: aluminium (70 GPa, 2700 kg/m^3), h = 4
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from ..board.effects import rib_property
@@ -51,9 +53,17 @@ class _Stiffener:
     def parallel(self, layout, candidate, offsets) -> list:
         """Full-span lines parallel to ``candidate`` (a row or column of :meth:`generate`), moved
         across by ``offsets`` [m]: finer places around a rib found on the first grid."""
-        (x0, y0), (x1, y1) = candidate.geometry["path"]
-        axis = 0 if abs(x1 - x0) < abs(y1 - y0) else 1  # a column x = const, else a row y = const
-        return self._lines(layout, axis, (x0, y0)[axis] + np.asarray(offsets, float))
+        path = np.asarray(candidate.geometry["path"], float)
+        axis = line_axis(path)
+        return self._lines(layout, axis, path[0, axis] + np.asarray(offsets, float))
+
+    def along(self, candidate, path):
+        """``candidate`` on the full-span straight line ``path`` (2, 2) [m] instead, named for it (a
+        rib moved to where another mesh, on which it is placed (:meth:`place`), follows it)."""
+        path = np.asarray(path, float)[[0, -1]]
+        axis = line_axis(path)
+        return replace(candidate, name=f"{self.name}@{_label(axis, path[0, axis])}", at=tuple(path.mean(axis=0)),
+                       geometry={**candidate.geometry, "path": path})
 
     def _lines(self, layout, axis: int, values) -> list:
         """Full-span lines x = v (``axis`` 0) or y = v (1) that cross the plate."""
@@ -62,7 +72,7 @@ class _Stiffener:
         for v in values:
             p0, p1 = lo.copy(), hi.copy()
             p0[axis] = p1[axis] = v
-            c = self.candidate(layout, f"{'xy'[axis]}={1e3 * v:.4g}mm", p0, p1)
+            c = self.candidate(layout, _label(axis, v), p0, p1)
             if c is not None:
                 out.append(c)
         return out
@@ -103,6 +113,17 @@ class _Stiffener:
         m = copy_model(model)
         m.add(f"effects.{candidate.name}", "embedded_beam2", candidate.data["conn"], self._property(value, candidate))
         return m
+
+
+def line_axis(path) -> int:
+    """0 for a column (x constant along ``path``), 1 for a row (y constant)."""
+    (x0, y0), (x1, y1) = np.asarray(path, float)[[0, -1]]
+    return 0 if abs(x1 - x0) < abs(y1 - y0) else 1
+
+
+def _label(axis: int, v: float) -> str:
+    """The name of the row or column at ``v`` [m]: ``x=<mm>mm`` (``axis`` 0) or ``y=<mm>mm``."""
+    return f"{'xy'[axis]}={1e3 * v:.4g}mm"
 
 
 def _extent(layout):
