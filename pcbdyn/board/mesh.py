@@ -7,7 +7,9 @@ must be nodes (standoffs, point masses, part centres, measurement points). Trian
 recombined into quads (frontal-Delaunay triangles + blossom recombination), which gives an
 all-quad mesh for most layouts (gmsh's "frontal-Delaunay for quads", algorithm 8, folded a few
 elements at small standoff pads, so algorithm 6 is used); when some triangles remain, the board is meshed at twice the size and every cell is
-split into quads (gmsh's all-quad subdivision), so the result is always all-quad at ``size``.
+split into quads (gmsh's all-quad subdivision), so the result is all-quad at ``size``. Where either
+pass folds an element (recombination can, in slivers between close footprints), the surfaces that
+folded keep their triangles: a mixed mesh rather than a refusal.
 """
 
 from __future__ import annotations
@@ -125,19 +127,48 @@ def gmsh_session(name: str):
 def generate_quads(gmsh, size: float) -> None:
     """Quads at ``size`` (frontal-Delaunay triangles recombined by blossom); where triangles remain, the
     mesh twice as coarse with every cell split into quads, by the frontal-Delaunay for quads (algorithm
-    6 on this pass gave other meshes run to run)."""
-    gmsh.option.setNumber("Mesh.Algorithm", 6)
-    gmsh.option.setNumber("Mesh.RecombineAll", 1)
-    gmsh.option.setNumber("Mesh.RecombinationAlgorithm", 1)
+    6 on this pass gave other meshes run to run). Where either folds an element (recombination can, in
+    the slivers between close footprints), the surfaces that folded keep the triangles of the first pass
+    and the others its quads: a mixed mesh, never a folded one."""
     gmsh.option.setNumber("Mesh.MeshSizeMin", 0.0)
-    gmsh.option.setNumber("Mesh.MeshSizeMax", size)
-    gmsh.model.mesh.generate(2)
-    if 2 in gmsh.model.mesh.getElementTypes(2):
+    gmsh.option.setNumber("Mesh.RecombinationAlgorithm", 1)
+    _generate(gmsh, size, 6, recombine=True)
+    folded = folded_surfaces(gmsh)
+    if 2 not in gmsh.model.mesh.getElementTypes(2) and not folded:
+        return
+    if not folded:
         gmsh.model.mesh.clear()
-        gmsh.option.setNumber("Mesh.Algorithm", 8)
-        gmsh.option.setNumber("Mesh.MeshSizeMax", 2.0 * size)
         gmsh.option.setNumber("Mesh.SubdivisionAlgorithm", 1)
-        gmsh.model.mesh.generate(2)
+        _generate(gmsh, 2.0 * size, 8, recombine=True)
+        gmsh.option.setNumber("Mesh.SubdivisionAlgorithm", 0)
+        if not folded_surfaces(gmsh):
+            return
+    gmsh.model.mesh.clear()
+    _generate(gmsh, size, 6, recombine=[t for _, t in gmsh.model.getEntities(2) if t not in folded])
+
+
+def _generate(gmsh, size: float, algorithm: int, recombine) -> None:
+    """A 2-D mesh at ``size`` by gmsh's ``algorithm``, its triangles recombined into quads on every surface
+    (``recombine`` True) or on the surfaces listed."""
+    gmsh.option.setNumber("Mesh.Algorithm", algorithm)
+    gmsh.option.setNumber("Mesh.MeshSizeMax", size)
+    gmsh.option.setNumber("Mesh.RecombineAll", 1 if recombine is True else 0)
+    if recombine is not True:
+        for t in recombine:
+            gmsh.model.mesh.setRecombine(2, t)
+    gmsh.model.mesh.generate(2)
+
+
+def folded_surfaces(gmsh) -> set:
+    """The surfaces whose elements do not all turn the same way in the xy plane (a folded element)."""
+    xyz, index = mesh_nodes(gmsh)
+    out = set()
+    for _, t in gmsh.model.getEntities(2):
+        for conn in surface_cells(gmsh, t, index):
+            area = _signed_area(xyz, conn)
+            if area.size and area.min() < 0 < area.max():
+                out.add(t)
+    return out
 
 
 def mesh_nodes(gmsh) -> tuple:

@@ -108,3 +108,21 @@ def test_a_kept_mesh_is_handed_out_as_a_copy():
     assert len(mesh_board(outline, [], [[0.05, 0.04]], 0.005).nodes) > len(nodes)
     square = np.array([[0.02, 0.02], [0.04, 0.02], [0.04, 0.04], [0.02, 0.04]])
     assert "U1" in mesh_board(outline, [("U1", square)], [[0.05, 0.04]], 0.01).cells
+
+
+def test_crowded_parts_mesh_without_folds():
+    """A layout whose quad recombination folds elements between close footprints meshes all the same:
+    the surfaces that folded keep triangles, none is inverted, the mesh covers the board once, and the
+    first frequencies agree with the board meshed twice as fine (a sound mixed mesh)."""
+    from pcbdyn.fe.modal import solve_modes
+
+    board = load_board(DATA / "crowded_parts.toml")
+    coarse = build_model(board)
+    areas = np.concatenate([_area(coarse.model.nodes, es.conn) for es in coarse.model.sets.values()
+                            if es.etype in ("quad4", "tri3")])
+    assert areas.min() > 0
+    assert areas.sum() == pytest.approx(board.outline.area(), rel=1e-12)
+    fine = build_model(board, mesh_size=board.mesh_size / 2)
+    f_c = solve_modes(coarse.model, n_modes=6).frequencies
+    f_f = solve_modes(fine.model, n_modes=6).frequencies
+    assert np.allclose(f_c, f_f, rtol=0.02)

@@ -26,7 +26,13 @@ Conversion (OpenSees node tag = pcbdyn node index + 1; the model's fixed DOFs be
   nodes of its footprint (pcbdyn ties the body to the least-squares rigid motion of the
   footprint; one node's rotations alone would carry a large inertia as a local rocking mode on
   a fine mesh).
-- embedded_beam2 and multi-point constraints: not supported (NotImplementedError).
+- multi-point constraints: a node tied to one other by all six rows of a rigid link (a standoff's
+  pad to its centre) becomes ``rigidLink('beam')``; a node whose rows follow several nodes (a lumped
+  part that moves with its footprint's rigid motion) has its mass and rotary inertia shared equally
+  by those nodes and is held (OpenSees has no general linear constraint: the part then acts on its
+  footprint's nodes, not on their least-squares plane, a modelling difference of its own).
+  Anything else raises NotImplementedError.
+- embedded_beam2: not supported (NotImplementedError).
 """
 
 from __future__ import annotations
@@ -126,10 +132,26 @@ def _beams(model, es, ele, trf, extra) -> None:
                         "-mass", p.rho * p.A, "-cMass")
 
 
+def _constraints(model) -> tuple:
+    """(rigid links [(master, slave)], followers {node: [nodes it follows]}) of ``model.mpcs``."""
+    rows: dict = {}
+    for s, terms in model.mpcs:
+        rows.setdefault(s // 6, []).append((s % 6, terms))
+    links, followers = [], {}
+    for node, rs in rows.items():
+        masters = sorted({m // 6 for _, terms in rs for m, _ in terms})
+        if len(masters) == 1 and sorted(d for d, _ in rs) == list(range(6)):
+            links.append((masters[0], node))
+        elif len(masters) > 1:
+            followers[node] = masters
+        else:
+            raise NotImplementedError(f"multi-point constraint of node {node}: {rs}")
+    return links, followers
+
+
 def build_opensees(model, shell: str = "ShellDKGQ") -> None:
     """Build ``model`` in the (wiped) OpenSees domain."""
-    if model.mpcs:
-        raise NotImplementedError("multi-point constraints (model.mpcs) are not converted")
+    links, followers = _constraints(model)
     if shell not in SHELLS:
         raise ValueError(f"shell must be one of {sorted(SHELLS)}")
     ops.wipe()
@@ -185,6 +207,12 @@ def build_opensees(model, shell: str = "ShellDKGQ") -> None:
             raise NotImplementedError(f"element type {es.etype}")
         if es.etype != "mass":
             stiff[np.unique(conn)] = True
+    for node, masters in followers.items():
+        mass[masters] += mass[node] / len(masters)
+        mass[node] = 0.0
+    for master, slave in links:
+        ops.rigidLink("beam", int(master) + 1, int(slave) + 1)
+        stiff[[master, slave]] = True
     for i in np.flatnonzero(mass.any(axis=1)):
         ops.mass(int(i) + 1, *mass[i].tolist())
     flags = np.zeros((n, 6), dtype=int)

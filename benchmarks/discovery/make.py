@@ -1,0 +1,135 @@
+"""A drawn case (:mod:`cases`) made into files: the handed board.toml, points.csv, the test (UFF
+with pcbdyn's noise model) of the truth solved in OpenSees on a mesh twice as fine as the model's,
+and truth.json (the case, its exact frequencies). Made on demand from the seed and kept in a cache
+outside git (``PCBDYN_DISCOVERY_CACHE``, default ``~/.cache/pcbdyn/discovery``); a folder made by the
+same code for the same seed is reused.
+
+    python benchmarks/discovery/make.py 0-9 [--cache DIR]
+
+needs openseespy (``pip install -e .[discovery]``: an extra, not a core dependency).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import sys
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+
+from cases import Case, draw  # noqa: E402
+from toml_text import board_text  # noqa: E402
+
+#: the truth is meshed this many times finer than the model
+TRUTH_REFINEMENT = 2.0
+#: modes solved beyond those tested, so that in-plane modes (a board on soft standoffs sliding on them)
+#: can be left out: a test in z does not see them
+EXTRA_MODES = 6
+#: the least share of a mode's translations out of the plane for a z test to measure it
+MIN_BENDING = 0.3
+#: damping of the simulated test's modes (written to the UFF; diagnose does not use it)
+ZETA = 0.01
+
+
+def cache_dir() -> Path:
+    return Path(os.environ.get("PCBDYN_DISCOVERY_CACHE", Path.home() / ".cache" / "pcbdyn" / "discovery"))
+
+
+def code_key() -> str:
+    """A digest of the generator's own code: a cached case made by other code is made again."""
+    h = hashlib.sha1()
+    for name in ("cases.py", "toml_text.py", "make.py", "opensees_truth.py", "detectability.py"):
+        h.update((HERE / name).read_bytes())
+    return h.hexdigest()[:12]
+
+
+def make(seed: int, cache: Path | None = None) -> Path:
+    """The folder of case ``seed`` (made if missing): board.toml, points.csv, test.uff, truth.json."""
+    folder = (cache or cache_dir()) / f"s{seed:04d}"
+    tj = folder / "truth.json"
+    key = code_key()
+    if tj.exists() and json.loads(tj.read_text()).get("key") == key and (folder / "test.uff").exists():
+        return folder
+    folder.mkdir(parents=True, exist_ok=True)
+    case = draw(seed)
+    (folder / "board.toml").write_text(board_text(case))
+    (folder / "truth.toml").write_text(board_text(case, truth=True, mesh_mm=case.mesh_mm / TRUTH_REFINEMENT))
+    from detectability import effect_chi2
+
+    frequencies = _solve_and_write(case, folder)
+    tj.write_text(json.dumps({"key": key, "case": case.to_json(), "frequencies_hz": frequencies,
+                              "signal_chi2": effect_chi2(case)}, indent=1))
+    return folder
+
+
+def _solve_and_write(case: Case, folder: Path) -> list:
+    from opensees_truth import solve_opensees
+
+    from pcbdyn.board import build_model, load_board
+    from pcbdyn.fe.modal import Modes as ModelModes
+    from pcbdyn.fe.probe import model_probe
+    from pcbdyn.testdata.csvio import write_points_csv
+    from pcbdyn.testdata.data import Dofs, Points
+    from pcbdyn.testdata.noise import Noise
+    from pcbdyn.testdata.simulate import simulate_test
+    from pcbdyn.testdata.uff import write_uff
+
+    tb = load_board(folder / "truth.toml")
+    model = build_model(tb, None, tb.mesh_size, shared_mesh=True).model
+    f, shapes = solve_opensees(model, case.test_modes + EXTRA_MODES, shell=case.shell)
+    keep = np.flatnonzero(bending_share(shapes[:, :3]) >= MIN_BENDING)[:case.test_modes]
+    f, shapes = f[keep], shapes[..., keep]
+    xy = 1e-3 * np.asarray(case.points, float)
+    ids = np.arange(1, len(xy) + 1)
+    points = Points(ids, np.column_stack([xy, np.zeros(len(xy))]))
+    dofs = Dofs(ids, np.tile([0.0, 0.0, 1.0], (len(ids), 1)))
+    write_points_csv(folder / "points.csv", points, dofs)
+    read = model_probe(model, points.xyz, dofs.directions, tol=0.02).P
+    z = np.asarray(read @ shapes.reshape(-1, shapes.shape[-1]))
+    modes = ModelModes(f, z, np.zeros((len(ids), 0)), None)
+    test = simulate_test(modes, points, dofs, np.eye(len(ids)), zeta=ZETA,
+                         noise=Noise(frequency_pct=case.noise[0], shape_pct=case.noise[1]), seed=case.seed)
+    write_uff(folder / "test.uff", test)
+    return [float(v) for v in f]
+
+
+def bending_share(u) -> np.ndarray:
+    """Per mode, the share of the translations ``u`` (n_nodes, 3, n_modes) along z."""
+    return np.linalg.norm(u[:, 2], axis=0) / np.linalg.norm(u.reshape(-1, u.shape[-1]), axis=0)
+
+
+def seeds(text: str) -> list:
+    """'0-9,15' -> [0, ..., 9, 15]."""
+    out = []
+    for part in text.split(","):
+        a, _, b = part.partition("-")
+        out += list(range(int(a), int(b or a) + 1))
+    return out
+
+
+def main(argv=None):
+    import argparse
+    import time
+
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("seeds", help="e.g. 0-9 or 1000-1004,1010")
+    ap.add_argument("--cache", default=None)
+    a = ap.parse_args(argv)
+    for s in seeds(a.seeds):
+        t0 = time.perf_counter()
+        folder = make(s, Path(a.cache) if a.cache else None)
+        t = json.loads((folder / "truth.json").read_text())
+        c = t["case"]
+        print(f"s{s:04d} {c['hold']:<10} parts {len(c['parts']):>2}  effects "
+              f"{','.join(e['kind'] for e in c['effects']) or '-':<28} chi2 "
+              f"{','.join(f'{v:.3g}' for v in t['signal_chi2']) or '-':<16} f1 {t['frequencies_hz'][0]:8.1f} Hz "
+              f"({time.perf_counter() - t0:.0f} s)", flush=True)
+
+
+if __name__ == "__main__":
+    main()

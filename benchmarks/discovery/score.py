@@ -1,0 +1,122 @@
+"""Judging a diagnosis of a drawn case against its truth (issue 37's acceptance, per case).
+
+Each hidden effect is one or two *atoms*, each a kind diagnose reports (its JSON ``type``), a place
+and a magnitude: a bracket is a point mass and a ground spring at one point, a heat sink a region
+whose stiffness changes by E_sink / E_board - 1 and a point mass at its centre, an undeclared
+standoff a ground spring (rigid: its stiffness is not judged). An atom is found when a reported
+effect of its type lies within :data:`PLACE_MM` (points, regions: from the region's centre, 0 inside
+the reported polygon) or :data:`LINE_MM` (stiffeners, line masses, edge stiffness: the farther of
+the two ends' distances to the reported line) and its magnitude is within :data:`MAGNITUDE` of the
+truth. A reported effect that matches no atom (of any size, by type and place) is invented.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+PLACE_MM = 15.0
+LINE_MM = 30.0
+MAGNITUDE = 0.30
+LINES = ("stiffener", "line_mass", "edge_stiffness")
+
+
+def atoms(case: dict, E_board: float) -> list:
+    """[(effect index, type, geometry {at | segment | rect}, magnitude or None)] of the case's effects."""
+    out = []
+    for i, e in enumerate(case["effects"]):
+        k = e["kind"]
+        if k in ("point_mass", "bracket"):
+            out.append((i, "point_mass", {"at": e["at"]}, e["mass"]))
+        if k in ("bracket", "ground_spring"):
+            out.append((i, "ground_spring", {"at": e["at"]}, e["k"]))
+        if k == "standoff":
+            out.append((i, "ground_spring", {"at": e["at"]}, None))
+        if k == "stiffener":
+            out.append((i, "stiffener", {"segment": e["path"]}, e["EI"]))
+        if k == "line_mass":
+            out.append((i, "line_mass", {"segment": e["segment"]}, e["mass"]))
+        if k == "edge_stiffness":
+            out.append((i, "edge_stiffness", {"segment": e["segment"]}, e["k_rot"]))
+        if k == "heat_sink":
+            (x, y), (a, b) = e["at"], e["size"]
+            out.append((i, "region_stiffness", {"rect": [x - a / 2, y - b / 2, x + a / 2, y + b / 2]},
+                        e["E"] / E_board - 1.0))
+            out.append((i, "point_mass", {"at": e["at"]}, e["mass"]))
+        if k == "region":
+            out.append((i, "region_stiffness", {"rect": e["rect"]}, e["factor"] - 1.0))
+    return out
+
+
+def _to_polyline(p, pts) -> float:
+    pts = np.asarray(pts, float).reshape(-1, 2)
+    if len(pts) == 1:
+        return float(np.linalg.norm(p - pts[0]))
+    a, b = pts[:-1], pts[1:]
+    ab = b - a
+    t = np.clip(np.einsum("ij,ij->i", p - a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-300), 0.0, 1.0)
+    return float(np.linalg.norm(a + t[:, None] * ab - p, axis=1).min())
+
+
+def _reported_line(r: dict):
+    for key in ("path_mm", "segment_mm"):
+        if r.get(key):
+            return np.asarray(r[key], float)
+    return np.asarray([r["at_mm"]], float)
+
+
+def distance(r: dict, geometry: dict) -> float:
+    """[mm] how far reported effect ``r`` lies from an atom's geometry."""
+    if "segment" in geometry:
+        line = _reported_line(r)
+        return max(_to_polyline(np.asarray(p, float), line) for p in geometry["segment"])
+    if "rect" in geometry:
+        x0, y0, x1, y1 = geometry["rect"]
+        p = np.array([(x0 + x1) / 2, (y0 + y1) / 2])
+    else:
+        p = np.asarray(geometry["at"], float)
+    if r.get("polygon_mm"):
+        from matplotlib.path import Path as PolyPath
+
+        poly = np.asarray(r["polygon_mm"], float)
+        if PolyPath(poly).contains_point(p):
+            return 0.0
+    return float(np.linalg.norm(np.asarray(r["at_mm"], float) - p))
+
+
+def judge(truth: dict, result: dict, detectable_chi2: float) -> dict:
+    """Per case: atoms (found or not, detectable or not, magnitude error, 2-sigma covered), the
+    reported effects that match no atom (invented), noise-only cleanliness and the errors."""
+    case = truth["case"]
+    E_board = next((p["true"] for p in case["parameters"] if p["name"] == "E_board"), case["E"])
+    reported = result.get("effects", []) if result else []
+    used = set()
+    rows = []
+    for i, typ, geom, mag in atoms(case, E_board):
+        tol = LINE_MM if typ in LINES else PLACE_MM
+        same = [(distance(r, geom), j) for j, r in enumerate(reported) if r.get("type") == typ]
+        d, j = min(same) if same else (np.inf, None)
+        row = {"effect": i, "kind": case["effects"][i]["kind"], "type": typ, "magnitude": mag,
+               "detectable": truth["signal_chi2"][i] >= detectable_chi2, "chi2": truth["signal_chi2"][i],
+               "distance_mm": d, "placed": d <= tol}
+        if j is not None and d <= tol:
+            used.add(j)
+            r = reported[j]
+            row["reported"] = r["magnitude"]
+            row["sigma"] = r.get("uncertainty")
+            if mag is None:
+                row.update(sized=True, covered=None)
+            else:
+                row["sized"] = abs(r["magnitude"] / mag - 1.0) <= MAGNITUDE
+                row["covered"] = abs(r["magnitude"] - mag) <= 2.0 * (r.get("uncertainty") or 0.0)
+        row["found"] = bool(row["placed"] and row.get("sized", False))
+        rows.append(row)
+    invented = [r for j, r in enumerate(reported) if j not in used and not any(
+        r.get("type") == typ and distance(r, g) <= 2 * (LINE_MM if typ in LINES else PLACE_MM)
+        for _, typ, g, _ in atoms(case, E_board))]
+    out = {"atoms": rows, "invented": [(r.get("type"), r.get("at_mm")) for r in invented],
+           "n_reported": len(reported), "noise_only_case": not case["effects"]}
+    if result:
+        out.update(before=result["before"]["max_freq_error_pct"],
+                   parameters_only=result["parameters_only"]["max_freq_error_pct"],
+                   after=result["after"]["max_freq_error_pct"], noise_only=result.get("noise_only"))
+    return out
