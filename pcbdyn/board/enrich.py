@@ -9,7 +9,8 @@ An effect is a dict (the shape of ``pcbdyn.diagnosis.Candidate`` kind/name/at/ge
      "name": str, "value": float (SI: kg, kg m^2, N/m, N m/rad/m, kg, N m^2, or the relative
      stiffness change s of a region, whose stiffness factor is 1 + s),
      "at": (x, y) [m], "segment": [[x, y], [x, y]] (edge_stiffness, line_mass),
-     "path": [[x, y], ...] (stiffener), "polygon": [[x, y], ...] (region_stiffness)}
+     "path": [[x, y], ...] (stiffener; "height" [m]: its section's, default aluminium 4 mm),
+     "polygon": [[x, y], ...] (region_stiffness)}
 
 A point_mass and a point_inertia at the same point become one ``[[masses]]`` entry.
 """
@@ -25,7 +26,7 @@ import tomlkit
 
 from .. import targets
 from ..inputs import entry_name, new_entry_name
-from .entries import MIN_SEGMENT, BoardError
+from .entries import MIN_SEGMENT, BoardError, RibSection
 
 TYPES = ("point_mass", "point_inertia", "ground_spring", "edge_stiffness", "line_mass", "stiffener",
          "region_stiffness")
@@ -109,9 +110,12 @@ def _entries(effects, names) -> list:
                 "name": names("line_masses", name), "from": _point(a), "to": _point(b),
                 "mass": targets.formatted(kind["line_masses", "mass"], v)}))
         elif typ == "stiffener":
-            out.append(("stiffeners", f"{name}: rib (aluminium, 4 mm high)", {
-                "name": names("stiffeners", name), "path": [_point(p) for p in e["path"]],
-                "EI": targets.formatted(kind["stiffeners", "EI"], v)}))
+            fields = {"name": names("stiffeners", name), "path": [_point(p) for p in e["path"]],
+                      "EI": targets.formatted(kind["stiffeners", "EI"], v)}
+            h = e.get("height", RibSection().h)
+            if h != RibSection().h:
+                fields["section"] = {"height": targets.quantity(h, "mm")}
+            out.append(("stiffeners", f"{name}: rib (aluminium, {1e3 * h:.3g} mm high)", fields))
         elif typ == "region_stiffness":
             out.append(("regions", f"{name}: stiffness changed by {100 * v:.4g} %", {
                 "name": names("regions", name), "polygon": [_point(p) for p in _outline(e["polygon"])],

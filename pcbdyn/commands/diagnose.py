@@ -17,6 +17,9 @@ import click
 from ..diagnosis import KINDS
 from .common import done, folder_outputs, input_errors, library_option, measured_configurations, parse_noise, result_path, step
 
+#: the correlation summaries of a diagnosis (JSON: max error, mean MAC, pairs per configuration)
+STATES = ("before", "parameters_only", "after")
+
 
 @click.command("diagnose")
 @click.argument("board_toml", type=click.Path(exists=True, dir_okay=False, path_type=Path))
@@ -65,25 +68,39 @@ def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size,
         tests = measured_configurations(board, test_uff, configs)
         ms = to_si(mesh_size, "mm", "--mesh-size") if mesh_size else None
         t0 = step("diagnosing")
-        d = diagnose(board, tests, freq_pct, shape_pct, mesh_size=ms, kinds=chosen, max_effects=max_effects,
-                     progress=lambda msg: click.echo(f"    {msg}", err=True), quick=quick, workers=workers,
-                     scheduler=scheduler)
+        record: dict = {}
+        try:
+            d = diagnose(board, tests, freq_pct, shape_pct, mesh_size=ms, kinds=chosen, max_effects=max_effects,
+                         progress=lambda msg: click.echo(f"    {msg}", err=True), quick=quick, workers=workers,
+                         scheduler=scheduler, record=record)
+        except Exception as exc:
+            if json_path is not None and not isinstance(exc, (KeyError, ValueError)):  # a bug: keep what was computed
+                write_json(json_path, {"complete": False, "error": f"{type(exc).__name__}: {exc}",
+                                       **{k: rep.summary(v) if k in STATES else v for k, v in record.items()}})
+            raise
         done(t0)
     click.echo(f"\n{board.name}: {d.message}\n")
     click.echo(rep.format_effects(d.effects))
     click.echo("")
     click.echo(rep.format_states(d.before, d.parameters_only, d.after))
-    enriched, written = None, []
+    enriched = None
     if d.effects:
         try:
             enriched = board.write_enriched(rep.enriched_effects(d), result_path(out, board_toml, "diagnosed", force))
-            written.append(enriched)
             click.echo(f"\nboard with the effects declared written to {enriched}", err=True)
         except StructureError as exc:
             click.echo(f"\nnote: the enriched board.toml was not written: {exc}", err=True)
+    if json_path is not None:  # first: pictures that fail must not lose the findings
+        write_json(json_path, {
+            "complete": True, "effects": d.effects, "noise_only": d.noise_only, "message": d.message,
+            "before": rep.summary(d.before), "parameters_only": rep.summary(d.parameters_only),
+            "after": rep.summary(d.after), "parameters": d.parameters, "statistics": d.statistics,
+            "enriched_board": None if enriched is None else str(enriched),
+        })
     if out is not None:
         from ..report.manifest import settle
 
+        written = [] if enriched is None else [enriched]
         written += [out / "effects.txt", out / "correlation.txt"]
         write_text(written[-2], rep.format_effects(d.effects) + "\n")
         write_text(written[-1], rep.format_states(d.before, d.parameters_only, d.after) + "\n")
@@ -91,10 +108,3 @@ def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size,
             written.append(out / "evidence.png")
             rep.plot_evidence(written[-1], board, d.evidence, d.effects)
         settle(out, written, "pcbdyn diagnose")
-    if json_path is not None:
-        write_json(json_path, {
-            "effects": d.effects, "noise_only": d.noise_only, "message": d.message,
-            "before": rep.summary(d.before), "parameters_only": rep.summary(d.parameters_only),
-            "after": rep.summary(d.after), "parameters": d.parameters, "statistics": d.statistics,
-            "enriched_board": None if enriched is None else str(enriched),
-        })

@@ -283,18 +283,21 @@ class AlongSides:
     def generate(self, layout, segments: int = 4) -> list:
         if not layout.planar:  # sides of a plate in one plane only
             return []
-        return [chain_candidate(self.name, layout, f"{side}[{i}]", chain)
-                for side, i, chain in layout.segment_runs(segments)]
+        return [chain_candidate(self.name, layout, f"{side}[{i}]" if i == j else f"{side}[{i}-{j}]", chain,
+                                run=(side, i, j)) for side, (i, j), chain in layout.segment_runs(segments)]
 
     def place(self, layout, candidate):
         return chain_candidate(self.name, layout, "placed", layout.side_chain(candidate.geometry["segment"]))
 
 
-def chain_candidate(kind_name: str, layout, label: str, chain: np.ndarray) -> Candidate:
+def chain_candidate(kind_name: str, layout, label: str, chain: np.ndarray, run=None) -> Candidate:
     """A candidate along a node chain of a boundary segment; ``at`` is the point of the chain
-    halfway along its length."""
+    halfway along its length; ``run``: (side, first piece, last piece) where it is a run of a side's
+    pieces (:meth:`.layout.Layout.segment_runs`), kept in ``data`` for the local moves."""
     p = layout.xy[chain]
     s = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))]
     mid = np.array([np.interp(0.5 * s[-1], s, p[:, 0]), np.interp(0.5 * s[-1], s, p[:, 1])])
-    return Candidate(kind_name, f"{kind_name}@{label}", tuple(mid), chain, {"segment": p[[0, -1]]},
-                     {"edges": np.column_stack([chain[:-1], chain[1:]]), "length": float(s[-1])})
+    data = {"edges": np.column_stack([chain[:-1], chain[1:]]), "length": float(s[-1])}
+    if run is not None:
+        data["run"] = run
+    return Candidate(kind_name, f"{kind_name}@{label}", tuple(mid), chain, {"segment": p[[0, -1]]}, data)

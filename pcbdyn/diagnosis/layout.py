@@ -119,9 +119,9 @@ class Layout:
         return out
 
     def segment_runs(self, n: int) -> list:
-        """[(side name, label, node chain)]: every run of consecutive pieces of :meth:`segments`
-        (label "i" for piece i alone, "i-j" for pieces i to j, the whole side included), so that an
-        effect over part of a side is one candidate wherever it starts and ends on the n cuts."""
+        """[(side name, (i, j), node chain)]: every run of consecutive pieces i to j of :meth:`segments`
+        (i = j: one piece; the whole side included), so that an effect over part of a side is one
+        candidate wherever it starts and ends on the n cuts."""
         pieces: dict = {}
         for name, i, chain in self.segments(n):
             pieces.setdefault(name, []).append(chain)
@@ -130,7 +130,7 @@ class Layout:
             for i in range(len(chains)):
                 for j in range(i, len(chains)):
                     run = np.concatenate([chains[i]] + [c[1:] for c in chains[i + 1:j + 1]])
-                    out.append((name, f"{i}" if i == j else f"{i}-{j}", run))
+                    out.append((name, (i, j), run))
         return out
 
     def nearest_node(self, xy) -> int:

@@ -22,7 +22,7 @@ whether what remains is noise, and otherwise find, place and size the effects th
    magnitudes estimated together with the declared parameters, each effect kept only if it
    also predicts data it was not fitted to; runs along the sides, stiffener lines and
    rectangular regions are walked to where they fit best (:func:`.select.refine`,
-   :class:`LocalMoves`) and a mass with an inertia beside it refitted as one body
+   :class:`.moves.LocalMoves`) and a mass with an inertia beside it refitted as one body
    (:mod:`.bodies`). The masses (and supports) found are then put on the finer meshes and the mesh
    correction measured again (:func:`_with_carried`: they change the shapes it depends on); where
    stiffeners were found, the structure is meshed along their lines first, every effect carried,
@@ -33,30 +33,29 @@ whether what remains is noise, and otherwise find, place and size the effects th
 
 from __future__ import annotations
 
-import math
-import re
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
-import shapely
 from scipy.stats import chi2 as chi2_dist
 
 from ..domain import StructureError
 from ..fe.modal import solve_modes
-from ..fe.probe import ProbeError, segment_parameter
 from ..parallel import spare_cores
 from ..problems.models import StructureModels, parameter_values
 from .bodies import as_bodies
-from .catalogue import KINDS, generate, kind, weighted_centre
+from .catalogue import KINDS, generate, kind
+from .evidence import evidence
 from .layout import from_structure
-from . import conforming, finer
+from .merge import MERGE_REACH, groups, mean_path, merged
+from .moves import LocalMoves, movable
+from . import conforming, finer, geometry_fit
 from .model_form import MESH_LEVELS, discretisation, fit_plate_share, kirchhoff_shift
 from .residual import ModalResidual, Observation, reading
 from .fitting import estimate
 from .scan import Runner
 from .select import ALPHA, adopt, penalty, refine, search, without_vanished
 from .support import supports
-from .uncertainty import jackknife_cov, parts
+from .uncertainty import jackknife_cov
 
 #: kinds whose effects :func:`_with_carried` carries onto the finer meshes
 MASS_KINDS = ("point_mass", "point_inertia", "line_mass")
@@ -206,18 +205,18 @@ def _with_carried(models, res, p, carried, forms, h, levels: int, runner, kirchh
 def _on_lines(models, res, cands, sel, forms, h, levels: int, runner, alpha, say):
     """(models, residual, candidates, selection) after :mod:`.conforming`'s stage, or None where the
     structure cannot be meshed along the lines found: parallel stiffeners fitted as shares of one
-    rib (:func:`_linked`) made that rib (their summed EI on their weighted mean line), the structure
+    rib (:func:`.merge.linked`) made that rib (their summed EI on their weighted mean line), the structure
     meshed along the stiffeners, the mesh correction measured there with every effect found carried
     onto the finer meshes (a rib on a row of nodes is the same on any mesh) with the plate theory's
-    gap, each line walked across to its least chi^2 (the correction measured again where a line
-    went further than :data:`.conforming.REMEASURE`), and the declared parameters and magnitudes
-    refitted. ``cands`` is returned with the chosen effects replaced by
+    gap, the ribs' ends and sections fitted there with the declared parameters and magnitudes
+    (:mod:`.geometry_fit`; the correction measured again where a rib went further than
+    :data:`.conforming.REMEASURE`). ``cands`` is returned with the chosen effects replaced by
     their places on the new mesh (same indices: the selection's penalty keeps its count)."""
     idx, chosen, values = list(sel.chosen), [cands[i] for i in sel.chosen], np.asarray(sel.values, float).copy()
     keep = []
-    for g in _neighbours(chosen, MERGE_REACH * h):
+    for g in groups(chosen, MERGE_REACH * h):
         if len(g) > 1 and all(chosen[k].kind == "stiffener" for k in g):
-            chosen[g[0]] = kind("stiffener").along(chosen[g[0]], _mean_path([chosen[k] for k in g], values[g]))
+            chosen[g[0]] = kind("stiffener").along(chosen[g[0]], mean_path([chosen[k] for k in g], values[g]))
             values[g[0]] = values[g].sum()
             g = g[:1]
         keep += g
@@ -232,27 +231,14 @@ def _on_lines(models, res, cands, sel, forms, h, levels: int, runner, alpha, say
         return None
     _with_carried(models, res, sel.p, list(zip(placed, values)), forms, h, levels, runner, kirchhoff=True)
     fit = estimate(res, sel.p, placed, values, conforming.STEPS, models.bounds)
-    for j, c in enumerate(chosen):
-        if c.kind != "stiffener":
-            continue
-        moved = 0.0
-        for _ in range(conforming.WALKS):
-            say(f"walking {chosen[j].name} across its line")
-            offset = conforming.walk(*base, res.observations, chosen, j, fit, models.bounds, runner)
-            if not offset:
-                break
-            there = conforming.moved(chosen, j, offset)
-            try:
-                trial = conforming.fit_at(*base, res.observations, there, fit.p, fit.values, models.bounds)
-            except StructureError:  # not meshed there: the line stays
-                break
-            if not trial[3].chi2 < fit.chi2:  # the parabola's vertex is no better: the line stays
-                break
-            (models, res, placed, fit), chosen, moved = trial, there, moved + offset
-            if abs(offset) < conforming.WALK * h * (1.0 - 1e-9):  # an inner vertex: the walk has arrived
-                break
-        if abs(moved) > conforming.REMEASURE * h:
-            say(f"  {chosen[j].name}: the mesh correction measured there")
+    say("fitting the stiffeners' ends, directions and sections on meshes along them")
+    ribs = geometry_fit.fit_ribs(*base, res.observations, placed, fit.p, fit.values, models.bounds, runner)
+    if ribs is not None and ribs.fit.chi2 < fit.chi2:
+        moved = max(float(np.abs(np.asarray(a.geometry["path"]) - np.asarray(b.geometry["path"])).max())
+                    for a, b in zip(placed, ribs.placed) if a.kind == "stiffener")
+        models, res, placed, fit = ribs.models, ribs.res, ribs.placed, ribs.fit
+        if moved > conforming.REMEASURE * h:
+            say("  the mesh correction measured where the stiffeners went")
             _with_carried(models, res, fit.p, list(zip(placed, fit.values)), forms, h, levels, runner, kirchhoff=True)
             fit = estimate(res, fit.p, placed, fit.values, conforming.STEPS, models.bounds)
     out = list(cands)
@@ -289,7 +275,7 @@ def _range_test(res, base, n_params, alpha) -> dict:
 
 def diagnose(structure, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_size=None, kinds=None,
              max_effects: int = 3, alpha: float = ALPHA, progress=None, workers: int | None = None,
-             scheduler=None, quick: bool = False) -> Diagnosis:
+             scheduler=None, quick: bool = False, record: dict | None = None) -> Diagnosis:
     """Diagnose ``structure`` (a board, or any structure of :mod:`pcbdyn.domain`) against ``tests`` =
     [(configuration name or None, :class:`pcbdyn.testdata.Modes`)]. ``workers`` local processes (None:
     the cores; 1: this process) or the Dask cluster at ``scheduler`` run the independent solves of
@@ -299,14 +285,17 @@ def diagnose(structure, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_s
     the candidates on a grid half as fine (:data:`QUICK_CANDIDATE_OPTIONS`, the local search still
     walks them to place), one trial per kind in each scan instead of two, and the masses found not
     carried onto the finer meshes to measure the correction again. The configurations of each
-    re-solve share the local cores (:func:`pcbdyn.parallel.spare_cores`)."""
+    re-solve share the local cores (:func:`pcbdyn.parallel.spare_cores`). ``record``: a dict that the
+    diagnosis fills as it goes (``before``, ``parameters_only``: summaries of the states;
+    ``parameters``, ``statistics``), so that a caller still has what was computed when a later step
+    fails."""
     with spare_cores(workers):
         return _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kinds, max_effects, alpha,
-                         progress, workers, scheduler, quick)
+                         progress, workers, scheduler, quick, {} if record is None else record)
 
 
 def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kinds, max_effects, alpha, progress,
-              workers, scheduler, quick) -> Diagnosis:
+              workers, scheduler, quick, record) -> Diagnosis:
     say = progress or (lambda msg: None)
     runner = Runner(workers, scheduler, lambda msg: say(f"  {msg}"))
     h = mesh_size or structure.mesh_size
@@ -317,6 +306,7 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
     res = ModalResidual.of_models(models, obs)
     say("solving the model as given")
     before = res.evaluate(p0)
+    record["before"] = before.summary(obs)
     unmatched = {ob.name or "base": (np.flatnonzero(~cs.matched) + 1).tolist() for ob, cs in zip(obs, before.configs)}
     support, shown, left, bounce = [], {}, unmatched, [np.zeros(ob.f.size, bool) for ob in obs]
     if any(unmatched.values()):  # modes the model has no partner for (MAC < 0.3): local modes of what it lacks
@@ -350,6 +340,7 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
     out = dict(before=before.summary(obs), parameters_only=(res.evaluate(base.p) if support else base.state).summary(obs),
                parameters={n: {"initial": float(a), "parameters_only": float(b)} for n, a, b in zip(names, p0, base.p)},
                statistics=stats)
+    record.update(out)
     if stats["p_value_noise"] > alpha and not any(unmatched.values()):
         for n, v in zip(names, base.p):
             out["parameters"][n]["final"] = float(v)
@@ -371,12 +362,12 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
         start = estimate(res, base.p, [cands[i] for i in held], [v for _, v in support], 10, models.bounds)
     sel = search(res, cands, p0, models.bounds, max_effects=max_effects, shortlist=1 if quick else 2, alpha=alpha,
                  base=start, runner=runner, held=held)
-    if any(_movable(cands[i]) for i in sel.chosen):
+    if any(movable(cands[i]) for i in sel.chosen):
         say("refining where the effects along the sides begin and end, where stiffeners run and what regions cover")
         sel = refine(res, cands, sel, LocalMoves(layout, cands, h), models.bounds, alpha=alpha, runner=runner)
     if {"point_mass", "point_inertia"} <= {cands[i].kind for i in sel.chosen}:
         say("fitting a part found as a mass with an inertia beside it as one body")
-        sel = as_bodies(res, cands, sel, _neighbours([cands[i] for i in sel.chosen], MERGE_REACH * h),
+        sel = as_bodies(res, cands, sel, groups([cands[i] for i in sel.chosen], MERGE_REACH * h),
                         MERGE_REACH * h, models.bounds, alpha=alpha)
     sel = without_vanished(res, cands, sel, models.bounds, alpha=alpha)
     carried = [(cands[i], v) for i, v in zip(sel.chosen, sel.values) if cands[i].kind in MASS_KINDS or cands[i].between_nodes]
@@ -404,7 +395,7 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
         out["parameters"][n]["final"] = float(v)
     chosen = [cands[i] for i in sel.chosen]
     cov_jack = jackknife_cov(res, sel.state, chosen, np.array([c.spec.scale for c in chosen]))
-    effects = [_merged(chosen, sel.values, sel.cov, cov_jack, g) for g in _neighbours(chosen, MERGE_REACH * h)]
+    effects = [merged(chosen, sel.values, sel.cov, cov_jack, g) for g in groups(chosen, MERGE_REACH * h)]
     if effects:
         msg = f"{len(effects)} effect(s) the model lacks: " + "; ".join(
             f"{e['type']} ({e['parameter']}) at {e['at_mm']} mm" for e in effects)
@@ -420,220 +411,5 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
                 "from them (a spring to ground)")
     if any(left.values()):
         msg += f"; test modes with no model partner (MAC < 0.3), left out of the fit: {left}"
-    return Diagnosis(effects, False, msg, after=sel.state.summary(obs), evidence=_evidence(plain, base.state, searched),
+    return Diagnosis(effects, False, msg, after=sel.state.summary(obs), evidence=evidence(plain, base.state, searched),
                      candidates=chosen, **out)
-
-
-#: the name of a candidate over a run of pieces of a side: "<kind>@<side>[i]" or "[i-j]"
-RUN = re.compile(r"^(?P<base>.+)\[(?P<i>\d+)(?:-(?P<j>\d+))?\]$")
-#: the name of a stiffener row or column: "stiffener@y=<value>mm" or "stiffener@x=<value>mm"
-LINE = re.compile(r"^(?P<base>.+@[xy])=(?P<v>[-0-9.e]+)mm$")
-
-
-def _movable(cand) -> bool:
-    """A candidate :class:`LocalMoves` can move (a run of pieces of a side, a stiffener line, a
-    rectangular region, a point between nodes)."""
-    return bool(RUN.match(cand.name) or LINE.match(cand.name) or _rectangle(cand) is not None or cand.between_nodes)
-
-
-def _rectangle(cand):
-    """(x0, y0, x1, y1) [m] of a region candidate whose polygon is an axis-aligned rectangle, else None."""
-    if cand.kind != "region_stiffness" or np.shape(cand.geometry["polygon"])[1] != 2:
-        return None
-    poly = np.asarray(cand.geometry["polygon"], float)
-    lo, hi = poly.min(axis=0), poly.max(axis=0)
-    on_box = np.all(np.isclose(poly[:, :1], [lo[0], hi[0]]).any(axis=1) & np.isclose(poly[:, 1:], [lo[1], hi[1]]).any(axis=1))
-    return (*lo, *hi) if len(poly) == 4 and on_box else None
-
-
-class LocalMoves:
-    """neighbours(i) for :func:`.select.refine`: for a run of pieces of a side, the runs of the
-    same kind and side that start and end at most one piece from its own; for a stiffener line,
-    the lines half an element (:data:`LINE_STEP`) to either side; for a rectangular region, the
-    rectangles with one side moved by one element (:data:`RECT_STEP`) in or out; for a point
-    between nodes (a support, :mod:`.support`), the points a quarter element (:data:`POINT_STEP`)
-    away along x and y.
-    Lines, rectangles and points are made on demand and appended to ``cands`` (the first grid
-    places an effect within a grid step; these walk it to where it is)."""
-
-    def __init__(self, layout, cands: list, h: float):
-        self.layout, self.cands, self.h = layout, cands, h
-        plate = layout.xy[layout.shell_nodes()]
-        self.lo, self.hi = plate.min(axis=0), plate.max(axis=0)
-        self.index = {c.name: k for k, c in enumerate(cands)}
-        self.runs: dict = {}
-        for k, c in enumerate(cands):
-            if m := RUN.match(c.name):
-                self.runs.setdefault(m["base"], {})[(int(m["i"]), int(m["j"] or m["i"]))] = k
-
-    def _add(self, made) -> list:
-        out = []
-        for c in made:
-            if c.name not in self.index:
-                self.index[c.name] = len(self.cands)
-                self.cands.append(c)
-            out.append(self.index[c.name])
-        return out
-
-    def __call__(self, k) -> list:
-        c = self.cands[k]
-        if m := RUN.match(c.name):
-            i, j = int(m["i"]), int(m["j"] or m["i"])
-            side = self.runs[m["base"]]
-            return [side[(a, b)] for a in (i - 1, i, i + 1) for b in (j - 1, j, j + 1)
-                    if (a, b) != (i, j) and (a, b) in side]
-        if LINE.match(c.name):
-            return self._add(kind("stiffener").parallel(self.layout, c, LINE_STEP * self.h * np.array([-1.0, 1.0])))
-        if c.between_nodes:
-            step, made = POINT_STEP * self.h, []
-            for d in ((step, 0.0), (-step, 0.0), (0.0, step), (0.0, -step)):
-                try:
-                    made.append(c.spec.place(self.layout, replace(c, at=(c.at[0] + d[0], c.at[1] + d[1]))))
-                except ProbeError:  # off the board
-                    continue
-            return self._add(made)
-        if (box := _rectangle(c)) is not None:
-            lo, hi, step, made = self.lo, self.hi, RECT_STEP * self.h, []
-            for side in range(4):
-                for d in (-step, step):
-                    b = np.array(box)
-                    b[side] = np.clip(b[side] + d, lo[side % 2], hi[side % 2])
-                    if b[2] - b[0] >= step and b[3] - b[1] >= step and not np.allclose(b, box):
-                        made.append(kind("region_stiffness").rectangle(self.layout, *b))
-            return self._add([r for r in made if r is not None])
-        return []
-
-
-#: [element sizes] how far a stiffener line moves in one step of the local search (:func:`_on_lines`
-#: then walks it to a fraction of this on meshes along it; twice as far in a step as a point moves:
-#: the bar of ``ho_al_bar``, found as two lines, took 22 s of local search in quarter steps, 13 s in
-#: halves)
-LINE_STEP = 0.5
-#: [element sizes] how far a point between nodes moves in one step of the local search
-POINT_STEP = 0.25
-#: [element sizes] how far a side of a rectangular region moves in one step of the local search
-RECT_STEP = 1.0
-
-
-#: kinds that act at one node: an effect between nodes is shared by its neighbours
-POINT_KINDS = ("point_mass", "point_inertia", "ground_spring")
-#: [element sizes] how far apart shares of one effect may be found (an unstructured mesh puts the
-#: nodes around a point up to about two elements apart)
-MERGE_REACH = 2.6
-
-
-def _linked(a, b, reach: float) -> bool:
-    """Two chosen effects that are one: point effects of one kind within ``reach`` [m] (a mass or a
-    spring between nodes is fitted as shares on the nodes around it), or a point mass within
-    ``reach`` of a line mass (a mass spread over part of an edge is fitted as a line plus points),
-    line masses whose segments overlap or lie within ``reach``, parallel stiffeners within
-    ``reach`` (a rib between two lines is fitted as shares on both), or overlapping rectangular
-    regions (a region between two is fitted as both)."""
-    if a.kind == b.kind and a.kind in POINT_KINDS:
-        return math.dist(a.at, b.at) <= reach
-    if a.kind == b.kind == "region_stiffness" and None not in (ra := _rectangle(a), rb := _rectangle(b)):
-        return min(ra[2], rb[2]) > max(ra[0], rb[0]) and min(ra[3], rb[3]) > max(ra[1], rb[1])  # they overlap
-    if a.kind == b.kind == "stiffener":
-        da, db = (np.diff(np.asarray(c.geometry["path"], float)[[0, -1]], axis=0)[0] for c in (a, b))
-        parallel = abs(da[0] * db[1] - da[1] * db[0]) <= 1e-6 * np.linalg.norm(da) * np.linalg.norm(db)
-        return parallel and _segment_gap(a.geometry["path"], b.geometry["path"]) <= reach
-    if a.kind == b.kind == "line_mass":  # masses along one stretch of a side add up
-        return _segment_gap(a.geometry["segment"], b.geometry["segment"]) <= reach
-    if {a.kind, b.kind} == {"point_mass", "line_mass"}:
-        line, point = (a, b) if a.kind == "line_mass" else (b, a)
-        return _to_segment(np.asarray(point.at, float)[:2], np.asarray(line.geometry["segment"], float)) <= reach
-    return False
-
-
-def _to_segment(p, seg) -> float:
-    """Distance [m] from point ``p`` to the straight segment ``seg`` (2, 2)."""
-    a, b = seg[:1], seg[1:]
-    return float(np.linalg.norm(a + segment_parameter(p[None], a, b)[:, None] * (b - a) - p))
-
-
-def _segment_gap(s, t) -> float:
-    """Shortest distance [m] between two straight segments (0 where they overlap or cross)."""
-    s, t = np.asarray(s, float), np.asarray(t, float)
-
-    def side(a, b, p):  # sign of p's side of the line a-b
-        (u, v), (w, z) = b - a, p - a
-        return np.sign(u * z - v * w)
-
-    if side(*s, t[0]) * side(*s, t[1]) < 0 and side(*t, s[0]) * side(*t, s[1]) < 0:
-        return 0.0  # they cross
-    return min([_to_segment(p, t) for p in s] + [_to_segment(p, s) for p in t])
-
-
-def _neighbours(chosen, reach: float) -> list:
-    """Groups of chosen effects linked (:func:`_linked`) directly or through others, reported as one."""
-    from scipy.sparse.csgraph import connected_components
-
-    n = len(chosen)
-    link = np.eye(n, dtype=bool)
-    for a in range(n):
-        for b in range(a + 1, n):
-            link[a, b] = link[b, a] = _linked(chosen[a], chosen[b], reach)
-    _, label = connected_components(link, directed=False)
-    return [np.flatnonzero(label == g).tolist() for g in dict.fromkeys(label.tolist())]
-
-
-def _merged(chosen, values, cov, cov_jack, group) -> dict:
-    """One effect entry (JSON-ready) for a group: the magnitudes summed at their weighted centre (on
-    line masses: the place and extent of the largest; parallel stiffeners: their weighted mean
-    path; overlapping regions: the mean change over the area they cover, their union, which keeps
-    the change's integral over the board), the uncertainty of that combination from the fit's
-    covariance ``cov``, the jackknife's ``cov_jack`` and the model-form budget
-    (:func:`.uncertainty.parts`)."""
-    lines = [k for k in group if chosen[k].kind == "line_mass"]
-    c = chosen[max(lines, key=lambda k: values[k]) if lines else group[0]]
-    d = c.describe()
-    v = np.asarray(values, float)[group]
-    w = np.ones(v.size)  # the combination reported: a sum, or for regions an area-weighted mean
-    if len(group) > 1:
-        d["name"] = "+".join(chosen[k].name for k in group)
-        d["merged_at_mm"] = np.round(1e3 * np.array([chosen[k].at for k in group]), 3).tolist()
-        if c.kind == "region_stiffness":
-            boxes = [shapely.box(*_rectangle(chosen[k])) for k in group]
-            union = shapely.union_all(boxes)
-            w = np.array([b.area for b in boxes]) / union.area
-            d["polygon_mm"] = np.round(1e3 * np.asarray(union.exterior.coords)[:-1], 3).tolist()
-            d["at_mm"] = np.round(1e3 * np.asarray(union.centroid.coords)[0], 3).tolist()
-        elif not lines:
-            d["at_mm"] = np.round(1e3 * weighted_centre([chosen[k] for k in group], v), 3).tolist()
-        if c.kind == "stiffener":
-            d["path_mm"] = np.round(1e3 * _mean_path([chosen[k] for k in group], v), 3).tolist()
-    sub = np.ix_(group, group)
-    u = parts(float(w @ v), w, cov[sub] if cov.size else cov, cov_jack[sub])
-    d.update(magnitude=float(w @ v), uncertainty=u.pop("total"), uncertainty_parts=u, kind=c.kind)
-    return d
-
-
-def _mean_path(stiffeners, values) -> np.ndarray:
-    """The line (2, 2) [m] of parallel ``stiffeners`` fitted as shares of one rib: their end
-    points' mean weighted by their ``values`` (EI)."""
-    v = np.asarray(values, float)
-    share = v / v.sum() if v.sum() > 0 else np.full(v.size, 1.0 / v.size)
-    paths = np.array([np.asarray(c.geometry["path"], float)[[0, -1]] for c in stiffeners])
-    return np.einsum("g,gij->ij", share, paths)
-
-
-def _evidence(res, state, cands) -> dict:
-    """{kind: (xy, chi^2 removed)} for the node kinds: the linear chi^2 drop of a candidate at each
-    node, the declared parameters projected out (the map of where the residual points)."""
-    out = {}
-    for name in ("point_mass", "ground_spring"):
-        idx = [i for i, c in enumerate(cands) if c.kind == name]
-        if not idx:
-            continue
-        A = res.effect_columns(state, [cands[i] for i in idx])
-        P = res.param_columns(state)
-        if P.shape[1]:
-            Q, _ = np.linalg.qr(P)
-            A, r = A - Q @ (Q.T @ A), state.r - Q @ (Q.T @ state.r)
-        else:
-            r = state.r
-        n2 = np.einsum("ij,ij->j", A, A)
-        gain = np.where(n2 > 0, (A.T @ r) ** 2 / np.where(n2 > 0, n2, 1.0), 0.0)
-        gain[(A.T @ r) < 0] = 0.0  # negative magnitudes are not physical
-        out[name] = (np.array([cands[i].at for i in idx]), gain)
-    return out

@@ -38,65 +38,84 @@ class _Stiffener:
         self.section = section
 
     def generate(self, layout, path_spacing: float = 0.02) -> list:
-        """Full-span rows (along x) and columns (along y) every ``path_spacing`` [m]."""
+        """Lines across the whole plate in :data:`DIRECTIONS`, ``path_spacing`` [m] apart: a bar at any
+        angle and of any length starts from the line it lies nearest (its ends and direction are
+        fitted after, :mod:`.geometry_fit`)."""
         if not path_spacing > 0:
             raise ValueError(f"path_spacing must be > 0 m, got {path_spacing}")
-        if not layout.planar:  # rows and columns of a plate in one plane only
+        if not layout.planar:  # lines of a plate in one plane only
             return []
         lo, hi = _extent(layout)
+        centre = 0.5 * (lo + hi)
         out = []
-        for axis in (1, 0):
-            n = max(1, int(round((hi[axis] - lo[axis]) / path_spacing)))
-            out += self._lines(layout, axis, lo[axis] + (np.arange(n) + 0.5) * (hi[axis] - lo[axis]) / n)
+        for angle in DIRECTIONS:
+            d = np.array([np.cos(angle), np.sin(angle)])
+            d[np.abs(d) < 1e-12] = 0.0
+            across = np.array([-d[1], d[0]])
+            half = 0.5 * float(np.abs(hi - lo) @ np.abs(across))  # the plate's half-width across the lines
+            n = max(1, int(round(2.0 * half / path_spacing)))
+            for s in -half + (np.arange(n) + 0.5) * (2.0 * half / n):
+                ends = _clipped(centre + s * across, d, lo, hi)
+                c = None if ends is None else self.candidate(layout, None, *ends)
+                if c is not None:
+                    out.append(c)
         return out
 
     def parallel(self, layout, candidate, offsets) -> list:
-        """Full-span lines parallel to ``candidate`` (a row or column of :meth:`generate`), moved
-        across by ``offsets`` [m]: finer places around a rib found on the first grid."""
-        path = np.asarray(candidate.geometry["path"], float)
-        axis = line_axis(path)
-        return self._lines(layout, axis, path[0, axis] + np.asarray(offsets, float))
-
-    def along(self, candidate, path):
-        """``candidate`` on the full-span straight line ``path`` (2, 2) [m] instead, named for it (a
-        rib moved to where another mesh, on which it is placed (:meth:`place`), follows it)."""
-        path = np.asarray(path, float)[[0, -1]]
-        axis = line_axis(path)
-        return replace(candidate, name=f"{self.name}@{_label(axis, path[0, axis])}", at=tuple(path.mean(axis=0)),
-                       geometry={**candidate.geometry, "path": path})
-
-    def _lines(self, layout, axis: int, values) -> list:
-        """Full-span lines x = v (``axis`` 0) or y = v (1) that cross the plate."""
-        lo, hi = _extent(layout)
+        """``candidate``'s line moved across itself by ``offsets`` [m] (same length and direction;
+        the pieces off the plate left out)."""
+        path = np.asarray(candidate.geometry["path"], float)[[0, -1]]
         out = []
-        for v in values:
-            p0, p1 = lo.copy(), hi.copy()
-            p0[axis] = p1[axis] = v
-            c = self.candidate(layout, _label(axis, v), p0, p1)
+        for o in np.asarray(offsets, float):
+            c = self.candidate(layout, None, *(path + o * normal(path)), height=candidate.data.get("height"))
             if c is not None:
                 out.append(c)
         return out
 
-    def candidate(self, layout, label: str, p0, p1):
-        """The rib along the straight line ``p0``-``p1`` [m] (None where it misses the plate)."""
+    def along(self, candidate, path):
+        """``candidate`` on the straight line ``path`` (2, 2) [m] instead, named for it (a rib moved to
+        where another mesh, on which it is placed (:meth:`place`), follows it)."""
+        path = np.asarray(path, float)[[0, -1]]
+        return replace(candidate, name=f"{self.name}@{self._tag(path, candidate.data.get('height'))}",
+                       at=tuple(path.mean(axis=0)), geometry={**candidate.geometry, "path": path})
+
+    def _tag(self, path, height) -> str:
+        """The name of a rib from its ends and, where it is not the kind's, its section height."""
+        same = height is None or np.isclose(height, self.section.h, rtol=1e-9, atol=0.0)
+        return label(path) + ("" if same else f"/h={1e3 * height:.4g}mm")
+
+    def candidate(self, layout, name, p0, p1, height: float | None = None):
+        """The rib along the straight line ``p0``-``p1`` [m] called ``stiffener@<name>`` (None: named
+        for its ends on the plate), of section ``height`` [m] (None: the kind's; the mass per length
+        of a rib of stiffness EI is 12 rho EI / (E h^2)); None where the line misses the plate."""
         conn, weights, ends = layout.line_cells(p0, p1)
         if not len(conn):
             return None
-        pts = np.vstack([ends[:1, 0], ends[:, 1]])
+        path = np.vstack([ends[:1, 0], ends[-1:, 1]])
         length = float(np.linalg.norm(ends[:, 1] - ends[:, 0], axis=1).sum())
-        return Candidate(self.name, f"{self.name}@{label}", tuple(0.5 * (pts[0] + pts[-1])), np.unique(conn),
-                         {"path": pts[[0, -1]]},
-                         {"conn": conn, "weights": weights, "length": length, "thickness": layout.thickness})
+        h = self.section.h if height is None else float(height)
+        return Candidate(self.name, f"{self.name}@{name or self._tag(path, height)}", tuple(path.mean(axis=0)), np.unique(conn),
+                         {"path": path}, {"conn": conn, "weights": weights, "length": length,
+                                          "thickness": layout.thickness, "height": h})
 
     def place(self, layout, candidate):
-        """Along ``candidate``'s line (ValueError where it misses the plate)."""
-        c = self.candidate(layout, "placed", *candidate.geometry["path"])
+        """Along ``candidate``'s line, of its section (ValueError where it misses the plate)."""
+        c = self.candidate(layout, "placed", *candidate.geometry["path"], height=candidate.data.get("height"))
         if c is None:
             raise ValueError(f"{candidate.name}: its line misses the plate")
         return c
 
+    def section_of(self, candidate) -> RibSection:
+        """The rib's section: the kind's material at the candidate's height."""
+        return replace(self.section, h=candidate.data.get("height", self.section.h))
+
+    def mass(self, candidate, value: float) -> float:
+        """[kg] the rib's mass at stiffness ``value`` (EI): rho b h times its length, b = 12 EI / (E h^3)."""
+        sec = self.section_of(candidate)
+        return 12.0 * sec.rho * value / (sec.E * sec.h**2) * candidate.data["length"]
+
     def _property(self, value: float, candidate):
-        return EmbeddedBeamProperty(rib_property(value, candidate.data["thickness"], self.section),
+        return EmbeddedBeamProperty(rib_property(value, candidate.data["thickness"], self.section_of(candidate)),
                                     candidate.data["weights"])
 
     def blocks(self, model, candidates) -> list:
@@ -115,15 +134,36 @@ class _Stiffener:
         return m
 
 
-def line_axis(path) -> int:
-    """0 for a column (x constant along ``path``), 1 for a row (y constant)."""
+#: [rad] the directions of the lines searched first: rows, columns and the diagonals between them
+DIRECTIONS = np.radians([0.0, 90.0, 45.0, 135.0])
+
+
+def normal(path) -> np.ndarray:
+    """The unit normal (2,) of the straight line ``path``, its larger component positive (+x across a
+    column, +y across a row, whichever way the path runs)."""
     (x0, y0), (x1, y1) = np.asarray(path, float)[[0, -1]]
-    return 0 if abs(x1 - x0) < abs(y1 - y0) else 1
+    n = np.array([y0 - y1, x1 - x0]) / np.hypot(x1 - x0, y1 - y0)
+    return -n if n[np.argmax(np.abs(n))] < 0 else n
 
 
-def _label(axis: int, v: float) -> str:
-    """The name of the row or column at ``v`` [m]: ``x=<mm>mm`` (``axis`` 0) or ``y=<mm>mm``."""
-    return f"{'xy'[axis]}={1e3 * v:.4g}mm"
+def label(path) -> str:
+    """The name of the line ``path`` from its ends: ``(x0,y0)-(x1,y1)mm``."""
+    (x0, y0), (x1, y1) = 1e3 * np.asarray(path, float)[[0, -1]]
+    return f"({x0:.4g},{y0:.4g})-({x1:.4g},{y1:.4g})mm"
+
+
+def _clipped(point, d, lo, hi):
+    """The ends (2, 2) of the line through ``point`` along ``d`` inside the box ``lo``-``hi`` (None
+    where it misses the box)."""
+    t0, t1 = -np.inf, np.inf
+    for k in range(2):
+        if d[k] == 0.0:
+            if not lo[k] <= point[k] <= hi[k]:
+                return None
+            continue
+        a, b = sorted(((lo[k] - point[k]) / d[k], (hi[k] - point[k]) / d[k]))
+        t0, t1 = max(t0, a), min(t1, b)
+    return None if t1 <= t0 else np.array([point + t0 * d, point + t1 * d])
 
 
 def _extent(layout):

@@ -64,9 +64,10 @@ def plot_evidence(path, board, evidence, effects) -> None:
         from .pictures3d import point_map_3d
 
         fig = _plt().figure(figsize=(6.5 * max(len(kinds), 1), 5.5))
+        grid = fig.add_gridspec(1, max(len(kinds), 1))
         for k, kind in enumerate(kinds):
             xyz, gain = evidence[kind]
-            ax = point_map_3d(fig, (1, len(kinds), k + 1), xyz, gain, "chi^2 removed",
+            ax = point_map_3d(fig, grid[0, k], xyz, gain, "chi^2 removed",
                               title=f"evidence for a {kind.replace('_', ' ')}")
             for e in effects:
                 ax.scatter(*np.asarray(e["at_mm"], float)[:, None], marker="*", s=200, c="r", edgecolors="w")
@@ -93,6 +94,8 @@ def enriched_effects(diagnosis) -> list:
         d = {"type": e["kind"], "name": e["name"], "value": e["magnitude"], "at": tuple(np.asarray(e["at_mm"]) / 1e3)}
         if "plate" in e:
             d["plate"] = e["plate"]
+        if "section_height_mm" in e:
+            d["height"] = 1e-3 * e["section_height_mm"]
         for key in ("segment", "path", "polygon"):
             if f"{key}_mm" in e:
                 d[key] = (np.asarray(e[f"{key}_mm"]) / 1e3).tolist()

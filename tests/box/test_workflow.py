@@ -103,7 +103,7 @@ def diagnosing(tmp_path_factory):
         write_uff(uff, simulated(path, 10, seed=5))
         js = tmp / f"{name}.json"
         res = CliRunner().invoke(main, ["diagnose", str(model), str(uff), "--noise", "f=0.2,shape=2", "--json",
-                                        str(js)])
+                                        str(js), "--out", str(tmp / f"{name}_out")])
         assert res.exit_code == 0, res.output
         out[name] = (json.loads(js.read_text()), res.output, tmp)
     return out
@@ -118,11 +118,14 @@ def test_diagnosis_finds_an_undeclared_mass_on_its_plate(diagnosing):
     assert e["magnitude"] == pytest.approx(0.060, rel=0.3)
     assert data["after"]["max_freq_error_pct"] < data["parameters_only"]["max_freq_error_pct"]
     assert "point_mass" in output and "upper" in output
+    assert (tmp / "hidden_out" / "evidence.png").stat().st_size > 0  # the 3-D evidence map (issue 37: it crashed)
+    assert "point_mass" in (tmp / "hidden_out" / "effects.txt").read_text()
     enriched = load_box(data["enriched_board"])  # the box with the mass declared on its plate
     found = next(m for m in enriched.masses if m.name != "relay")
     assert found.plate == "upper" and np.hypot(found.at[0] - 0.160, found.at[1] - 0.080) < 0.015
 
 
 def test_diagnosis_reports_nothing_on_the_control(diagnosing):
-    data, _, _ = diagnosing["control"]
+    data, _, tmp = diagnosing["control"]
     assert data["noise_only"] and data["effects"] == [] and data["enriched_board"] is None
+    assert (tmp / "control_out" / "correlation.txt").exists()

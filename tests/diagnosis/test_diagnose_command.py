@@ -24,3 +24,36 @@ def test_bad_options_and_configurations(tmp_path):
     assert r.exit_code == 2 and "t.uff" in r.output  # the malformed UFF is named before the configuration
     r = run(CARD / "board.toml", uff, "c2")
     assert r.exit_code == 2 and "NAME=FILE" in r.output
+
+
+def test_an_internal_error_still_writes_what_was_computed(tmp_path, monkeypatch):
+    """A bug in a later step (here: the candidates cannot be generated) ends the command with the
+    one-line internal error, and the JSON holds what was computed before it (the correlation as given
+    and with the declared parameters fitted), marked incomplete, with the error."""
+    import json
+
+    from pcbdyn.board import load_board
+    from pcbdyn.diagnosis import pipeline
+    from pcbdyn.fe.modal import solve_modes
+    from pcbdyn.testdata import read_points_csv, write_uff
+    from pcbdyn.testdata.noise import Noise
+    from pcbdyn.testdata.simulate import simulate_on_model
+
+    heavy = tmp_path / "heavy.toml"
+    heavy.write_text((CARD / "board.toml").read_text() + '\n[[masses]]\nname = "extra"\nat = ["120 mm", "150 mm"]\n'
+                                                          'mass = "40 g"\n')
+    truth = load_board(heavy).build().model
+    points, dofs = read_points_csv(CARD / "points.csv")
+    write_uff(tmp_path / "t.uff", simulate_on_model(truth, solve_modes(truth, n_modes=7), points, dofs,
+                                                   noise=Noise(frequency_pct=0.2, shape_pct=2.0), seed=3))
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("a bug in the candidates")
+
+    monkeypatch.setattr(pipeline, "generate", broken)
+    js = tmp_path / "d.json"
+    r = run(CARD / "board.toml", tmp_path / "t.uff", "--quick", "--workers", "1", "--json", js)
+    assert r.exit_code == 3 and "internal error" in r.output and "a bug in the candidates" in r.output
+    data = json.loads(js.read_text())
+    assert data["complete"] is False and "RuntimeError" in data["error"]
+    assert data["before"]["max_freq_error_pct"] > data["parameters_only"]["max_freq_error_pct"] > 0.5

@@ -90,14 +90,14 @@ def test_refine_moves_a_segment_found_too_short_to_the_true_run(card):
     """A line mass over two pieces of a free side, first fitted on one of them: the local search
     on the run's ends (:func:`refine` with the pipeline's neighbours) moves it to the true run and
     recovers its mass."""
-    from pcbdyn.diagnosis.pipeline import RUN, LocalMoves
+    from pcbdyn.diagnosis.moves import LocalMoves
     from pcbdyn.diagnosis.residual import ModalResidual, Observation
     from pcbdyn.diagnosis.select import Selection, estimate, refine
 
     m, cands = card
-    runs = {c.name: i for i, c in enumerate(cands) if c.kind == "line_mass" and RUN.match(c.name)}
-    side = RUN.match(next(n for n in runs if n.endswith("[1-2]")))["base"]
-    truth, start = runs[f"{side}[1-2]"], runs[f"{side}[1]"]
+    runs = {c.data["run"]: i for i, c in enumerate(cands) if c.kind == "line_mass" and "run" in c.data}
+    side = next(side for side, i, j in runs if (i, j) == (1, 2))
+    truth, start = runs[(side, 1, 2)], runs[(side, 1, 1)]
     f_test = solve_modes(dg.add_effect(m, cands[truth], 0.03), n_modes=N_MODES).frequencies
     res = ModalResidual([Observation(None, Modes.frequencies_only(f_test), np.full(N_MODES, SIGMA))], lambda p: [m])
     fit = estimate(res, np.zeros(0), [cands[start]], [0.03], 8)
@@ -146,7 +146,7 @@ def test_refine_walks_a_region_found_on_the_patch_grid_to_the_true_rectangle(car
     """A stiffened rectangle off the patch grid, first fitted on the patch that overlaps it most:
     moving one side by one element at a time (:class:`LocalMoves`) reaches the true rectangle and
     its stiffness change."""
-    from pcbdyn.diagnosis.pipeline import LocalMoves, _rectangle
+    from pcbdyn.diagnosis.moves import LocalMoves, rectangle
     from pcbdyn.diagnosis.residual import ModalResidual, Observation
     from pcbdyn.diagnosis.select import Selection, estimate, refine
 
@@ -157,7 +157,7 @@ def test_refine_walks_a_region_found_on_the_patch_grid_to_the_true_rectangle(car
     f_test = solve_modes(dg.add_effect(m, truth, 1.5), n_modes=N_MODES).frequencies
     res = ModalResidual([Observation(None, Modes.frequencies_only(f_test), np.full(N_MODES, SIGMA))], lambda p: [m])
     cands = list(cands)
-    patches = [i for i, c in enumerate(cands) if c.kind == "region_stiffness" and _rectangle(c) is not None]
+    patches = [i for i, c in enumerate(cands) if c.kind == "region_stiffness" and rectangle(c) is not None]
     start = min(patches, key=lambda i: np.hypot(*np.subtract(cands[i].at, truth.at)))
     fit = estimate(res, np.zeros(0), [cands[start]], [1.0], 8)
     assert fit.chi2 > 10.0  # the patch cannot explain the data
@@ -192,17 +192,17 @@ def test_held_out_share_tells_an_effect_every_fold_sees_from_one_fitted_to_one_f
 def test_parallel_stiffeners_side_by_side_are_reported_as_one_rib(card):
     """Two parallel ribs within reach are one rib fitted as shares: their stiffnesses add and the
     path lies between them, weighted; a crossing rib stays apart."""
-    from pcbdyn.diagnosis.pipeline import _merged, _neighbours
+    from pcbdyn.diagnosis.merge import groups, merged
 
     m, cands = card
     layout = dg.from_model(m)
     rib = dg.kind("stiffener")
-    a = rib.candidate(layout, "x=60mm", np.array([0.06, 0.0]), np.array([0.06, 0.18]))
-    b, cross = rib.parallel(layout, a, [0.01])[0], rib.candidate(layout, "y=90mm", np.array([0.0, 0.09]),
+    a = rib.candidate(layout, None, np.array([0.06, 0.0]), np.array([0.06, 0.18]))
+    b, cross = rib.parallel(layout, a, [0.01])[0], rib.candidate(layout, None, np.array([0.0, 0.09]),
                                                                     np.array([0.16, 0.09]))
-    groups = _neighbours([a, b, cross], 0.02)
+    groups = groups([a, b, cross], 0.02)
     assert sorted(map(sorted, groups)) == [[0, 1], [2]]
-    d = _merged([a, b, cross], np.array([3.0, 1.0, 2.0]), np.zeros((0, 0)), np.zeros((3, 3)), [0, 1])
+    d = merged([a, b, cross], np.array([3.0, 1.0, 2.0]), np.zeros((0, 0)), np.zeros((3, 3)), [0, 1])
     assert d["magnitude"] == pytest.approx(4.0)
     assert np.allclose(np.asarray(d["path_mm"])[:, 0], 62.5)
 
@@ -211,15 +211,15 @@ def test_overlapping_regions_are_reported_as_one_with_their_mean_change(card):
     """Two overlapping rectangles fitted to one stiffened region are one effect: the area they
     cover (their union, not its bounding box), with the mean change over it, so that the change's
     integral over the board is what the two add."""
-    from pcbdyn.diagnosis.pipeline import _merged, _neighbours
+    from pcbdyn.diagnosis.merge import groups, merged
 
     m, _ = card
     layout = dg.from_model(m)
     region = dg.kind("region_stiffness")
     a, b = region.rectangle(layout, 0.02, 0.02, 0.06, 0.06), region.rectangle(layout, 0.04, 0.04, 0.08, 0.08)
     far = region.rectangle(layout, 0.10, 0.10, 0.14, 0.14)
-    assert sorted(map(sorted, _neighbours([a, b, far], 0.02))) == [[0, 1], [2]]
-    d = _merged([a, b], np.array([2.0, 1.0]), np.zeros((0, 0)), np.zeros((2, 2)), [0, 1])
+    assert sorted(map(sorted, groups([a, b, far], 0.02))) == [[0, 1], [2]]
+    d = merged([a, b], np.array([2.0, 1.0]), np.zeros((0, 0)), np.zeros((2, 2)), [0, 1])
     union = shapely.Polygon(d["polygon_mm"])
     assert union.bounds == pytest.approx((20.0, 20.0, 80.0, 80.0))
     assert union.area == pytest.approx(2 * 40.0**2 - 20.0**2)
@@ -230,7 +230,7 @@ def test_overlapping_regions_are_reported_as_one_with_their_mean_change(card):
 
 def test_distances_to_segments_used_to_merge_effects():
     """Point-to-segment and segment-to-segment distances (merging effects found side by side)."""
-    from pcbdyn.diagnosis.pipeline import _segment_gap, _to_segment
+    from pcbdyn.diagnosis.merge import _segment_gap, _to_segment
 
     s = np.array([[0.0, 0.0], [1.0, 0.0]])
     for p, want in (([0.5, 2.0], 2.0), ([-3.0, 4.0], 5.0), ([1.5, 0.0], 0.5), ([0.3, 0.0], 0.0)):

@@ -1,0 +1,120 @@
+"""Shares of one effect reported as one: a diagnosis fits an effect that lies between nodes or
+between the candidates' places as shares on the places around it (a mass on the nodes around its
+point, a rib on two lines beside it, a region on two overlapping rectangles); :func:`groups` finds
+them and :func:`merged` reports each group as one effect, with the uncertainty of the combination."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import shapely
+
+from ..fe.probe import segment_parameter
+from .catalogue import weighted_centre
+from .moves import rectangle
+from .uncertainty import parts
+
+#: kinds that act at one node: an effect between nodes is shared by its neighbours
+POINT_KINDS = ("point_mass", "point_inertia", "ground_spring")
+#: [element sizes] how far apart shares of one effect may be found (an unstructured mesh puts the
+#: nodes around a point up to about two elements apart)
+MERGE_REACH = 2.6
+
+
+def linked(a, b, reach: float) -> bool:
+    """Two chosen effects that are one: point effects of one kind within ``reach`` [m] (a mass or a
+    spring between nodes is fitted as shares on the nodes around it), or a point mass within
+    ``reach`` of a line mass (a mass spread over part of an edge is fitted as a line plus points),
+    line masses whose segments overlap or lie within ``reach``, parallel stiffeners within
+    ``reach`` (a rib between two lines is fitted as shares on both), or overlapping rectangular
+    regions (a region between two is fitted as both)."""
+    if a.kind == b.kind and a.kind in POINT_KINDS:
+        return math.dist(a.at, b.at) <= reach
+    if a.kind == b.kind == "region_stiffness" and None not in (ra := rectangle(a), rb := rectangle(b)):
+        return min(ra[2], rb[2]) > max(ra[0], rb[0]) and min(ra[3], rb[3]) > max(ra[1], rb[1])  # they overlap
+    if a.kind == b.kind == "stiffener":
+        da, db = (np.diff(np.asarray(c.geometry["path"], float)[[0, -1]], axis=0)[0] for c in (a, b))
+        parallel = abs(da[0] * db[1] - da[1] * db[0]) <= 1e-6 * np.linalg.norm(da) * np.linalg.norm(db)
+        return parallel and _segment_gap(a.geometry["path"], b.geometry["path"]) <= reach
+    if a.kind == b.kind == "line_mass":  # masses along one stretch of a side add up
+        return _segment_gap(a.geometry["segment"], b.geometry["segment"]) <= reach
+    if {a.kind, b.kind} == {"point_mass", "line_mass"}:
+        line, point = (a, b) if a.kind == "line_mass" else (b, a)
+        return _to_segment(np.asarray(point.at, float)[:2], np.asarray(line.geometry["segment"], float)) <= reach
+    return False
+
+
+def _to_segment(p, seg) -> float:
+    """Distance [m] from point ``p`` to the straight segment ``seg`` (2, 2)."""
+    a, b = seg[:1], seg[1:]
+    return float(np.linalg.norm(a + segment_parameter(p[None], a, b)[:, None] * (b - a) - p))
+
+
+def _segment_gap(s, t) -> float:
+    """Shortest distance [m] between two straight segments (0 where they overlap or cross)."""
+    s, t = np.asarray(s, float), np.asarray(t, float)
+
+    def side(a, b, p):  # sign of p's side of the line a-b
+        (u, v), (w, z) = b - a, p - a
+        return np.sign(u * z - v * w)
+
+    if side(*s, t[0]) * side(*s, t[1]) < 0 and side(*t, s[0]) * side(*t, s[1]) < 0:
+        return 0.0  # they cross
+    return min([_to_segment(p, t) for p in s] + [_to_segment(p, s) for p in t])
+
+
+def groups(chosen, reach: float) -> list:
+    """Groups of chosen effects linked (:func:`linked`) directly or through others, reported as one."""
+    from scipy.sparse.csgraph import connected_components
+
+    n = len(chosen)
+    link = np.eye(n, dtype=bool)
+    for a in range(n):
+        for b in range(a + 1, n):
+            link[a, b] = link[b, a] = linked(chosen[a], chosen[b], reach)
+    _, label = connected_components(link, directed=False)
+    return [np.flatnonzero(label == g).tolist() for g in dict.fromkeys(label.tolist())]
+
+
+def merged(chosen, values, cov, cov_jack, group) -> dict:
+    """One effect entry (JSON-ready) for a group: the magnitudes summed at their weighted centre (on
+    line masses: the place and extent of the largest; parallel stiffeners: their weighted mean
+    path; overlapping regions: the mean change over the area they cover, their union, which keeps
+    the change's integral over the board), the uncertainty of that combination from the fit's
+    covariance ``cov``, the jackknife's ``cov_jack`` and the model-form budget
+    (:func:`.uncertainty.parts`)."""
+    lines = [k for k in group if chosen[k].kind == "line_mass"]
+    c = chosen[max(lines, key=lambda k: values[k]) if lines else group[0]]
+    d = c.describe()
+    v = np.asarray(values, float)[group]
+    w = np.ones(v.size)  # the combination reported: a sum, or for regions an area-weighted mean
+    if len(group) > 1:
+        d["name"] = "+".join(chosen[k].name for k in group)
+        d["merged_at_mm"] = np.round(1e3 * np.array([chosen[k].at for k in group]), 3).tolist()
+        if c.kind == "region_stiffness":
+            boxes = [shapely.box(*rectangle(chosen[k])) for k in group]
+            union = shapely.union_all(boxes)
+            w = np.array([b.area for b in boxes]) / union.area
+            d["polygon_mm"] = np.round(1e3 * np.asarray(union.exterior.coords)[:-1], 3).tolist()
+            d["at_mm"] = np.round(1e3 * np.asarray(union.centroid.coords)[0], 3).tolist()
+        elif not lines:
+            d["at_mm"] = np.round(1e3 * weighted_centre([chosen[k] for k in group], v), 3).tolist()
+        if c.kind == "stiffener":
+            d["path_mm"] = np.round(1e3 * mean_path([chosen[k] for k in group], v), 3).tolist()
+    if hasattr(c.spec, "mass"):  # a rib carries its mass: its section's, at the stiffness found
+        d["mass_kg"] = float(sum(chosen[k].spec.mass(chosen[k], values[k]) for k in group))
+        d["section_height_mm"] = round(1e3 * c.spec.section_of(c).h, 4)
+    sub = np.ix_(group, group)
+    u = parts(float(w @ v), w, cov[sub] if cov.size else cov, cov_jack[sub])
+    d.update(magnitude=float(w @ v), uncertainty=u.pop("total"), uncertainty_parts=u, kind=c.kind)
+    return d
+
+
+def mean_path(stiffeners, values) -> np.ndarray:
+    """The line (2, 2) [m] of parallel ``stiffeners`` fitted as shares of one rib: their end
+    points' mean weighted by their ``values`` (EI)."""
+    v = np.asarray(values, float)
+    share = v / v.sum() if v.sum() > 0 else np.full(v.size, 1.0 / v.size)
+    paths = np.array([np.asarray(c.geometry["path"], float)[[0, -1]] for c in stiffeners])
+    return np.einsum("g,gij->ij", share, paths)

@@ -1,0 +1,95 @@
+"""The local moves of the effects found (:func:`.select.refine`): where each effect may go next, read
+from its geometry (the run of a side's pieces it covers, its line, its rectangle, its point), never
+from its name. Forward selection places effects on a coarse grid; these moves walk them to where
+the data put them."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from ..fe.probe import ProbeError
+from .catalogue import kind
+
+#: [element sizes] how far a stiffener's line moves across itself in one step of the local search
+#: (:func:`.pipeline._on_lines` then walks it to a fraction of this on meshes along it; the bar of
+#: ``ho_al_bar``, found as two lines, took 22 s of local search in quarter steps, 13 s in halves)
+LINE_STEP = 0.5
+#: [element sizes] how far a point between nodes moves in one step of the local search
+POINT_STEP = 0.25
+#: [element sizes] how far a side of a rectangular region moves in one step of the local search
+RECT_STEP = 1.0
+
+
+def movable(cand) -> bool:
+    """A candidate :class:`LocalMoves` can move (a run of pieces of a side, a stiffener, a
+    rectangular region, a point between nodes)."""
+    return "run" in cand.data or cand.kind == "stiffener" or rectangle(cand) is not None or cand.between_nodes
+
+
+def rectangle(cand):
+    """(x0, y0, x1, y1) [m] of a region candidate whose polygon is an axis-aligned rectangle, else None."""
+    if cand.kind != "region_stiffness" or np.shape(cand.geometry["polygon"])[1] != 2:
+        return None
+    poly = np.asarray(cand.geometry["polygon"], float)
+    lo, hi = poly.min(axis=0), poly.max(axis=0)
+    on_box = np.all(np.isclose(poly[:, :1], [lo[0], hi[0]]).any(axis=1) & np.isclose(poly[:, 1:], [lo[1], hi[1]]).any(axis=1))
+    return (*lo, *hi) if len(poly) == 4 and on_box else None
+
+
+class LocalMoves:
+    """neighbours(i) for :func:`.select.refine`: for a run of pieces of a side, the runs of the
+    same kind and side that start and end at most one piece from its own; for a stiffener, its line
+    moved half an element (:data:`LINE_STEP`) across itself either way; for a rectangular region,
+    the rectangles with one side moved by one element (:data:`RECT_STEP`) in or out; for a point
+    between nodes (a support, :mod:`.support`), the points a quarter element (:data:`POINT_STEP`)
+    away along x and y. Lines, rectangles and points are made on demand and appended to ``cands``."""
+
+    def __init__(self, layout, cands: list, h: float):
+        self.layout, self.cands, self.h = layout, cands, h
+        plate = layout.xy[layout.shell_nodes()]
+        self.lo, self.hi = plate.min(axis=0), plate.max(axis=0)
+        self.index = {c.name: k for k, c in enumerate(cands)}
+        self.runs: dict = {}
+        for k, c in enumerate(cands):
+            if "run" in c.data:
+                side, i, j = c.data["run"]
+                self.runs.setdefault((c.kind, side), {})[(i, j)] = k
+
+    def _add(self, made) -> list:
+        out = []
+        for c in made:
+            if c.name not in self.index:
+                self.index[c.name] = len(self.cands)
+                self.cands.append(c)
+            out.append(self.index[c.name])
+        return out
+
+    def __call__(self, k) -> list:
+        c = self.cands[k]
+        if "run" in c.data:
+            side, i, j = c.data["run"]
+            runs = self.runs[(c.kind, side)]
+            return [runs[(a, b)] for a in (i - 1, i, i + 1) for b in (j - 1, j, j + 1)
+                    if (a, b) != (i, j) and (a, b) in runs]
+        if c.kind == "stiffener":
+            return self._add(kind("stiffener").parallel(self.layout, c, LINE_STEP * self.h * np.array([-1.0, 1.0])))
+        if c.between_nodes:
+            step, made = POINT_STEP * self.h, []
+            for d in ((step, 0.0), (-step, 0.0), (0.0, step), (0.0, -step)):
+                try:
+                    made.append(c.spec.place(self.layout, replace(c, at=(c.at[0] + d[0], c.at[1] + d[1]))))
+                except ProbeError:  # off the board
+                    continue
+            return self._add(made)
+        if (box := rectangle(c)) is not None:
+            lo, hi, step, made = self.lo, self.hi, RECT_STEP * self.h, []
+            for side in range(4):
+                for d in (-step, step):
+                    b = np.array(box)
+                    b[side] = np.clip(b[side] + d, lo[side % 2], hi[side % 2])
+                    if b[2] - b[0] >= step and b[3] - b[1] >= step and not np.allclose(b, box):
+                        made.append(kind("region_stiffness").rectangle(self.layout, *b))
+            return self._add([r for r in made if r is not None])
+        return []

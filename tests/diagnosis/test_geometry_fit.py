@@ -1,0 +1,77 @@
+"""A rib's place and section fitted on meshes along it (:mod:`pcbdyn.diagnosis.geometry_fit`, issue
+37): a steel bar glued at 22 degrees across part of a free plate, tested on a mesh twice as fine as
+the model's; the fit starts from the full-span row nearest the bar with the kind's default section
+(aluminium, 4 mm) and must bring its ends, stiffness and mass to the bar's."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pcbdyn import diagnosis as dg
+from pcbdyn.board import load_board
+from pcbdyn.diagnosis.geometry_fit import fit_ribs
+from pcbdyn.diagnosis.residual import ModalResidual, Observation, reading
+from pcbdyn.diagnosis.scan import Runner
+from pcbdyn.fe.modal import solve_modes
+from pcbdyn.problems.models import StructureModels
+from pcbdyn.testdata.data import Dofs, Points
+from pcbdyn.testdata.simulate import simulate_on_model
+
+PLATE = """
+[board]
+name = "plate with a bar"
+outline = { width = "160 mm", height = "110 mm" }
+thickness = "1.6 mm"
+material = { E = "22 GPa", nu = 0.15, rho = "1900 kg/m^3" }
+mesh_size = "MESH"
+
+[analysis]
+modes = 12
+"""
+#: a steel flat bar 5 x 3 mm from (25, 35) to (135, 80) mm: EI = 200 GPa 5 mm (3 mm)^3 / 12
+BAR = ((0.025, 0.035), (0.135, 0.080))
+E_STEEL, RHO_STEEL, W, H = 200e9, 7850.0, 5e-3, 3e-3
+BAR_EI = E_STEEL * W * H**3 / 12.0
+BAR_MASS = RHO_STEEL * W * H * float(np.hypot(*np.subtract(BAR[1], BAR[0])))
+TRUTH = f"""
+[[stiffeners]]
+name = "bar"
+path = [["{1e3 * BAR[0][0]} mm", "{1e3 * BAR[0][1]} mm"], ["{1e3 * BAR[1][0]} mm", "{1e3 * BAR[1][1]} mm"]]
+EI = "{BAR_EI} N*m^2"
+section = {{ E = "200 GPa", rho = "7850 kg/m^3", height = "3 mm" }}
+"""
+
+
+def _distance(p, seg) -> float:
+    a, b = (np.asarray(q, float) for q in seg)
+    t = np.clip((p - a) @ (b - a) / ((b - a) @ (b - a)), 0.0, 1.0)
+    return float(np.linalg.norm(a + t * (b - a) - p))
+
+
+def test_a_finite_oblique_bar_found_from_the_nearest_row(tmp_path):
+    (tmp_path / "model.toml").write_text(PLATE.replace("MESH", "8 mm"))
+    (tmp_path / "truth.toml").write_text(PLATE.replace("MESH", "4 mm") + TRUTH)
+    truth = load_board(tmp_path / "truth.toml").build().model
+    xy = np.stack(np.meshgrid(np.linspace(0.01, 0.15, 9), np.linspace(0.01, 0.10, 7)), -1).reshape(-1, 2)
+    ids = np.arange(1, len(xy) + 1)
+    points, dofs = Points(ids, np.c_[xy, np.zeros(len(xy))]), Dofs(ids, np.tile([0.0, 0.0, 1.0], (len(ids), 1)))
+    test = simulate_on_model(truth, solve_modes(truth, n_modes=8), points, dofs).modes
+
+    models = StructureModels(load_board(tmp_path / "model.toml"), [None], mesh_size=8e-3, shared_mesh=True)
+    ob = Observation(None, test, np.full(test.n_modes, 0.002 / np.sqrt(3)),
+                     read=reading(models.models[0].model, test.xyz, test.directions),
+                     sigma_s=np.full(test.n_modes, 0.02 / np.sqrt(3)))
+    res = ModalResidual.of_models(models, [ob])
+    layout = dg.from_structure(models.models[0])
+    rib = dg.kind("stiffener")
+    rows = [c for c in rib.generate(layout, path_spacing=8e-3) if abs(np.diff(c.geometry["path"][:, 1])[0]) < 1e-9]
+    start = min(rows, key=lambda c: abs(c.at[1] - 0.0575))
+    before = res.evaluate(np.zeros(0), [start], [0.2]).chi2
+    found = fit_ribs(models.structure, [None], [], 8e-3, [ob], [start], np.zeros(0), [0.2], None, Runner(1), steps=12)
+    assert found is not None and found.fit.chi2 < 1e-2 * before
+    path = np.asarray(found.placed[0].geometry["path"], float)
+    assert max(_distance(p, BAR) for p in path) < 2e-3  # the ends lie on the bar, within a quarter element
+    assert max(_distance(p, path) for p in np.asarray(BAR)) < 4e-3  # and reach its ends within half an element
+    assert found.fit.values[0] == pytest.approx(BAR_EI, rel=0.10)
+    assert rib.mass(found.placed[0], found.fit.values[0]) == pytest.approx(BAR_MASS, rel=0.10)
