@@ -1,6 +1,6 @@
 """Checks of the OpenSees converter (:mod:`opensees_truth`): a plain script printing tables.
 
-    OPENBLAS_NUM_THREADS=1 .venv/bin/python tests/diagnosis/check_opensees_truth.py [--timing] [--shell ASDShellQ4]
+    OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/discovery/check_opensees_truth.py [--timing] [--shell ASDShellQ4]
 
 a. simply supported square plate against Kirchhoff's f_mn;
 b. a beam alone (Iy != Iz, skew axis, offset) against pcbdyn's beam (axes and offset);

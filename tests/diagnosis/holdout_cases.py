@@ -4,7 +4,7 @@ The bench of :mod:`bench_cases` makes its data with pcbdyn's own elements (at a 
 model's mesh). These cases guard against a diagnosis tuned to its own engine: the true boards (the
 example boards with their declared parameters off the nominal values and the hidden effect
 declared as a board entry) are meshed four times finer than the model and solved in OpenSees with
-its Kirchhoff plate element ShellDKGQ (:mod:`opensees_truth`), whose free-edge twisting modes
+its Kirchhoff plate element ShellDKGQ (benchmarks/discovery/opensees_truth.py), whose free-edge twisting modes
 differ from pcbdyn's Mindlin shell by up to about 1 % however fine the mesh: a model-form error
 that no declared parameter absorbs entirely, as between any two FE codes or a code and a real
 board (the diagnosis fits the plate theory's share last, :mod:`pcbdyn.diagnosis.model_form`).
@@ -120,6 +120,7 @@ def generate(case: Case, folder: Path = HERE) -> Path:
     """Solve the case's true board in OpenSees per configuration; write ``<case>.json``."""
     import tempfile
 
+    sys.path.insert(0, str(bc.ROOT / "benchmarks" / "discovery"))
     from opensees_truth import solve_opensees
 
     from pcbdyn.board import build_model, load_board
