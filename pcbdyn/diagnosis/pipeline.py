@@ -411,5 +411,12 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
                 "from them (a spring to ground)")
     if any(left.values()):
         msg += f"; test modes with no model partner (MAC < 0.3), left out of the fit: {left}"
-    return Diagnosis(effects, False, msg, after=sel.state.summary(obs), evidence=evidence(plain, base.state, searched),
+    after = sel.state.summary(obs)
+    po, worse = out["parameters_only"]["max_freq_error_pct"], after["max_freq_error_pct"]
+    stats["after_worse_than_parameters_only"] = bool(worse > po)
+    if worse > po:
+        msg += (f"; note: with the effects chi^2 is lower ({stats['chi2_parameters_only']:.4g} -> {sel.chi2[-1]:.4g}) "
+                f"but the largest frequency error of the paired modes grew ({po:.2f} % -> {worse:.2f} %): the effects "
+                "trade frequencies for shapes, or pair other modes; read them with care")
+    return Diagnosis(effects, False, msg, after=after, evidence=evidence(plain, base.state, searched),
                      candidates=chosen, **out)
