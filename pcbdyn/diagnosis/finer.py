@@ -14,13 +14,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..fe.modal import solve_modes
+from ..problems.error_budget import KIRCHHOFF_SHEAR
 from .catalogue import add_effect, place
 from .layout import from_structure
 from .residual import reading
 
-#: the factor on the shells' transverse shear (``with_shear_factor`` of a structure's model) of the
-#: Kirchhoff limit: a shear this much stiffer is a Kirchhoff plate to within 0.1 % of the gap
-KIRCHHOFF_SHEAR = 1000.0
 #: modes solved on a finer mesh beyond the highest paired on the model's own, so that a mode that
 #: moves up a place or two as the mesh resolves it is still there to pair
 SPARE_MODES = 6

@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..correlation.mac import mac
+from ..problems.error_budget import richardson
 from ..updating.solvers import covariance
 from .residual import paired_mac
 from .fitting import estimate
@@ -41,8 +42,8 @@ def discretisation(finer, ob, coarse_state):
     (:class:`.finer.Solved`), taken one after the other while some mode is not yet resolved (modes
     paired by MAC at the points, level to level).
     A mode resolved between two levels (:data:`RESOLVED_SHAPE_CHANGE`) is corrected by Richardson
-    extrapolation of an O(h^2) element from them, f_0 = f_fine + (f_fine - f_coarse) / 3, whose own
-    error (a third of the step) stays as noise; a mode no level resolves (or with no shapes to
+    extrapolation from them (:func:`pcbdyn.problems.error_budget.richardson`), whose own error (a
+    third of the step) stays as noise; a mode no level resolves (or with no shapes to
     tell) takes the finest frequency, the last step counted as noise. The shape error is 4/3 of
     the change from the model's mesh to the next."""
     f0 = coarse_state.f_a / ob.f_scale
@@ -52,8 +53,9 @@ def discretisation(finer, ob, coarse_state):
     for solved in finer:
         f, U, k, change = pair(solved, ob, u_prev, k_prev)
         ok = todo & (change <= RESOLVED_SHAPE_CHANGE)
-        scale = np.where(ok, (f + (f - f_prev) / 3.0) / f0, np.where(todo, f / f0, scale))
-        sigma = np.where(todo, np.abs(f - f_prev) / f0 / np.where(ok, 3.0, 1.0), sigma)
+        f_conv, _, left = richardson(f_prev, f)
+        scale = np.where(ok, f_conv / f0, np.where(todo, f / f0, scale))
+        sigma = np.where(todo, np.where(ok, left, np.abs(f - f_prev)) / f0, sigma)
         resolved |= ok
         todo &= ~ok
         if ds is None:
@@ -67,7 +69,7 @@ def discretisation(finer, ob, coarse_state):
 def kirchhoff_shift(fine, limit, ob, coarse_state) -> np.ndarray:
     """Relative frequency change per paired mode from ``fine`` (the modes on the finest mesh of
     :func:`discretisation`) to ``limit`` (the same mesh with the shells' transverse shear made
-    rigid: the Kirchhoff limit, :data:`.finer.KIRCHHOFF_SHEAR`). The gap grows as the mesh resolves
+    rigid: the Kirchhoff limit, :data:`pcbdyn.problems.error_budget.KIRCHHOFF_SHEAR`). The gap grows as the mesh resolves
     the shear boundary layer at free edges (about 1 % on the twisting modes of a 2.8 mm card at a
     quarter of its model's mesh, half that at the model's mesh), so it is measured where the
     frequencies are corrected to."""

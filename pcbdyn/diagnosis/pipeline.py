@@ -41,6 +41,7 @@ from scipy.stats import chi2 as chi2_dist
 from ..domain import StructureError
 from ..fe.modal import solve_modes
 from ..parallel import spare_cores
+from ..problems.error_budget import noise_sigma
 from ..problems.models import StructureModels, parameter_values
 from .bodies import as_bodies
 from .catalogue import KINDS, generate, kind
@@ -94,11 +95,11 @@ def _noise_sigmas(ob: Observation, freq_pct, shape_pct, basis_shapes):
     """Per-mode relative standard deviations of the frequencies and of a shape component
     (``basis_shapes``: the model's modes at the points, needed only where the shape noise is not stated)."""
     m = ob.f.size
-    sf = np.full(m, (0.2 if freq_pct is None else freq_pct) / 100.0 / np.sqrt(3.0))
+    sf = np.full(m, noise_sigma(0.2 if freq_pct is None else freq_pct))
     if ob.shapes is None:
         return sf, None
     if shape_pct is not None:
-        return sf, np.full(m, shape_pct / 100.0 / np.sqrt(3.0))
+        return sf, np.full(m, noise_sigma(shape_pct))
     n_pts = ob.shapes.shape[0]
     k = min(basis_shapes.shape[1], max(n_pts // 2, 1))
     Q, _ = np.linalg.qr(basis_shapes[:, :k])

@@ -13,7 +13,7 @@ stated (uniform bounds in percent, thesis eqs. 5.72-5.73: standard deviation bou
 shape equations the rows' noise is measured by redrawing it on the data, a parametric bootstrap) or,
 when none is stated, estimated from the residual. A stated noise never makes the estimate surer than
 the fit's own residual says (s^2 >= 1), so model error shows in the standard deviation too. What the
-mesh does to each mode (:mod:`.discretisation`) adds a systematic part, kept apart in the library
+mesh does to each mode (:mod:`.error_budget`) adds a systematic part, kept apart in the library
 record, since it does not average out over runs on similar meshes.
 """
 
@@ -31,7 +31,7 @@ from ..updating.iteration import build_equations
 from ..updating.solvers import covariance
 from ..updating.success import add_noise
 from ..updating.weighting import NOISE_REDRAWS
-from .discretisation import measured_mesh_steps
+from .error_budget import measured_mesh_steps, noise_sigma
 from .problem import UpdateProblem
 from .run import correlation_state, run
 
@@ -245,7 +245,7 @@ def calibrate(cal: Calibration, method: str = "freq", solver: str = "bounded", n
     """Fit ``cal`` with ``method`` and ``solver`` (``run_options`` go to :func:`.run.run`) and give
     every parameter its standard deviation (module docstring; ``noise`` = (frequency %, shape %),
     uniform bounds, None where not stated). With ``mesh_error`` what the model's mesh does to each
-    paired mode (:mod:`.discretisation`) joins the covariance as a systematic error. Returns ``cal``
+    paired mode (:mod:`.error_budget`) joins the covariance as a systematic error. Returns ``cal``
     filled in."""
     if method not in METHODS:
         raise CalibrationError(f"--method {method}: a calibration uses one of {', '.join(METHODS)}")
@@ -295,7 +295,7 @@ def posterior_covariance(cal: Calibration, fit, p, noise, seed: int = 0) -> tupl
     f_pct, shape_pct = noise
     (A, b), blocks, states = build_equations(fit, p)
     if cal.method == "freq":
-        rel = 1.0 if f_pct is None else f_pct / 100.0 / math.sqrt(3.0)
+        rel = 1.0 if f_pct is None else noise_sigma(f_pct)
         d = np.concatenate([1.0 / (rel * np.asarray(cfg.f_x, float)[st["used"]]) for cfg, st in zip(fit, states)])
         A = np.vstack([blk.A for blk in blocks]) * d[:, None]
         b = np.concatenate([blk.b for blk in blocks]) * d

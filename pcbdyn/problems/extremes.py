@@ -10,6 +10,7 @@ from dataclasses import dataclass
 
 from ..correlation import correlate
 from ..fe.modal import solve_modes
+from .error_budget import richardson
 
 
 @dataclass
@@ -88,9 +89,9 @@ def correlate_extreme(board, kind: str, tests, mesh_size=None, min_mac: float = 
 
 def mesh_errors(coarse: Extreme, fine: Extreme) -> list:
     """Per configuration {test mode: the model's discretisation error [%]} of the modes paired on both
-    meshes, ``fine`` on a mesh twice as fine as ``coarse``: 4/3 of the frequency change (an O(h^2)
-    element's error at h, Richardson), relative to the finer frequency."""
+    meshes, ``fine`` on a mesh twice as fine as ``coarse``: the coarse mesh's error
+    (:func:`.error_budget.richardson`) relative to its frequency."""
     out = []
     for fc, ff in zip(coarse.f_model(), fine.f_model()):
-        out.append({t: 400.0 / 3.0 * abs(fc[t] - ff[t]) / ff[t] for t in fc if t in ff})
+        out.append({t: 100.0 * float(richardson(fc[t], ff[t])[1]) / fc[t] for t in fc if t in ff})
     return out

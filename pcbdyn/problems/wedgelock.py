@@ -22,6 +22,7 @@ from scipy.stats import chi2 as chi2_dist
 
 from ..testdata import TestDataError
 from . import guides
+from .error_budget import noise_sigma
 from .extremes import Extreme, correlate_extreme, mesh_errors
 from .spring_fit import ALPHA, SpringFit, SpringModel, chi2, significance
 
@@ -137,7 +138,7 @@ def _noise_and_tolerance(tests, mesh, noise, tol_pct) -> tuple:
     sigma, tol = [], []
     for (_, test), m in zip(tests, mesh):
         modes = range(1, test.n_modes + 1)
-        sigma.append({t: float(np.hypot(noise / np.sqrt(3.0), m.get(t, 0.0))) for t in modes})
+        sigma.append({t: float(np.hypot(100.0 * noise_sigma(noise), m.get(t, 0.0))) for t in modes})
         tol.append({t: float(tol_pct if tol_pct is not None else noise + m.get(t, 0.0)) for t in modes})
     return sigma, tol
 
