@@ -45,11 +45,16 @@ def test_json_dash_writes_json_alone_on_stdout(card):
 
 
 def test_a_study_whose_out_is_a_file_fails_before_the_shots(tmp_path):
+    """``study`` takes ``--out`` like every command (it wrote where its study.toml's ``out`` said, beside the
+    example); an ``out`` left in the file is refused with the fix."""
     (tmp_path / "taken").write_text("x")
     spec = tmp_path / "study.toml"
+    spec.write_text('[study]\ncase = "simulated_free_pcb"\nlevels_pct = [0]\nshots = 1\n')
+    r = run(["study", spec, "--quiet", "--out", tmp_path / "taken"])
+    assert r.exit_code == 2 and "--out" in r.output and "is a file" in r.output and "building case" not in r.output
     spec.write_text('[study]\ncase = "simulated_free_pcb"\nlevels_pct = [0]\nshots = 1\nout = "taken"\n')
     r = run(["study", spec, "--quiet"])
-    assert r.exit_code == 2 and "[study] out = taken: is a file" in r.output and "building case" not in r.output
+    assert r.exit_code == 2 and "study.out" in r.output and "--out DIR" in r.output and "Traceback" not in r.output
 
 
 def test_update_reports_bounds_and_worse_configurations_on_the_thesis_data(card, tmp_path):
