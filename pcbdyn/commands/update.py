@@ -54,7 +54,7 @@ def parse_frf_freqs(text) -> list:
 @click.option("--solver", type=click.Choice(["ls", "tls", "bayes", "bounded"]), default="bounded", show_default=True)
 @click.option("--params", default=None, help="comma-separated parameter names (default: all [[parameters]])")
 @click.option("--max-iter", type=click.IntRange(min=1), default=20, show_default=True)
-@click.option("--tol", "tol_pct", type=float, default=0.1, show_default=True,
+@click.option("--tol", "tol_pct", type=float, default=0.1, show_default=True,  # problems.run.TOL_FREQ_PCT
               help="stop when the max frequency error is below this percentage (eq. 7.2)")
 @click.option("--mesh-size", default=None, help="override board.mesh_size, e.g. '10 mm'")
 @folder_outputs("folder for board.updated.toml, the iteration plot and tables (default: board.updated.toml beside "
