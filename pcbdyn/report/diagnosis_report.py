@@ -6,7 +6,7 @@ import numpy as np
 
 #: SI unit of an effect -> (display unit, factor from SI)
 DISPLAY = {"kg": ("g", 1e3), "kg*m^2": ("kg*mm^2", 1e6), "N/m": ("N/mm", 1e-3), "N*m/rad/m": ("N*m/rad/m", 1.0),
-           "N*m^2": ("N*m^2", 1.0), "1": ("%", 100.0)}
+           "N*m^2": ("N*m^2", 1.0), "1": ("%", 100.0), "Pa": ("GPa", 1e-9)}
 
 
 def shown(value: float, unit: str) -> tuple:

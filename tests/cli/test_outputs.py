@@ -111,3 +111,14 @@ def test_a_bug_is_one_line_with_a_log_not_a_traceback(card, monkeypatch):
     assert "internal error (a bug in pcbdyn" in line and "\n" not in line
     log = Path(line.rsplit("the traceback is in ", 1)[1])
     assert "something inside broke" in log.read_text() and "Traceback" in log.read_text()
+
+
+def test_a_modulus_is_printed_in_gpa(card, tmp_path):
+    """The parameter table printed E_board as 2.6e+10 Pa; it prints 26 GPa (the JSON keeps SI values)."""
+    js = tmp_path / "u.json"
+    r = run(["update", card, "--frequencies", TABLE, "--params", "E_board", "--max-iter", "1", "--out",
+             tmp_path / "out", "--json", js])
+    assert r.exit_code == 0, r.output
+    assert re.search(r"E_board\s+GPa\s+26\s+\d+\.\d+", r.output), r.output
+    e = json.loads(js.read_text())["parameters"]["E_board"]
+    assert (e["unit"], e["display_unit"], e["initial"]) == ("Pa", "GPa", 26e9)
