@@ -19,7 +19,7 @@ ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = ROOT / "examples"
 BOARDS = [EXAMPLES / n / "board.toml" for n in ("six_part_card", "plain_plate", "wedge_locked", "kicad_board")]
 BOARDS += sorted((ROOT / "tests" / "data" / "boards").glob("*.toml"))
-LIBRARY = sorted((ROOT / "pcbdyn" / "library").glob("*.toml"))
+LIBRARY = sorted((ROOT / "library").glob("*.toml"))
 
 
 @dataclass
