@@ -74,14 +74,12 @@ def command(study_toml: Path, out: Path | None, json_path: Path | None, schedule
     click.echo("mean success ratio [%]:\n" + table.round(1).to_string() + "\n")
     if out is not None:
         from ..report.localisation_plots import success_ratio_figure
+        from ..report.manifest import replacing
 
-        from ..report.manifest import settle
-
-        written = [out / name for name in ("shots.csv", "summary.csv", "success_ratios.png")]
-        write_text(written[0], df.to_csv(index=False))
-        write_text(written[1], summary.to_csv(index=False))
-        success_ratio_figure(written[2], summary)
-        settle(out, written, "pcbdyn study")
+        with replacing(out, "pcbdyn study") as run:  # the earlier --out stays whole until all is written
+            write_text(run.path / "shots.csv", df.to_csv(index=False))
+            write_text(run.path / "summary.csv", summary.to_csv(index=False))
+            success_ratio_figure(run.path / "success_ratios.png", summary)
         click.echo(f"wrote {out}/shots.csv, summary.csv, success_ratios.png", err=True)
     if json_path is not None:
         write_json(json_path, {"case": spec["case"], "true_errors": true,

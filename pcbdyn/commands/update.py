@@ -105,9 +105,19 @@ def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping,
                                  progress=lambda h: click.echo(rep.progress_line(h), err=True))
         done(t0)
         what = outcome(problem, res, before, after)
-        dst = problem.write_updated(res.p, result_path(out, board_toml, "updated", force), source=(
-            f"pcbdyn update ({what['status']})"))
-    rows = rep.parameter_rows(problem, res.p)
+        rows = rep.parameter_rows(problem, res.p)
+        source = f"pcbdyn update ({what['status']})"
+        if out is None:
+            dst = problem.write_updated(res.p, result_path(None, board_toml, "updated", force), source=source)
+        else:
+            from ..report.manifest import replacing
+
+            with replacing(out, "pcbdyn update") as staged:  # the earlier --out stays whole until all is written
+                dst = staged.final(problem.write_updated(res.p, result_path(staged.path, board_toml, "updated"),
+                                                         source=source))
+                rep.plot_iterations(staged.path / "iterations.png", problem, res)
+                write_text(staged.path / "parameters.txt", rep.format_parameters(rows) + "\n")
+                write_text(staged.path / "correlation.txt", rep.format_correlation(before, after) + "\n")
     click.echo(f"\n{board.name}: {what['status']} after {res.iterations} iteration(s) ({res.reason}; best iterate "
                f"{res.best_iteration})")
     for line in what["details"]:
@@ -116,13 +126,5 @@ def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping,
     click.echo("")
     click.echo(rep.format_correlation(before, after))
     click.echo(f"\nupdated board written to {dst}", err=True)
-    if out is not None:
-        from ..report.manifest import settle
-
-        written = [dst, out / "iterations.png", out / "parameters.txt", out / "correlation.txt"]
-        rep.plot_iterations(written[1], problem, res)
-        write_text(written[2], rep.format_parameters(rows) + "\n")
-        write_text(written[3], rep.format_correlation(before, after) + "\n")
-        settle(out, written, "pcbdyn update")
     if json_path is not None:
         write_json(json_path, rep.update_json(problem, res, rows, before, after, what, method, solver, dst))

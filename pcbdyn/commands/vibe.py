@@ -68,18 +68,18 @@ def command(board_toml, psd_text, sine_csv, sweep_rate, sweeps, damping_text, du
     click.echo("\n" + report.format_table(report.parts_table(a)))
     written = []
     if out is not None:
-        t0 = step(f"writing tables and pictures to {out}")
-        written = report.write_outputs(out, board, bm.model, a)
-        if html:
-            inputs = {"configuration": config or "base", "PSD": f"{psd_text} ({psd.source})",
-                      "sine sweep": str(sine_csv) if sine_csv else None, "damping": damping.describe(),
-                      "axis": axis, "duration": None if seconds is None else f"{seconds:g} s",
-                      "chassis frequency": None if chassis is None else f"{chassis:g} Hz",
-                      "excluded parts": ", ".join(exclude) or None}
-            written.append(report.html_page(out, board_toml, board, a, inputs).name)
-        from ..report.manifest import settle
+        from ..report.manifest import replacing
 
-        settle(out, [out / w for w in written], "pcbdyn vibe")
+        t0 = step(f"writing tables and pictures to {out}")
+        with replacing(out, "pcbdyn vibe") as run:  # the earlier --out stays whole until all is written
+            written = report.write_outputs(run.path, board, bm.model, a)
+            if html:
+                inputs = {"configuration": config or "base", "PSD": f"{psd_text} ({psd.source})",
+                          "sine sweep": str(sine_csv) if sine_csv else None, "damping": damping.describe(),
+                          "axis": axis, "duration": None if seconds is None else f"{seconds:g} s",
+                          "chassis frequency": None if chassis is None else f"{chassis:g} Hz",
+                          "excluded parts": ", ".join(exclude) or None}
+                written.append(report.html_page(run.path, board_toml, board, a, inputs).name)
         done(t0)
         click.echo(f"results written to {out}/ ({len(written)} files)", err=True)
     if json_path is not None:

@@ -122,3 +122,11 @@ def test_a_modulus_is_printed_in_gpa(card, tmp_path):
     assert re.search(r"E_board\s+GPa\s+26\s+\d+\.\d+", r.output), r.output
     e = json.loads(js.read_text())["parameters"]["E_board"]
     assert (e["unit"], e["display_unit"], e["initial"]) == ("Pa", "GPa", 26e9)
+
+
+def test_a_folder_that_is_not_pcbdyns_is_refused_as_out_before_any_work(card, tmp_path):
+    """--out replaces its folder whole: the board's own folder (files, no manifest) is refused, untouched."""
+    before = sorted(p.name for p in tmp_path.iterdir())
+    r = run(["update", card, "--frequencies", TABLE, "--max-iter", "1", "--out", tmp_path])
+    assert r.exit_code == 2 and "not an output folder of pcbdyn" in r.output and "building the models" not in r.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == before
