@@ -120,3 +120,27 @@ def test_the_localisation_figure_names_its_parameters_without_overlap(tmp_path, 
     shown = {t for t, _ in texts}
     assert {names[i] for i in (10, 12, 22, 24)} <= shown and f"1. {names[order[0]]}" in shown
     assert not overlapping(texts)
+
+
+def test_the_pictures_of_correlate_localize_and_update_on_the_card(tmp_path, drawn):
+    """The pictures the commands draw on the six-part card and a simulated test of it (MAC matrix, frequencies,
+    shape pairs, COMAC, localisation, FBM map, iterations): no text meets another."""
+    from click.testing import CliRunner
+
+    from pcbdyn.cli import main
+
+    def run(*args):
+        res = CliRunner().invoke(main, [str(a) for a in args])
+        assert res.exit_code == 0, res.output
+
+    card = CARD.parent
+    truth = tmp_path / "truth.toml"
+    truth.write_text(CARD.read_text().replace('E = "26 GPa"', 'E = "27 GPa"'))
+    run("simulate-test", truth, "--points", card / "points.csv", "--excite", "135,63.57", "--noise", "f=0.2,shape=2",
+        "--seed", 1, "--out", tmp_path / "t.uff")
+    run("correlate", CARD, tmp_path / "t.uff", "--out", tmp_path / "c")
+    run("localize", CARD, tmp_path / "t.uff", "--out", tmp_path / "l")
+    run("update", CARD, tmp_path / "t.uff", "--params", "E_board,t_PGA", "--max-iter", 3, "--out", tmp_path / "u")
+    assert {"mac_matrix.png", "frequencies.png", "comac.png", "localisation.png", "fbm_map.png", "iterations.png"} <= {
+        name.split(".pcbdyn~")[0].lstrip(".") + ".png" for name in drawn}
+    assert {name: overlapping(texts) for name, texts in drawn.items() if overlapping(texts)} == {}
