@@ -66,31 +66,37 @@ def summary_lines(a) -> list:
     return lines + [f"note: {n}" for n in a.notes]
 
 
-def board_map(path, board, model, a) -> None:
-    """RMS relative displacement over the board (grey) with each part's footprint coloured by its
-    margin (red fails Steinberg's criterion, green passes)."""
+def margin_map(path, board, model, field_mm, field_label: str, parts, margin_label: str, title: str) -> None:
+    """A response over the board (grey, ``field_mm`` per node) with each part's footprint coloured by
+    its margin (red fails, green passes); ``parts`` have ``ref`` and ``margin``."""
     from matplotlib.colors import TwoSlopeNorm
     from matplotlib.patches import Polygon
 
     plt = _plt()
-    fig, ax = plt.subplots(figsize=(7.0, 7.0))
+    (x0, y0), (x1, y1) = board.outline.bbox
+    fig, ax = plt.subplots(figsize=(7.5, float(np.clip(6.0 * (y1 - y0) / (x1 - x0), 3.0, 7.5)) + 2.0))
     _outline(ax, board.outline)
-    z = np.nan_to_num(a.node_z_rms) * 1e3
-    cf = ax.tricontourf(_shell_triangulation(model), z, levels=12, cmap="Greys", alpha=0.6)
-    fig.colorbar(cf, ax=ax, fraction=0.046, pad=0.02, label="RMS relative displacement [mm]")
+    cf = ax.tricontourf(_shell_triangulation(model), np.nan_to_num(field_mm), levels=12, cmap="Greys", alpha=0.6)
+    fig.colorbar(cf, ax=ax, fraction=0.046, pad=0.02, label=field_label)
     cmap, norm = plt.get_cmap("RdYlGn"), TwoSlopeNorm(vmin=-1.0, vcenter=0.0, vmax=1.0)
     corners = {c.ref: c.corners() for c in board.components}
-    for p in a.parts:
+    for p in parts:
         m = float(np.clip(p.margin, -1.0, 1.0))
         ax.add_patch(Polygon(corners[p.ref] * 1e3, closed=True, facecolor=cmap(norm(m)), edgecolor="k", alpha=0.9))
         x, y = corners[p.ref].mean(axis=0) * 1e3
         ax.text(x, y, f"{p.ref}\n{100 * p.margin:+.0f} %", ha="center", va="center", fontsize=8)
     sm = plt.cm.ScalarMappable(norm=norm, cmap=cmap)
-    fig.colorbar(sm, ax=ax, orientation="horizontal", fraction=0.05, pad=0.1,
-                 label="margin z_allow / (3 z_rms) - 1 (clipped at +-100 %)")
-    ax.set(aspect="equal", xlabel="x [mm]", ylabel="y [mm]",
-           title=f"{board.name}: margin per part under {a.psd.name} ({a.input_grms:.1f} grms, {a.axis})")
+    fig.colorbar(sm, ax=ax, orientation="horizontal", fraction=0.05, pad=0.1, label=f"{margin_label} (clipped at +-100 %)")
+    ax.set(aspect="equal", xlabel="x [mm]", ylabel="y [mm]")
+    ax.set_title(title, fontsize=10)
     _save(fig, path)
+
+
+def board_map(path, board, model, a) -> None:
+    """RMS relative displacement over the board with each part coloured by its margin."""
+    margin_map(path, board, model, a.node_z_rms * 1e3, "RMS relative displacement [mm]", a.parts,
+               "margin z_allow / (3 z_rms) - 1",
+               f"{board.name}: margin per part under {a.psd.name} ({a.input_grms:.1f} grms, {a.axis})")
 
 
 def spectra_plot(path, a) -> None:

@@ -42,6 +42,19 @@ from .transient import Oscillators, Peaks, refine, states
 POINTS_PER_CYCLE = 40
 #: periods of the fundamental the response is followed past the end of the input
 WINDOW_CYCLES = 2.0
+#: a pulse's modes are computed up to this many over its duration (an oscillator above responds to
+#: it nearly statically: a half-sine's SRS at Q = 10 is within 1.1 % of its peak from 10 / T up)
+PULSE_BAND = 10.0
+
+
+def analysis_band(inp) -> float:
+    """The frequency [Hz] up to which modes are computed (the static residual takes the rest): ten
+    over a pulse's duration, a record's Nyquist frequency, the top of an SRS."""
+    if isinstance(inp, SrsSpec):
+        return float(inp.f[-1])
+    if inp.kind == "history":
+        return 0.5 / float(np.diff(inp.t).min())
+    return PULSE_BAND / inp.duration
 
 
 @dataclass
