@@ -38,8 +38,9 @@ from .srs import octave_points, srs
 from .srs import combine as combine_peaks
 from .transient import Oscillators, Peaks, refine, states
 
-#: samples per period of the highest mode kept
+#: samples per period of the highest mode kept (at the parts; the board map every ``MAP_STRIDE``-th)
 POINTS_PER_CYCLE = 40
+MAP_STRIDE = 4
 #: periods of the fundamental the response is followed past the end of the input
 WINDOW_CYCLES = 2.0
 #: a pulse's modes are computed up to this many over its duration (an oscillator above responds to
@@ -146,10 +147,12 @@ class ShockAssessment:
         }
 
 
-def transient_peaks(be: BaseExcitation, t, a, displacement: dict, acceleration: dict, until: float) -> dict:
+def transient_peaks(be: BaseExcitation, t, a, displacement: dict, acceleration: dict, until: float,
+                    sparse: tuple = ()) -> dict:
     """{name: :class:`.transient.Peaks`} of the outputs read by each matrix of ``displacement``
     (rows on the columns [modes, R]) and of ``acceleration`` (rows on [r, modes, R]) under the base
-    acceleration (``t``, ``a``) (zero after it) from t[0] to ``until`` [s]."""
+    acceleration (``t``, ``a``) (zero after it) from t[0] to ``until`` [s]; the outputs named in
+    ``sparse`` (a whole board's nodes) are read at every ``MAP_STRIDE``-th point only."""
     t, a = np.asarray(t, dtype=float), np.asarray(a, dtype=float)
     if a[-1] != 0.0:  # zero after the record: a jump
         t, a = np.append(t, t[-1]), np.append(a, 0.0)
@@ -164,7 +167,8 @@ def transient_peaks(be: BaseExcitation, t, a, displacement: dict, acceleration: 
         z, zd = osc.displacement(y)
         q = np.column_stack([-gamma * z, -ab])
         for k, B in displacement.items():
-            peaks[k].update(tb, q @ B.T)
+            every = MAP_STRIDE if k in sparse else 1
+            peaks[k].update(tb[::every], q[::every] @ B.T)
         if acceleration:
             qdd = -gamma * (ab[:, None] - 2.0 * zw * zd - w2 * z)
             qa = np.column_stack([ab, qdd, np.zeros_like(ab)])
@@ -235,7 +239,7 @@ def assess_shock(board, bm, modes, K, M, inp: Transient | SrsSpec, damping: Damp
     timed = isinstance(inp, Transient)
     if timed:
         until = float(inp.t[-1]) + WINDOW_CYCLES / float(be.frequencies[0])
-        peaks = transient_peaks(be, inp.t, inp.a, disp, acc, until)
+        peaks = transient_peaks(be, inp.t, inp.a, disp, acc, until, sparse=("nodes",))
         node_peak = peaks["nodes"].magnitude
         f_srs = octave_points(*srs_band)
         s_srs, q_srs, rule = srs(inp.t, inp.a, f_srs, srs_q), srs_q, None

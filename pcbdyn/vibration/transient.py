@@ -23,8 +23,12 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.signal import lfilter
 
+from .spectra import VibrationError
+
 #: output points per block of the recursion (bounds the memory of long records)
 BLOCK = 4096
+#: most time points a response is sampled at (three arrays of this length are held)
+MAX_STEPS = 5_000_000
 #: steps whose lengths differ by less than this fraction of the longest step are taken as equal
 _SAME_STEP = 1e-9
 _TAYLOR = 18  # terms of the phi series used for |x| < 0.5 (the next term is below 1e-21)
@@ -88,7 +92,12 @@ def refine(t: np.ndarray, a: np.ndarray, h_max: float) -> tuple:
     into equal sub-steps no longer than ``h_max`` (a zero-length step, a jump, is kept as it is)."""
     t, a = np.asarray(t, dtype=float), np.asarray(a, dtype=float)
     length = np.diff(t)
-    n = np.maximum(1, np.ceil(length / h_max - 1e-9)).astype(int)
+    n = np.maximum(1, np.ceil(length / h_max - 1e-9))
+    if n.sum() > MAX_STEPS:
+        raise VibrationError(f"the input spans {t[-1] - t[0]:.4g} s: sampling the response {1 / h_max:.4g} times per "
+                             f"second takes {n.sum():.3g} points, more than {MAX_STEPS:.0e}; shorten the record to the "
+                             "shock itself (or lower the highest frequency asked for)")
+    n = n.astype(int)
     seg = np.repeat(np.arange(length.size), n)
     frac = (np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)) / np.repeat(n, n)
     tt = np.append(t[seg] + frac * length[seg], t[-1])
