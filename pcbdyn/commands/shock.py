@@ -10,7 +10,7 @@ from pathlib import Path
 import click
 
 from .common import PROBE_TOL, done, folder_outputs, input_errors, library_option, number_pair, solve_structure, step
-from .vibe import MAX_MODES
+from .vibe import MAX_MODES, report_verdict
 
 _FILE = click.Path(exists=True, dir_okay=False, path_type=Path)
 
@@ -48,7 +48,6 @@ def command(board_toml, pulse_text, history_csv, srs_csv, combination, damping_t
     responses at every part against Steinberg's shock allowable, and the SRS of the input."""
     from ..board import load_board
     from ..report import shock_report as report
-    from ..report.files import write_json
     from ..vibration import VibrationError, judged_parts, parse_damping
     from ..vibration.pulses import parse_pulse, read_history, read_srs
     from ..vibration.shock import analysis_band, assess_shock
@@ -68,23 +67,8 @@ def command(board_toml, pulse_text, history_csv, srs_csv, combination, damping_t
         s = assess_shock(board, bm, modes, K, M, inp, damping, axis=axis, parts=parts, combination=combination,
                          srs_band=band, srs_q=srs_q, probe_tol=PROBE_TOL)
         done(t0)
-    click.echo(f"\n{board.name} [{config or 'base'}] under {inp.name}:")
-    click.echo("\n".join(report.summary_lines(s)))
-    click.echo("\n" + report.format_table(report.parts_table(s)))
-    written = []
-    if out is not None:
-        t0 = step(f"writing tables and pictures to {out}")
-        written = report.write_outputs(out, board, bm.model, s)
-        if html:
-            inputs = {"configuration": config or "base", "input": inp.describe(), "damping": damping.describe(),
-                      "axis": axis, "SRS": f"Q = {s.srs_q:g}, {s.srs_f[0]:g}-{s.srs_f[-1]:.5g} Hz at 1/12 octave",
-                      "combination": s.combination.upper() if s.combination else None,
-                      "excluded parts": ", ".join(exclude) or None}
-            written.append(report.html_page(out, board_toml, board, s, inputs).name)
-        from ..report.manifest import settle
-
-        settle(out, [out / w for w in written], "pcbdyn shock")
-        done(t0)
-        click.echo(f"results written to {out}/ ({len(written)} files)", err=True)
-    if json_path is not None:
-        write_json(json_path, {"board": board.name, "configuration": config or "base", **s.to_dict(), "files": written})
+    inputs = {"configuration": config or "base", "input": inp.describe(), "damping": damping.describe(),
+              "axis": axis, "SRS": f"Q = {s.srs_q:g}, {s.srs_f[0]:g}-{s.srs_f[-1]:.5g} Hz at 1/12 octave",
+              "combination": s.combination.upper() if s.combination else None,
+              "excluded parts": ", ".join(exclude) or None}
+    report_verdict("shock", report, s, board_toml, board, bm.model, inp.name, inputs, out, json_path, html)

@@ -42,7 +42,6 @@ def command(board_toml, psd_text, sine_csv, sweep_rate, sweeps, damping_text, du
     from ..board import BoardError, load_board
     from ..fe import ModelError
     from ..report import vibration_report as report
-    from ..report.files import write_json
     from ..testdata import TestDataError
     from ..units import UnitError, to_si
     from ..vibration import (VibrationError, analysis_band, assess, judged_parts, load_psd, parse_damping,
@@ -63,25 +62,35 @@ def command(board_toml, psd_text, sine_csv, sweep_rate, sweeps, damping_text, du
         done(t0)
     except (BoardError, ModelError, TestDataError, UnitError, VibrationError) as exc:
         fail(str(exc))
-    click.echo(f"\n{board.name} [{config or 'base'}] under {psd.name}:")
-    click.echo("\n".join(report.summary_lines(a)))
-    click.echo("\n" + report.format_table(report.parts_table(a)))
+    inputs = {"configuration": config or "base", "PSD": f"{psd_text} ({psd.source})",
+              "sine sweep": str(sine_csv) if sine_csv else None, "damping": damping.describe(),
+              "axis": axis, "duration": None if seconds is None else f"{seconds:g} s",
+              "chassis frequency": None if chassis is None else f"{chassis:g} Hz",
+              "excluded parts": ", ".join(exclude) or None}
+    report_verdict("vibe", report, a, board_toml, board, bm.model, psd.name, inputs, out, json_path, html)
+
+
+def report_verdict(name: str, report, result, board_toml, board, model, input_name: str, inputs: dict, out, json_path,
+                   html: bool) -> None:
+    """The end of ``vibe`` and ``shock``: print the summary and the parts table of ``result`` (through
+    its ``report`` module), write its files into ``out`` (the page with ``html``, the manifest) and
+    the JSON, with the files written."""
+    click.echo(f"\n{board.name} [{inputs['configuration']}] under {input_name}:")
+    click.echo("\n".join(report.summary_lines(result)))
+    click.echo("\n" + report.format_table(report.parts_table(result)))
     written = []
     if out is not None:
-        t0 = step(f"writing tables and pictures to {out}")
-        written = report.write_outputs(out, board, bm.model, a)
-        if html:
-            inputs = {"configuration": config or "base", "PSD": f"{psd_text} ({psd.source})",
-                      "sine sweep": str(sine_csv) if sine_csv else None, "damping": damping.describe(),
-                      "axis": axis, "duration": None if seconds is None else f"{seconds:g} s",
-                      "chassis frequency": None if chassis is None else f"{chassis:g} Hz",
-                      "excluded parts": ", ".join(exclude) or None}
-            written.append(report.html_page(out, board_toml, board, a, inputs).name)
         from ..report.manifest import settle
 
-        settle(out, [out / w for w in written], "pcbdyn vibe")
+        t0 = step(f"writing tables and pictures to {out}")
+        written = report.write_outputs(out, board, model, result)
+        if html:
+            written.append(report.html_page(out, board_toml, board, result, inputs).name)
+        settle(out, [out / w for w in written], f"pcbdyn {name}")
         done(t0)
         click.echo(f"results written to {out}/ ({len(written)} files)", err=True)
     if json_path is not None:
-        write_json(json_path, {"board": board.name, "configuration": config or "base", **a.to_dict(),
+        from ..report.files import write_json
+
+        write_json(json_path, {"board": board.name, "configuration": inputs["configuration"], **result.to_dict(),
                                "files": written})

@@ -13,7 +13,8 @@ from ..vibration.spectra import G
 from ..vibration.srs import PV_SEVERE, pseudo_velocity
 from .correlation_plots import _plt, _save
 from .files import write_text
-from .vibration_report import format_table, margin_map
+from .vibration_report import format_table, margin_map, verdict, verdict_page
+from .vibration_report import modes_table as vibration_modes_table
 
 __all__ = ["format_table", "html_page", "parts_table", "summary_lines", "write_outputs"]
 
@@ -46,10 +47,10 @@ def parts_table(s) -> pd.DataFrame:
 
 
 def modes_table(s) -> pd.DataFrame:
-    be = s.excitation
-    return pd.DataFrame({"mode": np.arange(1, be.frequencies.size + 1), "frequency [Hz]": be.frequencies,
-                         "damping ratio": be.zeta, "Q": 0.5 / be.zeta, "participation [kg^0.5]": be.gamma,
-                         "eff. mass [%]": 100.0 * be.effective_mass_fraction, "damping from": s.damping_source})
+    """vibe's modes table with each mode's participation factor."""
+    df = vibration_modes_table(s)
+    df.insert(4, "participation [kg^0.5]", s.excitation.gamma)
+    return df
 
 
 def srs_table(s) -> pd.DataFrame:
@@ -111,20 +112,13 @@ def write_outputs(out: Path, board, model, s) -> list:
 
 def html_page(out: Path, board_toml, board, s, inputs: dict) -> Path:
     """report.html in ``out`` (after :func:`write_outputs`): verdicts, tables, pictures, inputs."""
-    from .html import Page, describe_file
-
-    failing = [p.ref for p in s.parts if not p.ok]
-    verdict = f"{len(failing)} of {len(s.parts)} part(s) fail: {', '.join(failing)}" if failing else \
-        f"all {len(s.parts)} part(s) pass Steinberg's shock criterion"
-    page = Page(f"pcbdyn shock: {board.name}", subtitle=f"{s.input.name} along {s.axis}: {verdict}")
-    page.items("Inputs", {"board": describe_file(board_toml), **inputs})
-    page.text("Summary", summary_lines(s))
-    page.table("Parts, worst margin first", parts_table(s), status=["good" if p.ok else "bad" for p in s.parts],
-               note="z: peak relative displacement normal to the board at the part's centre; z_allow: Steinberg's shock "
-                    "allowable (six times his vibration allowable) for a part where the board's displacement is "
-                    "measured; ratio z / z_allow; r: position factor read from the model (z / largest z on the board); "
-                    "a: peak absolute acceleration along the axis; kappa: peak curvature along or across the part, "
-                    "averaged over its footprint; t: time of each peak.")
+    page = verdict_page("shock", board, board_toml, f"{s.input.name} along {s.axis}: {verdict(s.parts, 'shock criterion')}",
+                        inputs, summary_lines(s), parts_table(s), s.parts,
+                        "z: peak relative displacement normal to the board at the part's centre; z_allow: Steinberg's "
+                        "shock allowable (six times his vibration allowable) for a part where the board's displacement "
+                        "is measured; ratio z / z_allow; r: position factor read from the model (z / largest z on the "
+                        "board); a: peak absolute acceleration along the axis; kappa: peak curvature along or across "
+                        "the part, averaged over its footprint; t: time of each peak.")
     page.pictures("Board map and shock response spectrum", [out / "board_map.png", out / "srs.png"],
                   ["margin per part over the peak relative displacement", "SRS and pseudo-velocity"])
     page.table("Shock response spectrum", srs_table(s))

@@ -134,22 +134,35 @@ def write_outputs(out: Path, board, model, a) -> list:
     return ["parts.csv", "modes.csv", "response_psd.csv", "board_map.png", "response_psd.png"]
 
 
-def html_page(out: Path, board_toml, board, a, inputs: dict) -> Path:
-    """report.html in ``out`` (after :func:`write_outputs`): verdicts, tables, pictures, inputs."""
+def verdict(parts, criterion: str) -> str:
+    """'2 of 6 part(s) fail: U1, U3' or 'all 6 part(s) pass Steinberg's <criterion>'."""
+    failing = [p.ref for p in parts if not p.ok]
+    return f"{len(failing)} of {len(parts)} part(s) fail: {', '.join(failing)}" if failing else \
+        f"all {len(parts)} part(s) pass Steinberg's {criterion}"
+
+
+def verdict_page(command: str, board, board_toml, subtitle: str, inputs: dict, summary: list, parts_df, parts,
+                 note: str):
+    """The head of the page of ``vibe`` and ``shock``: title, inputs, summary and the parts table
+    (rows coloured by verdict); the caller adds its pictures and tables and writes it."""
     from .html import Page, describe_file
 
-    failing = [p.ref for p in a.parts if not p.ok]
-    verdict = f"{len(failing)} of {len(a.parts)} part(s) fail: {', '.join(failing)}" if failing else \
-        f"all {len(a.parts)} part(s) pass Steinberg's criterion"
-    page = Page(f"pcbdyn vibe: {board.name}",
-                subtitle=f"{a.psd.name}, {a.input_grms:.2f} grms along {a.axis}: {verdict}")
+    page = Page(f"pcbdyn {command}: {board.name}", subtitle=subtitle)
     page.items("Inputs", {"board": describe_file(board_toml), **inputs})
-    page.text("Summary", summary_lines(a))
-    page.table("Parts, worst margin first", parts_table(a), status=["good" if p.ok else "bad" for p in a.parts],
-               note="z: RMS relative displacement normal to the board at the part's centre; z_allow: Steinberg's "
-                    "allowable (2e7 reversals at 3 sigma) for a part where the board's displacement is measured; "
-                    "r: Steinberg's position factor read from the model (z / largest z on the board); life: three-band "
-                    "technique and Miner's rule at the zero up-crossing rate nu0.")
+    page.text("Summary", summary)
+    page.table("Parts, worst margin first", parts_df, status=["good" if p.ok else "bad" for p in parts], note=note)
+    return page
+
+
+def html_page(out: Path, board_toml, board, a, inputs: dict) -> Path:
+    """report.html in ``out`` (after :func:`write_outputs`): verdicts, tables, pictures, inputs."""
+    page = verdict_page("vibe", board, board_toml,
+                        f"{a.psd.name}, {a.input_grms:.2f} grms along {a.axis}: {verdict(a.parts, 'criterion')}",
+                        inputs, summary_lines(a), parts_table(a), a.parts,
+                        "z: RMS relative displacement normal to the board at the part's centre; z_allow: Steinberg's "
+                        "allowable (2e7 reversals at 3 sigma) for a part where the board's displacement is measured; "
+                        "r: Steinberg's position factor read from the model (z / largest z on the board); life: "
+                        "three-band technique and Miner's rule at the zero up-crossing rate nu0.")
     page.pictures("Board map and response spectra", [out / "board_map.png", out / "response_psd.png"],
                   ["margin per part over the RMS relative displacement", "input and response acceleration PSDs"])
     page.table("Modes", modes_table(a))

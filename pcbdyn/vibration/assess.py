@@ -22,20 +22,15 @@ import numpy as np
 from . import steinberg
 from .base_excitation import BaseExcitation, base_excitation
 from .damping import Damping, modal_damping
-from .parts import judged_parts, part_readers, shell_nodes
+from .parts import PartVerdict, judged_parts, part_readers, shell_nodes
 from .spectra import G, Psd, SineSweep, VibrationError, frequency_grid
 
 
 @dataclass
-class PartResult:
-    """Steinberg's check of one part (SI units; lives in hours, None where nothing moves)."""
+class PartResult(PartVerdict):
+    """Steinberg's check of one part (SI units; lives in hours, None where nothing moves); its
+    margin z_allow / (3 z) - 1 is negative when it fails Steinberg's 2e7-cycle criterion."""
 
-    ref: str
-    package: str
-    c: float
-    span_m: float
-    length_m: float
-    position_factor: float
     z_rms_m: float
     z_allow_m: float
     z_allow_board_m: float | None
@@ -49,19 +44,8 @@ class PartResult:
     sine_damage: float | None = None
 
     @property
-    def margin(self) -> float:
-        """z_allow / (3 z) - 1: negative when the part fails Steinberg's 2e7-cycle criterion."""
-        return steinberg.margin(self.ratio)
-
-    @property
     def ok(self) -> bool:
         return self.ratio <= 1.0 and (self.damage or 0.0) < 1.0 and (self.sine_damage or 0.0) < 1.0
-
-    def to_dict(self) -> dict:
-        d = dict(self.__dict__)
-        d["margin"] = None if np.isinf(self.margin) else self.margin
-        d["ok"] = self.ok
-        return d
 
 
 @dataclass
@@ -127,6 +111,16 @@ def _sine(be: BaseExcitation, sine: SineSweep, B: np.ndarray, parts, results) ->
         res.sine_damage = sine.sweeps * steinberg.sweep_damage(f, z[:, j], res.z_allow_m, sine.rate)
 
 
+def board_excitation(board, bm, modes, K, M, damping: Damping, axis: str, probe_tol: float | None) -> tuple:
+    """(:class:`BaseExcitation` of the solved board along ``axis`` with the modal damping asked for,
+    where each mode's damping came from); a free board is refused naming its file."""
+    zeta, source = modal_damping(damping, bm.model, modes, probe_tol)
+    try:
+        return base_excitation(bm.model, modes, K, M, zeta, axis), source
+    except VibrationError as exc:
+        raise VibrationError(f"{board.path.name}: {exc}") from None
+
+
 def assess(board, bm, modes, K, M, psd: Psd, damping: Damping, *, axis: str = "z", duration: float | None = None,
            sine: SineSweep | None = None, chassis_hz: float | None = None, parts=None,
            probe_tol: float | None = None) -> Assessment:
@@ -137,11 +131,7 @@ def assess(board, bm, modes, K, M, psd: Psd, damping: Damping, *, axis: str = "z
     ``probe_tol`` [m]: how far off the board a test point of a UFF damping file may lie."""
     parts = judged_parts(board) if parts is None else parts
     model = bm.model
-    zeta, source = modal_damping(damping, model, modes, probe_tol)
-    try:
-        be = base_excitation(model, modes, K, M, zeta, axis)
-    except VibrationError as exc:
-        raise VibrationError(f"{board.path.name}: {exc}") from None
+    be, source = board_excitation(board, bm, modes, K, M, damping, axis, probe_tol)
     grid = frequency_grid(psd.f[0], psd.f[-1], be.frequencies, be.zeta)
     C0, C2 = be.covariance(psd, grid), be.covariance(psd, grid, moment=2)
     nodes = shell_nodes(model)

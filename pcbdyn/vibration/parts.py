@@ -44,6 +44,31 @@ class Part:
     samples: np.ndarray
 
 
+@dataclass
+class PartVerdict:
+    """What the part results of ``vibe`` and ``shock`` share: the part (reference, package, Steinberg
+    constant, board span B and length L [m], position factor r read from the model), the margin from
+    their ``ratio`` of response to allowable, and the JSON row (with the margin and ``ok``)."""
+
+    ref: str
+    package: str
+    c: float
+    span_m: float
+    length_m: float
+    position_factor: float
+
+    @property
+    def margin(self) -> float:
+        """allowable / response - 1: negative when the part fails (infinite when nothing moves)."""
+        return 1.0 / self.ratio - 1.0 if self.ratio > 0 else float("inf")
+
+    def to_dict(self) -> dict:
+        d = dict(self.__dict__)
+        d["margin"] = None if np.isinf(self.margin) else self.margin
+        d["ok"] = self.ok
+        return d
+
+
 def _chord(outline, centre, angle) -> float:
     """Length of the outline's chord through ``centre`` along ``angle`` (holes ignored)."""
     from shapely.geometry import LineString, Point, Polygon

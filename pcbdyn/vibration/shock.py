@@ -29,11 +29,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import steinberg
-from .base_excitation import BaseExcitation, base_excitation
-from .damping import Damping, modal_damping
-from .parts import judged_parts, part_readers, shell_nodes
+from .assess import board_excitation
+from .base_excitation import BaseExcitation
+from .damping import Damping
+from .parts import PartVerdict, judged_parts, part_readers, shell_nodes
 from .pulses import SrsSpec, Transient
-from .spectra import G, VibrationError
+from .spectra import G
 from .srs import octave_points, srs
 from .srs import combine as combine_peaks
 from .transient import Oscillators, Peaks, refine, states
@@ -59,15 +60,10 @@ def analysis_band(inp) -> float:
 
 
 @dataclass
-class ShockPart:
-    """Steinberg's shock check of one part (SI; times None for an SRS input)."""
+class ShockPart(PartVerdict):
+    """Steinberg's shock check of one part (SI; times None for an SRS input); its margin
+    z_allow / z - 1 is negative when it fails Steinberg's shock criterion."""
 
-    ref: str
-    package: str
-    c: float
-    span_m: float
-    length_m: float
-    position_factor: float
     z_peak_m: float
     t_peak_s: float | None
     z_allow_m: float
@@ -79,19 +75,8 @@ class ShockPart:
     t_curvature_s: float | None
 
     @property
-    def margin(self) -> float:
-        """z_allow / z - 1: negative when the part fails Steinberg's shock criterion."""
-        return steinberg.margin(self.ratio)
-
-    @property
     def ok(self) -> bool:
         return self.ratio <= 1.0
-
-    def to_dict(self) -> dict:
-        d = dict(self.__dict__)
-        d["margin"] = None if np.isinf(self.margin) else self.margin
-        d["ok"] = self.ok
-        return d
 
 
 @dataclass
@@ -222,11 +207,7 @@ def assess_shock(board, bm, modes, K, M, inp: Transient | SrsSpec, damping: Damp
     ``probe_tol`` as in :func:`.assess.assess`."""
     parts = judged_parts(board) if parts is None else parts
     model = bm.model
-    zeta, source = modal_damping(damping, model, modes, probe_tol)
-    try:
-        be = base_excitation(model, modes, K, M, zeta, axis)
-    except VibrationError as exc:
-        raise VibrationError(f"{board.path.name}: {exc}") from None
+    be, source = board_excitation(board, bm, modes, K, M, damping, axis, probe_tol)
     nodes = shell_nodes(model)
     disp = {"nodes": be.basis[6 * nodes + 2]}
     acc = {}

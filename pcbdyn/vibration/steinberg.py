@@ -57,12 +57,6 @@ def shock_allowable_displacement(span: float, length: float, thickness: float, c
     return SHOCK_FACTOR * allowable_displacement(span, length, thickness, c, r)
 
 
-def margin(ratio: float) -> float:
-    """allowable / response - 1 for a ``ratio`` of response to allowable: negative when a part fails
-    (infinite when nothing moves)."""
-    return 1.0 / ratio - 1.0 if ratio > 0 else float("inf")
-
-
 def reference_cycles(b: float = B_EXPONENT) -> float:
     """N_ref: cycles to failure at a displacement amplitude equal to the allowable (see module)."""
     return N_ALLOWABLE * sum(p * (k / 3.0) ** b for k, p in BANDS)

@@ -6,7 +6,7 @@ and a free board refused."""
 import numpy as np
 import pytest
 from closed_form import half_sine_response, maximax
-from vibe_plates import A, B, navier, solve, write_plate
+from vibe_plates import A, B, navier, solve, write_free_plate, write_plate
 
 from pcbdyn.vibration import parse_damping
 from pcbdyn.vibration.pulses import SrsSpec, parse_pulse, read_history
@@ -122,11 +122,7 @@ def test_the_json_contract(pulse_run):
 
 
 def test_free_board_is_refused(tmp_path):
-    path = tmp_path / "free.toml"
-    path.write_text(f'[board]\nname = "free"\noutline = {{ width = "{A * 1e3:g} mm", height = "{B * 1e3:g} mm" }}\n'
-                    'thickness = "1.6 mm"\nmaterial = { E = "22 GPa", nu = 0.15, rho = "1850 kg/m^3" }\n'
-                    'mesh_size = "20 mm"\n[analysis]\nmodes = 3\n')
-    board, bm, modes, K, M = solve(path, 2000.0)
+    board, bm, modes, K, M = solve(write_free_plate(tmp_path), 2000.0)
     with pytest.raises(VibrationError, match=r"free.toml: the model is free .*declare how the board is held in "
                                              r"\[\[fixtures\]\]"):
         assess_shock(board, bm, modes, K, M, parse_pulse("half-sine 100 g 1 ms"), parse_damping(None), parts=[])
