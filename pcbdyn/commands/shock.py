@@ -10,7 +10,7 @@ from pathlib import Path
 import click
 
 from .common import PROBE_TOL, done, folder_outputs, input_errors, library_option, number_pair, solve_structure, step
-from .vibe import MAX_MODES, report_verdict
+from .vibe import MAX_MODES, MIN_MODES, report_verdict
 
 _FILE = click.Path(exists=True, dir_okay=False, path_type=Path)
 
@@ -51,18 +51,20 @@ def command(board_toml, pulse_text, history_csv, srs_csv, combination, damping_t
     from ..vibration import VibrationError, judged_parts, parse_damping
     from ..vibration.pulses import parse_pulse, read_history, read_srs
     from ..vibration.shock import analysis_band, assess_shock
+    from ..vibration.srs import octave_points
 
     given = [x for x in (pulse_text, history_csv, srs_csv) if x is not None]
     if len(given) != 1:
         raise click.UsageError("give exactly one of --pulse, --history and --srs")
     band = number_pair(srs_band, "--srs-band", "Hz")
     with input_errors(VibrationError):
+        octave_points(*band)  # a bad band is said before any work
         board = load_board(board_toml)
         inp = parse_pulse(pulse_text) if pulse_text else read_history(history_csv) if history_csv else \
             read_srs(srs_csv, srs_q)
         damping = parse_damping(damping_text)
         parts = judged_parts(board, exclude)
-        bm, modes, K, M = solve_structure(board, config, n_modes=MAX_MODES, f_max=analysis_band(inp))
+        bm, modes, K, M = solve_structure(board, config, n_modes=MAX_MODES, f_max=analysis_band(inp), min_modes=MIN_MODES)
         t0 = step(f"shock response of {len(parts)} part(s) to {inp.name} along {axis}")
         s = assess_shock(board, bm, modes, K, M, inp, damping, axis=axis, parts=parts, combination=combination,
                          srs_band=band, srs_q=srs_q, probe_tol=PROBE_TOL)

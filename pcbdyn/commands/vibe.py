@@ -12,6 +12,8 @@ from .common import PROBE_TOL, done, fail, folder_outputs, library_option, solve
 
 #: at most this many modes are computed (all of them up to twice the top input frequency otherwise)
 MAX_MODES = 150
+#: at least this many, whatever the band (a spectrum below the fundamental still needs them)
+MIN_MODES = 3
 
 
 @click.command("vibe")
@@ -55,7 +57,8 @@ def command(board_toml, psd_text, sine_csv, sweep_rate, sweeps, damping_text, du
         seconds = to_si(duration, "s", "--duration") if duration is not None else psd.duration
         chassis = to_si(chassis_freq, "Hz", "--chassis-freq") if chassis_freq is not None else None
         parts = judged_parts(board, exclude)
-        bm, modes, K, M = solve_structure(board, config, n_modes=MAX_MODES, f_max=analysis_band(psd, sine))
+        bm, modes, K, M = solve_structure(board, config, n_modes=MAX_MODES, f_max=analysis_band(psd, sine),
+                                          min_modes=MIN_MODES)
         t0 = step(f"random response of {len(parts)} part(s) to {psd.name} along {axis}")
         a = assess(board, bm, modes, K, M, psd, damping, axis=axis, duration=seconds, sine=sine, chassis_hz=chassis,
                    parts=parts, probe_tol=PROBE_TOL)
