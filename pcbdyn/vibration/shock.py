@@ -35,7 +35,7 @@ from .damping import Damping
 from .parts import PartVerdict, judged_parts, part_readers, shell_nodes
 from .pulses import SrsSpec, Transient
 from .spectra import G
-from .srs import octave_points, srs
+from .srs import octave_points, pseudo_velocity, srs
 from .srs import combine as combine_peaks
 from .transient import Oscillators, Peaks, refine, states
 
@@ -106,8 +106,6 @@ class ShockAssessment:
         participation), parts[] (ref, z_peak_m, curvature_peak_1pm, z_allow_m, ratio, t_peak_s, ...)
         worst margin first, srs (frequency, value), and the rest."""
         be, inp = self.excitation, self.input
-        from .srs import pseudo_velocity
-
         return {
             "input": {"kind": inp.kind, "name": inp.name, "source": inp.source, "peak": inp.peak / G, "peak_unit": "g",
                       "duration": inp.duration, "duration_unit": "s",

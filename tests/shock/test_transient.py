@@ -81,3 +81,37 @@ def test_combination_rules():
     np.testing.assert_allclose(combine(terms, "srss"), [5.0, np.sqrt(3)])
     np.testing.assert_allclose(combine(terms, "abs"), [7.0, 3.0])
     np.testing.assert_allclose(combine(terms, "nrl"), [4.0 + 3.0, 1.0 + np.sqrt(2)])
+
+
+@pytest.mark.parametrize("text", ["sawtooth 100 g 6 ms", "trapezoid 50 g 11 ms rise 1 ms fall 2 ms"])
+def test_srs_of_the_other_pulses_matches_an_ode_solver(text):
+    """The terminal-peak sawtooth (its drop a jump: a step of zero length) and a trapezoid: the SRS
+    at Q = 10 against scipy's DOP853 on the oscillator's equation, tolerance 1e-11, with the
+    maximum of the absolute acceleration over its dense output (4000 points per period) during
+    and 3 periods after the pulse."""
+    from scipy.integrate import solve_ivp
+
+    from pcbdyn.vibration.pulses import parse_pulse
+
+    p = parse_pulse(text)
+    f = np.array([20.0, 150.0, 900.0, 4000.0])
+    got = srs(p.t, p.a, f, 10.0)
+    for fi, g in zip(f, got):
+        w, zeta = 2 * np.pi * fi, 0.05
+
+        def rhs(t, y):
+            a = np.interp(t, p.t, p.a, right=0.0) if t < p.t[-1] else 0.0
+            return [y[1], -a - 2 * zeta * w * y[1] - w**2 * y[0]]
+
+        peak = 0.0
+        for t0, t1, y0 in ((0.0, p.t[-1], [0.0, 0.0]), (p.t[-1], p.t[-1] + 3 / fi, None)):
+            sol = solve_ivp(rhs, (t0, t1), y0 if y0 is not None else last, method="DOP853", rtol=1e-11,
+                            atol=1e-14, dense_output=True, max_step=1 / (50 * fi))
+            tt = np.linspace(t0, t1, int(4000 * (t1 - t0) * fi) + 2)
+            z, zd = sol.sol(tt)
+            peak = max(peak, np.abs(2 * zeta * w * zd + w**2 * z).max())
+            last = sol.y[:, -1]
+        # the response is sampled 64 times per period while the pulse lasts: never above the true
+        # peak, at most 1 - cos(pi / 64) = 0.12 % below it (measured: 2.3e-4 at 150 Hz, trapezoid);
+        # the free decay's peak is exact (the reference's 4000 points per period miss 3e-7 of it)
+        assert peak * (1 - 1.3e-3) <= g <= peak * (1 + 1e-6), fi
