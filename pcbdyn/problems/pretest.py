@@ -1,0 +1,201 @@
+"""The pretest of a structure (board or box) from its model: sensors, their mass loading, the exciter and, for a
+free structure, its suspension, read off the target modes at candidate points (:mod:`.pretest_points`);
+the numerics are :mod:`pcbdyn.updating.design`'s. The perturbed configurations are :mod:`.pretest_configs`'.
+
+The model is the structure's base configuration on its independent DOFs (:class:`.system.ConfigSystem`,
+with the derivatives of the parameters named), its target modes the first N elastic ones or those in a band.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..fe.modal import eigenpairs
+from ..updating import design
+from .pretest_points import Candidates, is_box
+from .system import ConfigSystem, ProblemError
+
+#: spare modes solved above the target ones (a perturbation may move a mode across the last target)
+SPARE = 2
+
+
+@dataclass
+class PretestModel:
+    """``system`` (the base configuration), ``p0`` [SI] of its ``names``, the target modes' eigenvalues
+    ``lam`` [rad^2/s^2] and shapes ``phi`` (independent DOFs, mass-normalised), the rigid-body modes
+    ``rigid`` (a free structure's; (n, 0) otherwise)."""
+
+    structure: object
+    system: ConfigSystem
+    names: list
+    p0: np.ndarray
+    lam: np.ndarray
+    phi: np.ndarray
+    rigid: np.ndarray
+    mesh_size: float | None = None
+
+    @property
+    def free(self) -> bool:
+        return self.system.pm.model.free
+
+    @property
+    def frequencies(self) -> np.ndarray:
+        return np.sqrt(self.lam) / (2 * np.pi)
+
+    def matrices(self):
+        return self.system.model(self.p0)
+
+    def modes(self, extra_M=None, extra_K=None, n=None) -> tuple:
+        """(eigenvalues, shapes) of the first ``n`` (default: the targets') elastic modes of the base model
+        with ``extra_M``/``extra_K`` added (added masses, springs; sparse, independent DOFs)."""
+        K, M, _, _ = self.matrices()
+        K = K if extra_K is None else K + extra_K
+        M = M if extra_M is None else M + extra_M
+        n = self.lam.size if n is None else n
+        lam, vec, rigid = eigenpairs(K, M, n_modes=n, free=self.free)
+        order = np.argsort(lam[~rigid], kind="stable")[:n]
+        return lam[~rigid][order], vec[:, ~rigid][:, order]
+
+    def read(self, xyz, directions) -> sp.csr_matrix:
+        """P: the model read at points ``xyz`` (k, 3) along ``directions`` (k, 3)."""
+        return self.system.measurement_matrix(np.asarray(xyz, float), np.asarray(directions, float))
+
+    def point_mass(self, xyz, mass: float) -> sp.csr_matrix:
+        """The mass matrix of point masses ``mass`` [kg] at ``xyz`` (k, 3), moving with the shell's three
+        translations there (interpolated as the test reads them)."""
+        xyz = np.atleast_2d(np.asarray(xyz, float))
+        P = self.read(np.repeat(xyz, 3, axis=0), np.tile(np.eye(3), (len(xyz), 1)))
+        return sp.csr_matrix(mass * (P.T @ P))
+
+
+def pretest_model(structure, names=(), n_modes: int | None = None, band=None, mesh_size=None) -> PretestModel:
+    """The :class:`PretestModel` of ``structure``'s base configuration: ``n_modes`` target modes (default the
+    structure's [analysis] modes), or those in ``band`` = (lo, hi) [Hz]."""
+    pm = structure.build(None, mesh_size)
+    names = list(names)
+    system = ConfigSystem(pm, names)
+    p0 = np.array([pm.parameters[n].value for n in names], float)
+    K, M, _, _ = system.model(p0)
+    n = structure.analysis.modes if n_modes is None and band is None else n_modes
+    lam, vec, rigid = eigenpairs(K, M, n_modes=n, f_max=None if band is None else band[1], free=pm.model.free)
+    el = np.flatnonzero(~rigid)
+    el = el[np.argsort(lam[el], kind="stable")]
+    f = np.sqrt(np.clip(lam[el], 0, None)) / (2 * np.pi)
+    el = el[(f >= band[0]) & (f <= band[1])] if band is not None else el[:n]
+    if el.size == 0:
+        raise ProblemError(f"{structure.path.name}: no elastic mode in {band[0]:g}-{band[1]:g} Hz; widen --band")
+    return PretestModel(structure, system, names, p0, lam[el], vec[:, el], vec[:, rigid], mesh_size)
+
+
+# --------------------------------------------------------------------------------------------- sensors
+def sensor_directions(cand: Candidates, triaxial: bool) -> tuple:
+    """(directions (n_rows, 3), the candidate of each row, code of each row): triaxial x, y, z at every
+    point; uniaxial along the surface normal's axis (a board's z; a box plate's normal)."""
+    if triaxial:
+        d = np.tile(np.eye(3), (len(cand), 1))
+        return d, np.repeat(np.arange(len(cand)), 3), ["+x", "+y", "+z"] * len(cand)
+    axis = np.argmax(np.abs(cand.normal), axis=1)
+    return np.eye(3)[axis], np.arange(len(cand)), [f"+{'xyz'[a]}" for a in axis]
+
+
+@dataclass
+class Sensors:
+    """Chosen candidates ``chosen`` (indices into the candidates), the :class:`~pcbdyn.updating.design.SensorSet`
+    behind them, and the measured rows: ``directions`` (n_rows, 3), ``codes`` and ``point`` (candidate of
+    each row)."""
+
+    chosen: np.ndarray
+    result: design.SensorSet
+    directions: np.ndarray
+    codes: list
+    point: np.ndarray
+
+
+def choose_sensors(model: PretestModel, cand: Candidates, n_sensors: int, triaxial: bool,
+                   max_automac: float = 0.25) -> Sensors:
+    """EfI with the AutoMAC guard over the usable candidates (:func:`pcbdyn.updating.design.choose_sensors`)."""
+    use = np.flatnonzero(cand.usable)
+    dirs, point, codes = sensor_directions(cand, triaxial)
+    rows = np.flatnonzero(np.isin(point, use))
+    Phi = model.read(cand.xyz[point[rows]], dirs[rows]) @ model.phi
+    try:
+        res = design.choose_sensors(Phi, n_sensors, point[rows], max_automac)
+    except ValueError as exc:
+        raise ProblemError(f"--sensors: {exc}") from None
+    chosen = np.unique(point[rows])[res.chosen]
+    keep = np.flatnonzero(np.isin(point, chosen))
+    return Sensors(chosen, res, dirs[keep], [codes[i] for i in keep], point[keep])
+
+
+def mass_loading(model: PretestModel, xyz, sensor_mass: float) -> dict:
+    """What sensors of ``sensor_mass`` [kg] at ``xyz`` do to the target modes: the relative frequency shift
+    [%] to first order, -1/2 m sum phi^2 over their three translations (mass-normalised modes, the
+    Rayleigh quotient), and re-solved with the masses on."""
+    P = model.read(np.repeat(xyz, 3, axis=0), np.tile(np.eye(3), (len(xyz), 1)))
+    first = -50.0 * sensor_mass * np.sum(np.asarray(P @ model.phi) ** 2, axis=0)
+    lam, _ = model.modes(extra_M=model.point_mass(xyz, sensor_mass))
+    return {"sensor_mass_kg": sensor_mass, "first_order_pct": first,
+            "shift_pct": 100.0 * (np.sqrt(lam / model.lam) - 1.0)}
+
+
+# --------------------------------------------------------------------------------------------- exciter
+def choose_exciter(model: PretestModel, cand: Candidates) -> dict:
+    """The usable candidate, along its normal, whose smallest driving-point share over the target modes is
+    largest (:func:`pcbdyn.updating.design.best_exciter`)."""
+    dirs, _, codes = sensor_directions(cand, False)
+    Phi = model.read(cand.xyz, dirs) @ model.phi
+    j, share = design.best_exciter(Phi, cand.usable)
+    return {"index": j, "direction": codes[j], "share": share}
+
+
+# ------------------------------------------------------------------------------------------ suspension
+@dataclass
+class Suspension:
+    """Suspension springs of a free structure: ``chosen`` candidates (springs along the global z), the
+    stiffness ``k`` [N/m] of each, the suspension modes' frequencies predicted on the rigid-body modes
+    (``predicted_hz``) and re-solved with the springs on (``solved_hz``, the lowest six), the target
+    modes with the springs (``elastic_hz``) and the share of the first elastic mode aimed at."""
+
+    chosen: np.ndarray
+    k: float
+    predicted_hz: np.ndarray
+    solved_hz: np.ndarray
+    elastic_hz: np.ndarray
+    target_share: float
+
+    def shift_pct(self, free_hz) -> np.ndarray:
+        return 100.0 * (self.elastic_hz / np.asarray(free_hz) - 1.0)
+
+
+def springs(model: PretestModel, xyz, k: float) -> sp.csr_matrix:
+    """The stiffness of springs ``k`` [N/m] to ground along z at ``xyz`` (k, 3)."""
+    P = model.read(xyz, np.tile([0.0, 0.0, 1.0], (len(xyz), 1)))
+    return sp.csr_matrix(k * (P.T @ P))
+
+
+def choose_suspension(model: PretestModel, cand: Candidates, share: float = 0.1, max_shift_pct: float = 0.1,
+                      n_points: int = 4, n_low: int = 2) -> Suspension:
+    """Springs along z at ``n_points`` candidates near the nodal lines of the ``n_low`` lowest modes, spread
+    so that they hold every rigid motion they can (:func:`pcbdyn.updating.design.spread_points`), of the
+    stiffness that puts the highest suspension mode at ``share`` of the first elastic mode, or less where
+    that would shift a target mode by more than ``max_shift_pct`` to first order (50 k sum phi^2 / lambda
+    %); then solved again with the springs on (the suspension modes are the six lowest)."""
+    if not model.free:
+        raise ProblemError(f"{model.structure.path.name}: the structure is held by its supports; a suspension is "
+                           "for a free one")
+    z = np.tile([0.0, 0.0, 1.0], (len(cand), 1))
+    at = np.asarray(model.read(cand.xyz, z) @ np.column_stack([model.phi, model.rigid]))
+    phi, R = at[:, :model.lam.size], at[:, model.lam.size:]
+    use = np.flatnonzero(cand.usable)
+    pick = use[design.spread_points(design.nodal_score(phi[use, :n_low]), R[use], n_points)]
+    unit = design.spring_share(R[pick])
+    omega = 2 * np.pi * share * float(model.frequencies[0])
+    shift_per_k = float(np.max(50.0 * np.sum(phi[pick] ** 2, axis=0) / model.lam))
+    k = min(omega**2 / float(unit.max()), max_shift_pct / shift_per_k)
+    K, M, _, _ = model.matrices()
+    lam, _, _ = eigenpairs(K + springs(model, cand.xyz[pick], k), M, n_modes=model.lam.size + 6, free=True)
+    f = np.sqrt(np.clip(np.sort(lam), 0, None)) / (2 * np.pi)
+    return Suspension(pick, k, np.sqrt(k * unit) / (2 * np.pi), f[:6], f[6:6 + model.lam.size], share)
