@@ -2,66 +2,73 @@
 free structure, its suspension, read off the target modes at candidate points (:mod:`.pretest_points`);
 the numerics are :mod:`pcbdyn.updating.design`'s. The perturbed configurations are :mod:`.pretest_configs`'.
 
-The model is the structure's base configuration on its independent DOFs (:class:`.system.ConfigSystem`,
-with the derivatives of the parameters named), its target modes the first N elastic ones or those in a band.
+The model is the structure's base configuration on its independent DOFs with the derivatives of the
+parameters named, its target modes the first N elastic ones or those in a band.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.sparse as sp
 
+from ..fe.assembly import assemble
+from ..fe.constraints import build_reduction
 from ..fe.modal import eigenpairs
+from ..fe.probe import model_probe
 from ..updating import design
+from .models import parameter_derivatives
 from .pretest_points import Candidates, is_box
-from .system import ConfigSystem, ProblemError
-
-#: spare modes solved above the target ones (a perturbation may move a mode across the last target)
-SPARE = 2
-
+from .system import ProblemError
 
 @dataclass
 class PretestModel:
-    """``system`` (the base configuration), ``p0`` [SI] of its ``names``, the target modes' eigenvalues
-    ``lam`` [rad^2/s^2] and shapes ``phi`` (independent DOFs, mass-normalised), the rigid-body modes
-    ``rigid`` (a free structure's; (n, 0) otherwise)."""
+    """One configuration of ``structure`` (``pm``, built) at its parameters' starting values ``p0`` [SI]:
+    ``K``, ``M`` and the derivatives ``dKs``, ``dMs`` of the parameters ``names`` on the independent DOFs
+    (``reduction``), the target modes' eigenvalues ``lam`` [rad^2/s^2] and shapes ``phi`` (mass-normalised),
+    and the rigid-body modes ``rigid`` (a free structure's; (n, 0) otherwise). The matrices are made once,
+    at p0: a design is linear there."""
 
     structure: object
-    system: ConfigSystem
+    pm: object
     names: list
     p0: np.ndarray
-    lam: np.ndarray
-    phi: np.ndarray
-    rigid: np.ndarray
+    K: sp.spmatrix
+    M: sp.spmatrix
+    dKs: list
+    dMs: list
+    reduction: object
+    lam: np.ndarray = None
+    phi: np.ndarray = None
+    rigid: np.ndarray = None
     mesh_size: float | None = None
 
     @property
     def free(self) -> bool:
-        return self.system.pm.model.free
+        return self.pm.model.free
 
     @property
     def frequencies(self) -> np.ndarray:
         return np.sqrt(self.lam) / (2 * np.pi)
 
     def matrices(self):
-        return self.system.model(self.p0)
+        return self.K, self.M, self.dKs, self.dMs
 
     def modes(self, extra_M=None, extra_K=None, n=None) -> tuple:
-        """(eigenvalues, shapes) of the first ``n`` (default: the targets') elastic modes of the base model
-        with ``extra_M``/``extra_K`` added (added masses, springs; sparse, independent DOFs)."""
-        K, M, _, _ = self.matrices()
-        K = K if extra_K is None else K + extra_K
-        M = M if extra_M is None else M + extra_M
+        """(eigenvalues, shapes) of the first ``n`` (default: the targets') elastic modes with ``extra_M``/
+        ``extra_K`` added (added masses, springs; sparse, independent DOFs)."""
+        K = self.K if extra_K is None else self.K + extra_K
+        M = self.M if extra_M is None else self.M + extra_M
         n = self.lam.size if n is None else n
         lam, vec, rigid = eigenpairs(K, M, n_modes=n, free=self.free)
         order = np.argsort(lam[~rigid], kind="stable")[:n]
         return lam[~rigid][order], vec[:, ~rigid][:, order]
 
     def read(self, xyz, directions) -> sp.csr_matrix:
-        """P: the model read at points ``xyz`` (k, 3) along ``directions`` (k, 3)."""
-        return self.system.measurement_matrix(np.asarray(xyz, float), np.asarray(directions, float))
+        """P: the model read at points ``xyz`` (k, 3) along ``directions`` (k, 3), on the independent DOFs."""
+        P = model_probe(self.pm.model, np.asarray(xyz, float), np.asarray(directions, float)).P
+        return sp.csr_matrix(P @ self.reduction.T)
 
     def point_mass(self, xyz, mass: float) -> sp.csr_matrix:
         """The mass matrix of point masses ``mass`` [kg] at ``xyz`` (k, 3), moving with the shell's three
@@ -71,23 +78,34 @@ class PretestModel:
         return sp.csr_matrix(mass * (P.T @ P))
 
 
+def configuration_model(structure, config=None, names=(), mesh_size=None) -> PretestModel:
+    """The :class:`PretestModel` of one configuration without modes: K, M by one assembly, the
+    derivatives by central differences of the sets each parameter touches (one evaluation at p0: no
+    interpolation of the matrices over the parameters' range is worth making)."""
+    pm = structure.build(config, mesh_size)
+    names = list(names)
+    K, M = assemble(pm.model)
+    red = build_reduction(pm.model, K, M)
+    pairs = parameter_derivatives(pm, names)
+    p0 = np.array([pm.parameters[n].value for n in names], float)
+    return PretestModel(structure, pm, names, p0, red.reduce(K), red.reduce(M), [red.reduce(dK) for dK, _ in pairs],
+                        [red.reduce(dM) for _, dM in pairs], red, mesh_size=mesh_size)
+
+
 def pretest_model(structure, names=(), n_modes: int | None = None, band=None, mesh_size=None) -> PretestModel:
     """The :class:`PretestModel` of ``structure``'s base configuration: ``n_modes`` target modes (default the
     structure's [analysis] modes), or those in ``band`` = (lo, hi) [Hz]."""
-    pm = structure.build(None, mesh_size)
-    names = list(names)
-    system = ConfigSystem(pm, names)
-    p0 = np.array([pm.parameters[n].value for n in names], float)
-    K, M, _, _ = system.model(p0)
+    model = configuration_model(structure, None, names, mesh_size)
     n = structure.analysis.modes if n_modes is None and band is None else n_modes
-    lam, vec, rigid = eigenpairs(K, M, n_modes=n, f_max=None if band is None else band[1], free=pm.model.free)
+    lam, vec, rigid = eigenpairs(model.K, model.M, n_modes=n, f_max=None if band is None else band[1],
+                                 free=model.free)
     el = np.flatnonzero(~rigid)
     el = el[np.argsort(lam[el], kind="stable")]
     f = np.sqrt(np.clip(lam[el], 0, None)) / (2 * np.pi)
     el = el[(f >= band[0]) & (f <= band[1])] if band is not None else el[:n]
     if el.size == 0:
         raise ProblemError(f"{structure.path.name}: no elastic mode in {band[0]:g}-{band[1]:g} Hz; widen --band")
-    return PretestModel(structure, system, names, p0, lam[el], vec[:, el], vec[:, rigid], mesh_size)
+    return replace(model, lam=lam[el], phi=vec[:, el], rigid=vec[:, rigid])
 
 
 # --------------------------------------------------------------------------------------------- sensors
@@ -143,12 +161,13 @@ def mass_loading(model: PretestModel, xyz, sensor_mass: float) -> dict:
 
 # --------------------------------------------------------------------------------------------- exciter
 def choose_exciter(model: PretestModel, cand: Candidates) -> dict:
-    """The usable candidate, along its normal, whose smallest driving-point share over the target modes is
-    largest (:func:`pcbdyn.updating.design.best_exciter`)."""
-    dirs, _, codes = sensor_directions(cand, False)
-    Phi = model.read(cand.xyz, dirs) @ model.phi
-    j, share = design.best_exciter(Phi, cand.usable)
-    return {"index": j, "direction": codes[j], "share": share}
+    """The usable candidate and direction (a board: its normal; a box, whose modes live on different plates:
+    x, y or z) whose smallest driving-point share over the target modes is largest
+    (:func:`pcbdyn.updating.design.best_exciter`)."""
+    dirs, point, codes = sensor_directions(cand, is_box(model.structure))
+    Phi = model.read(cand.xyz[point], dirs) @ model.phi
+    j, share = design.best_exciter(Phi, cand.usable[point])
+    return {"index": int(point[j]), "direction": codes[j], "share": share}
 
 
 # ------------------------------------------------------------------------------------------ suspension

@@ -21,9 +21,8 @@ from ..inputs import entry_name, new_entry_name
 from ..updating import design
 from ..updating.equations import frequency_equations
 from ..updating.pbc import condition_number
-from .pretest import PretestModel
+from .pretest import PretestModel, configuration_model
 from .pretest_points import Candidates, is_box
-from .system import ConfigSystem
 
 
 def frequency_block(lam, phi, model: PretestModel, dKs, dMs, sigma_rel: float) -> np.ndarray:
@@ -87,7 +86,7 @@ def design_configurations(model: PretestModel, cand: Candidates, masses, k: int,
     if names:
         own = []
         for c in names:
-            other = replace(model, system=ConfigSystem(model.structure.build(c, model.mesh_size), model.names))
+            other = replace(configuration_model(model.structure, c, model.names, model.mesh_size), lam=model.lam)
             lam, phi = other.modes()
             _, _, dK, dM = other.matrices()
             own.append(frequency_block(lam, phi, model, dK, dM, sigma))
