@@ -52,7 +52,7 @@ def six_thickness_card(path: Path) -> Path:
     text = (CARD / "board.toml").read_text().split("[[parameters]]")[0].rstrip() + "\n"
     text += "".join(f'\n[[parameters]]\nname = "t_U{i}"\ntarget = "components.U{i}.thickness"\n'
                     'bounds = ["2 mm", "10 mm"]\n' for i in range(1, 7))
-    path.write_text(text)
+    path.write_text(text + "\n[analysis]\nmodes = 7\n")
     return path
 
 
