@@ -39,21 +39,12 @@ from pcbdyn.problems.pretest_points import read_candidates  # noqa: E402
 from pcbdyn.testdata import Noise, read_points_csv  # noqa: E402
 from pcbdyn.testdata.simulate import simulate_on_model  # noqa: E402
 
-ROOT = Path(__file__).resolve().parents[1]
-CARD = ROOT / "examples/six_part_card"
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "problems"))
+from pretest_cards import CARD, NAMES, six_thickness_card  # noqa: E402
+
 TRUE_T = np.array([4.2, 3.0, 4.0, 2.9, 3.9, 4.4]) * 1e-3
-NAMES = [f"t_U{i}" for i in range(1, 7)]
 F_PCT, SHAPE_PCT = 0.2, 2.0
 MASSES = [0.010, 0.020, 0.0532]
-
-
-def six_thickness_card(path: Path) -> Path:
-    """The six-part card with t_U1..t_U6 as its parameters (instead of the families and E)."""
-    text = (CARD / "board.toml").read_text().split("[[parameters]]")[0].rstrip() + "\n"
-    text += "".join(f'\n[[parameters]]\nname = "t_U{i}"\ntarget = "components.U{i}.thickness"\n'
-                    'bounds = ["2 mm", "10 mm"]\n' for i in range(1, 7))
-    path.write_text(text + "\n[analysis]\nmodes = 7\n")
-    return path
 
 
 def truth_card(model_toml: Path, path: Path) -> Path:

@@ -25,6 +25,11 @@ from .pretest import PretestModel, configuration_model
 from .pretest_points import Candidates, is_box
 
 
+#: a configuration none of whose target frequencies moves by this many sigma of the frequency noise cannot
+#: be told from the base test: it would count as a replicate of it (more information, the same directions)
+NOT_TOLD = 3.0
+
+
 def frequency_block(lam, phi, model: PretestModel, dKs, dMs, sigma_rel: float) -> np.ndarray:
     """Rows d(f_i)/f_i per x_j (eq. 3.2, relative rows, column-weighted), over the relative noise."""
     f = np.sqrt(lam) / (2 * np.pi)
@@ -42,7 +47,8 @@ def identifiability(model: PretestModel, blocks) -> dict:
 class Design:
     """``chosen``: [(candidate index, mass [kg])] of each designed configuration; ``before``/``after``/
     ``existing`` (the structure's own configurations with the base test; None without any):
-    :func:`identifiability` dicts; ``candidates``: how many (place, mass) candidates were weighed."""
+    :func:`identifiability` dicts; ``candidates``: how many (place, mass) candidates were weighed (those
+    that move a target mode by at least :data:`NOT_TOLD` sigma of the frequency noise)."""
 
     chosen: list
     before: dict
@@ -76,10 +82,16 @@ def design_configurations(model: PretestModel, cand: Candidates, masses, k: int,
         unit = model.point_mass(cand.xyz[i], 1.0)
         for m in masses:
             lam, phi = model.modes(extra_M=m * unit)
+            if np.max(np.abs(np.sqrt(lam / model.lam) - 1.0)) < NOT_TOLD * sigma:
+                continue  # the base test again, within the noise: a replicate, not a perturbation
             blocks.append(frequency_block(lam, phi, model, dKs, dMs, sigma))
             which.append((int(i), float(m)))
         if progress is not None:
             progress(n + 1, where.size)
+    if len({i for i, _ in which}) < k:
+        raise StructureError(f"{model.structure.path.name}: only {len({i for i, _ in which})} candidate places move "
+                             f"a target mode by more than {NOT_TOLD:g} sigma of the frequency noise with the masses "
+                             f"offered; offer heavier --masses, more places (--max-places), or fewer --configurations")
     pick = design.d_optimal(base.T @ base, np.stack([A.T @ A for A in blocks]), k, [i for i, _ in which])
     existing = None
     names = model.structure.configuration_names()

@@ -61,7 +61,7 @@ def summary(data: dict) -> str:
     lines = [f"{data['structure']}: {len(data['target_modes_hz'])} target modes ({f} Hz); "
              f"{data['candidates']['usable']} of {data['candidates']['count']} candidate points usable"]
     s = data["sensors"]
-    lines.append(f"sensors: {len(s)} ({s[0]['direction'] if s else '-'}), log det(Phi^T Phi) "
+    lines.append(f"sensors: {len(s)} ({', '.join(sorted({q['direction'] for q in s}))}), log det(Phi^T Phi) "
                  f"{data['fisher_log_det']:.2f} (EfI alone {data['efi_log_det']:.2f}), largest off-diagonal AutoMAC "
                  f"{data['automac_max_offdiag']:.3f}")
     ml = data["mass_loading"]

@@ -6,7 +6,6 @@ benchmarks/bench_pretest_configs.py."""
 
 from __future__ import annotations
 
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -17,18 +16,9 @@ from pcbdyn.problems.pretest_configs import (configuration_entries, design_confi
                                              identifiability, write_configurations)
 from pcbdyn.problems.pretest_points import read_candidates
 from pcbdyn.updating import design
+from pretest_cards import CARD, NAMES, six_thickness_card
 
-CARD = Path(__file__).resolve().parents[2] / "examples/six_part_card"
-NAMES = [f"t_U{i}" for i in range(1, 7)]
 SIGMA = 0.2 / 100 / np.sqrt(3)
-
-
-def six_thickness_card(path: Path) -> Path:
-    text = (CARD / "board.toml").read_text().split("[[parameters]]")[0].rstrip() + "\n"
-    text += "".join(f'\n[[parameters]]\nname = "t_U{i}"\ntarget = "components.U{i}.thickness"\n'
-                    'bounds = ["2 mm", "10 mm"]\n' for i in range(1, 7))
-    path.write_text(text + "\n[analysis]\nmodes = 7\n")
-    return path
 
 
 def blocks_of(board, model, configs):
