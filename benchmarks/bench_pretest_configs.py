@@ -79,7 +79,8 @@ def predicted_at_truth(truth_model_toml: Path, configs) -> dict:
     for label, cfgs in configs.items():
         blocks = []
         for c in [None] + cfgs:
-            m = base if c is None else replace(configuration_model(board, c, NAMES), lam=base.lam)
+            m = base if c is None else replace(configuration_model(board, c, NAMES), lam=base.lam,
+                                               position=base.position)
             lam, phi = m.modes()
             _, _, dK, dM = m.matrices()
             blocks.append(frequency_block(lam, phi, m, dK, dM, sigma))

@@ -27,8 +27,10 @@ class PretestModel:
     """One configuration of ``structure`` (``pm``, built) at its parameters' starting values ``p0`` [SI]:
     ``K``, ``M`` and the derivatives ``dKs``, ``dMs`` of the parameters ``names`` on the independent DOFs
     (``reduction``), the target modes' eigenvalues ``lam`` [rad^2/s^2] and shapes ``phi`` (mass-normalised),
-    and the rigid-body modes ``rigid`` (a free structure's; (n, 0) otherwise). The matrices are made once,
-    at p0: a design is linear there."""
+    and the rigid-body modes ``rigid`` (a free structure's; (n, 0) otherwise); ``position``: each target's
+    place among the elastic modes (0: the first), ``low_lam``, ``low_phi``: the two lowest elastic modes
+    (those a suspension must leave alone first). The matrices are made once, at p0: a design is linear
+    there."""
 
     structure: object
     pm: object
@@ -43,6 +45,9 @@ class PretestModel:
     phi: np.ndarray = None
     rigid: np.ndarray = None
     mesh_size: float | None = None
+    position: np.ndarray = None
+    low_lam: np.ndarray = None
+    low_phi: np.ndarray = None
 
     @property
     def free(self) -> bool:
@@ -55,14 +60,14 @@ class PretestModel:
     def matrices(self):
         return self.K, self.M, self.dKs, self.dMs
 
-    def modes(self, extra_M=None, extra_K=None, n=None) -> tuple:
-        """(eigenvalues, shapes) of the first ``n`` (default: the targets') elastic modes with ``extra_M``/
-        ``extra_K`` added (added masses, springs; sparse, independent DOFs)."""
+    def modes(self, extra_M=None, extra_K=None) -> tuple:
+        """(eigenvalues, shapes) of the elastic modes at the targets' places (``position``; default the first
+        ones) with ``extra_M``/``extra_K`` added (added masses, springs; sparse, independent DOFs)."""
         K = self.K if extra_K is None else self.K + extra_K
         M = self.M if extra_M is None else self.M + extra_M
-        n = self.lam.size if n is None else n
-        lam, vec, rigid = eigenpairs(K, M, n_modes=n, free=self.free)
-        order = np.argsort(lam[~rigid], kind="stable")[:n]
+        at = np.arange(self.lam.size) if self.position is None else self.position
+        lam, vec, rigid = eigenpairs(K, M, n_modes=int(at.max()) + 1, free=self.free)
+        order = np.argsort(lam[~rigid], kind="stable")[at]
         return lam[~rigid][order], vec[:, ~rigid][:, order]
 
     def read(self, xyz, directions) -> sp.csr_matrix:
@@ -102,10 +107,12 @@ def pretest_model(structure, names=(), n_modes: int | None = None, band=None, me
     el = np.flatnonzero(~rigid)
     el = el[np.argsort(lam[el], kind="stable")]
     f = np.sqrt(np.clip(lam[el], 0, None)) / (2 * np.pi)
-    el = el[(f >= band[0]) & (f <= band[1])] if band is not None else el[:n]
-    if el.size == 0:
+    position = np.flatnonzero((f >= band[0]) & (f <= band[1])) if band is not None else np.arange(min(n, el.size))
+    if position.size == 0:
         raise ProblemError(f"{structure.path.name}: no elastic mode in {band[0]:g}-{band[1]:g} Hz; widen --band")
-    return replace(model, lam=lam[el], phi=vec[:, el], rigid=vec[:, rigid])
+    tg, low = el[position], el[:2]
+    return replace(model, lam=lam[tg], phi=vec[:, tg], rigid=vec[:, rigid], position=position, low_lam=lam[low],
+                   low_phi=vec[:, low])
 
 
 # --------------------------------------------------------------------------------------------- sensors
@@ -196,25 +203,29 @@ def springs(model: PretestModel, xyz, k: float) -> sp.csr_matrix:
 
 
 def choose_suspension(model: PretestModel, cand: Candidates, share: float = 0.1, max_shift_pct: float = 0.1,
-                      n_points: int = 4, n_low: int = 2) -> Suspension:
-    """Springs along z at ``n_points`` candidates near the nodal lines of the ``n_low`` lowest modes, spread
+                      n_points: int = 4) -> Suspension:
+    """Springs along z at ``n_points`` candidates near the nodal lines of the two lowest elastic modes, spread
     so that they hold every rigid motion they can (:func:`pcbdyn.updating.design.spread_points`), of the
     stiffness that puts the highest suspension mode at ``share`` of the first elastic mode, or less where
-    that would shift a target mode by more than ``max_shift_pct`` to first order (50 k sum phi^2 / lambda
-    %); then solved again with the springs on (the suspension modes are the six lowest)."""
+    that would shift one of those two or a target mode by more than ``max_shift_pct`` to first order
+    (50 k sum phi^2 / lambda %); then solved again with the springs on (the suspension modes are the six
+    lowest, the targets keep their places among the elastic modes)."""
     if not model.free:
         raise ProblemError(f"{model.structure.path.name}: the structure is held by its supports; a suspension is "
                            "for a free one")
     z = np.tile([0.0, 0.0, 1.0], (len(cand), 1))
-    at = np.asarray(model.read(cand.xyz, z) @ np.column_stack([model.phi, model.rigid]))
-    phi, R = at[:, :model.lam.size], at[:, model.lam.size:]
+    at = np.asarray(model.read(cand.xyz, z) @ np.column_stack([model.low_phi, model.phi, model.rigid]))
+    n_low, n_t = model.low_lam.size, model.lam.size
+    low, R = at[:, :n_low], at[:, n_low + n_t:]
     use = np.flatnonzero(cand.usable)
-    pick = use[design.spread_points(design.nodal_score(phi[use, :n_low]), R[use], n_points)]
+    pick = use[design.spread_points(design.nodal_score(low[use]), R[use], n_points)]
     unit = design.spring_share(R[pick])
-    omega = 2 * np.pi * share * float(model.frequencies[0])
-    shift_per_k = float(np.max(50.0 * np.sum(phi[pick] ** 2, axis=0) / model.lam))
+    omega = share * float(np.sqrt(model.low_lam[0]))
+    lam_all = np.r_[model.low_lam, model.lam]
+    shift_per_k = float(np.max(50.0 * np.sum(at[pick, :n_low + n_t] ** 2, axis=0) / lam_all))
     k = min(omega**2 / float(unit.max()), max_shift_pct / shift_per_k)
     K, M, _, _ = model.matrices()
-    lam, _, _ = eigenpairs(K + springs(model, cand.xyz[pick], k), M, n_modes=model.lam.size + 6, free=True)
+    lam, _, _ = eigenpairs(K + springs(model, cand.xyz[pick], k), M, n_modes=int(model.position.max()) + 7,
+                           free=True)
     f = np.sqrt(np.clip(np.sort(lam), 0, None)) / (2 * np.pi)
-    return Suspension(pick, k, np.sqrt(k * unit) / (2 * np.pi), f[:6], f[6:6 + model.lam.size], share)
+    return Suspension(pick, k, np.sqrt(k * unit) / (2 * np.pi), f[:6], f[6 + model.position], share)

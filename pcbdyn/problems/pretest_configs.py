@@ -98,7 +98,8 @@ def design_configurations(model: PretestModel, cand: Candidates, masses, k: int,
     if names:
         own = []
         for c in names:
-            other = replace(configuration_model(model.structure, c, model.names, model.mesh_size), lam=model.lam)
+            other = replace(configuration_model(model.structure, c, model.names, model.mesh_size), lam=model.lam,
+                            position=model.position)
             lam, phi = other.modes()
             _, _, dK, dM = other.matrices()
             own.append(frequency_block(lam, phi, model, dK, dM, sigma))

@@ -38,12 +38,13 @@ def pretest_json(structure, model, cand, source: dict, sensors, loading, exciter
                     "share_per_mode": exciter["share"].tolist(), "min_share": float(exciter["share"].min())},
     }
     if suspension is not None:
+        first = float(np.sqrt(model.low_lam[0]) / (2 * np.pi))
         data["suspension"] = {
             "points": [_where(cand, i, box) for i in suspension.chosen], "direction": "+z",
             "stiffness_n_per_m": suspension.k, "suspension_hz": suspension.solved_hz.tolist(),
             "predicted_suspension_hz": suspension.predicted_hz.tolist(),
-            "first_elastic_hz": float(model.frequencies[0]),
-            "suspension_share_of_first_elastic": float(suspension.solved_hz.max() / model.frequencies[0]),
+            "first_elastic_hz": first,
+            "suspension_share_of_first_elastic": float(suspension.solved_hz.max() / first),
             "elastic_hz_with_springs": suspension.elastic_hz.tolist(),
             "elastic_shift_max_pct": float(np.max(np.abs(suspension.shift_pct(model.frequencies))))}
     data["configurations"] = entries

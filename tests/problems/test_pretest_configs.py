@@ -7,6 +7,8 @@ benchmarks/bench_pretest_configs.py."""
 from __future__ import annotations
 
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -24,8 +26,7 @@ SIGMA = 0.2 / 100 / np.sqrt(3)
 def blocks_of(board, model, configs):
     out = []
     for c in configs:
-        m = configuration_model(board, c, NAMES)
-        m.lam = model.lam
+        m = replace(configuration_model(board, c, NAMES), lam=model.lam, position=model.position)
         lam, phi = m.modes()
         out.append(frequency_block(lam, phi, m, m.dKs, m.dMs, SIGMA))
     return out
