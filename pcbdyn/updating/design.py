@@ -102,21 +102,23 @@ def choose_sensors(Phi, n_keep: int, groups=None, max_automac: float = 0.25, max
     """EfI (:func:`effective_independence`), then exchanges of one chosen sensor for one candidate: while
     the largest off-diagonal AutoMAC exceeds ``max_automac`` the exchange that lowers it most, then those
     that raise log det(Phi^T Phi) most without breaking the bound (steepest ascent, until none helps).
-    The AutoMAC bound is a guard on the set, not a guarantee: the result reports the value reached."""
+    The AutoMAC bound is a guard on the set, not a guarantee: when no exchange brings it under the bound,
+    the value reached becomes the bound of the log det exchanges, and the result reports it."""
     _, B = _group_blocks(Phi, groups)
     G_all = np.einsum("gri,grj->gij", B, B)
     chosen = effective_independence(Phi, n_keep, groups)
     efi = log_det(G_all[chosen].sum(axis=0))
+    bound = max_automac
     for _ in range(max_passes):
         G = G_all[chosen].sum(axis=0)
         ld, am = log_det(G), float(automac_offdiag(G))
-        over = max(am - max_automac, 0.0)
+        over = max(am - bound, 0.0)
         others = np.setdiff1d(np.arange(B.shape[0]), chosen)
         best = None
         for pos, g in enumerate(chosen):
             trial = (G - G_all[g])[None] + G_all[others]
             lds, ams = _log_dets(trial), automac_offdiag(trial)
-            overs = np.maximum(ams - max_automac, 0.0)
+            overs = np.maximum(ams - bound, 0.0)
             if over > 0:
                 gain = np.where(np.isfinite(lds), over - overs, -np.inf)
                 ok = gain > 1e-12
@@ -127,6 +129,9 @@ def choose_sensors(Phi, n_keep: int, groups=None, max_automac: float = 0.25, max
                 h = int(np.argmax(np.where(ok, gain, -np.inf)))
                 if best is None or gain[h] > best[0]:
                     best = (gain[h], pos, others[h])
+        if best is None and over > 0:
+            bound = am + 1e-12  # the guard cannot be met: keep what was reached, raise the determinant
+            continue
         if best is None:
             break
         chosen = np.sort(np.r_[np.delete(chosen, best[1]), best[2]])
