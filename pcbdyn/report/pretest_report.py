@@ -67,7 +67,9 @@ def summary(data: dict) -> str:
                  f"{data['automac_max_offdiag']:.3f}")
     ml = data["mass_loading"]
     lines.append(f"mass loading of {ml['sensor_mass_kg'] * 1e3:g} g sensors: frequency shifts "
-                 + ", ".join(f"{v:+.2f}" for v in ml["shift_pct"]) + " %")
+                 + ", ".join(f"{v:+.2f}" for v in ml["shift_pct"]) + " %"
+                 + ("; more than 1 %: lighter sensors, fewer, or a laser vibrometer"
+                    if max(abs(v) for v in ml["shift_pct"]) > 1.0 else ""))
     e = data["exciter"]
     lines.append(f"exciter: point {e['id']} ({e['x_mm']:.1f}, {e['y_mm']:.1f}"
                  + (f", {e['z_mm']:.1f}" if "z_mm" in e else "") + f" mm) along {e['direction']}, every target mode "
