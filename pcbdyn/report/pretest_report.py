@@ -123,7 +123,7 @@ def pretest_map(path, cand, data: dict, box: bool) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig = plt.figure(figsize=(7, 6))
+    fig = plt.figure(figsize=(8, 6))
     ax = fig.add_subplot(projection="3d" if box else None)
     dims = 3 if box else 2
 
@@ -147,9 +147,9 @@ def pretest_map(path, cand, data: dict, box: bool) -> Path:
     ax.set_ylabel("y [mm]")
     if not box:
         ax.set_aspect("equal")
-    ax.legend(loc="upper right", fontsize=7)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=7)
     ax.set_title(f"pretest: {data['structure']}")
-    return save_figure(fig, path)
+    return save_figure(fig, path, bbox_inches="tight")
 
 
 def pretest_page(out: Path, toml_path, data: dict, written: list) -> Path:
