@@ -41,6 +41,8 @@ def _quantities(text: str, unit: str, option: str) -> list:
 @click.option("--max-automac", type=click.FloatRange(0.0, 1.0), default=0.25, show_default=True,
               help="bound on the sensors' largest off-diagonal AutoMAC")
 @click.option("--sensor-mass", default="2 g", show_default=True, help="mass of one sensor (its loading is reported)")
+@click.option("--exciter-share", type=click.FloatRange(0.0, 1.0), default=0.1, show_default=True,
+              help="the exciter must drive every target mode at this share of the mode's best point at least")
 @click.option("--suspension-share", type=click.FloatRange(0.01, 0.5), default=0.1, show_default=True,
               help="free structures: highest suspension mode as a share of the first elastic one")
 @click.option("--parameters", "names", default=None,
@@ -57,7 +59,7 @@ def _quantities(text: str, unit: str, option: str) -> list:
                 html=True)
 @library_option()
 def command(structure_toml, candidates_csv, spacing, n_sensors, directions, n_modes, band, max_automac, sensor_mass,
-            suspension_share, names, n_configs, masses, noise, max_places, out, json_path, html):
+            exciter_share, suspension_share, names, n_configs, masses, noise, max_places, out, json_path, html):
     """Plan a modal test: sensors, exciter, suspension and perturbed configurations from the model."""
     from ..problems import load_structure
     from ..problems.pretest import choose_exciter, choose_sensors, choose_suspension, mass_loading, pretest_model
@@ -102,7 +104,7 @@ def command(structure_toml, candidates_csv, spacing, n_sensors, directions, n_mo
                   "candidates (EfI, AutoMAC guard)")
         sensors = choose_sensors(model, cand, n, triaxial, max_automac)
         loading = mass_loading(model, cand.xyz[sensors.chosen], m_sensor)
-        exciter = choose_exciter(model, cand)
+        exciter = {**choose_exciter(model, cand), "required_share": exciter_share}
         suspension = choose_suspension(model, cand, suspension_share) if model.free else None
         done(t0)
         designed, entries = None, []

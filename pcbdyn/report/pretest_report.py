@@ -35,7 +35,9 @@ def pretest_json(structure, model, cand, source: dict, sensors, loading, exciter
                          "first_order_pct": loading["first_order_pct"].tolist(),
                          "shift_pct": loading["shift_pct"].tolist()},
         "exciter": {**_where(cand, exciter["index"], box), "direction": exciter["direction"],
-                    "share_per_mode": exciter["share"].tolist(), "min_share": float(exciter["share"].min())},
+                    "share_per_mode": exciter["share"].tolist(), "min_share": float(exciter["share"].min()),
+                    "required_share": exciter["required_share"],
+                    "meets_required_share": bool(exciter["share"].min() >= exciter["required_share"])},
     }
     if suspension is not None:
         first = float(np.sqrt(model.low_lam[0]) / (2 * np.pi))
@@ -73,7 +75,9 @@ def summary(data: dict) -> str:
     e = data["exciter"]
     lines.append(f"exciter: point {e['id']} ({e['x_mm']:.1f}, {e['y_mm']:.1f}"
                  + (f", {e['z_mm']:.1f}" if "z_mm" in e else "") + f" mm) along {e['direction']}, every target mode "
-                 f"driven at >= {100 * e['min_share']:.0f} % of its best point")
+                 f"driven at >= {100 * e['min_share']:.0f} % of its best point"
+                 + ("" if e["meets_required_share"] else f", below the {100 * e['required_share']:g} % asked for: no "
+                    "single point drives every target mode; excite at two points, or split the band"))
     if "suspension" in data:
         sp = data["suspension"]
         pts = "; ".join(f"({p['x_mm']:.1f}, {p['y_mm']:.1f})" for p in sp["points"])

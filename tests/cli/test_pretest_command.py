@@ -36,6 +36,7 @@ def test_board_pretest_contract_and_configurations(tmp_path):
     assert len(d["sensors"]) == 12 and all(set(s) == {"id", "x_mm", "y_mm", "direction"} for s in d["sensors"])
     assert d["automac_max_offdiag"] <= 0.25
     assert d["suspension"]["suspension_share_of_first_elastic"] < 0.15
+    assert d["exciter"]["meets_required_share"] and d["exciter"]["min_share"] >= d["exciter"]["required_share"] == 0.1
     assert [c["name"] for c in d["configurations"]] == ["pretest1", "pretest2"]
     for c in d["configurations"]:
         (m,) = c["masses"]
