@@ -15,7 +15,7 @@ import re
 import numpy as np
 
 from ..units import shown
-from .data import Dofs, Modes, Points, TestDataError
+from .data import FILE_FLOOR_HZ, Dofs, Modes, Points, TestDataError, check_frequencies
 from .uff_write import _atomic
 
 _LENGTH = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "um": 1e-6, "in": 0.0254}
@@ -149,7 +149,7 @@ def read_modes_csv(freq_path, shapes_path) -> Modes:
     scale = {None: 1.0, "hz": 1.0, "khz": 1e3}.get((u or "hz").lower())
     if scale is None:
         raise TestDataError(f"{freq_path}: frequency unit '{u}' is not Hz or kHz")
-    f = numbers(freq_path, df, col) * scale
+    f = check_frequencies(numbers(freq_path, df, col) * scale, str(freq_path), floor=FILE_FLOOR_HZ)
     zeta = numbers(freq_path, df, cols["damping ratio"][0]) if "damping ratio" in cols else None
     mpc = numbers(freq_path, df, cols["mpc"][0]) if "mpc" in cols else None
     sf, scols = _table(shapes_path)

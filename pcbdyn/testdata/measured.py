@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .data import Modes, TestDataError, check_frequencies
+from .data import FILE_FLOOR_HZ, Modes, TestDataError, check_frequencies
 from .uff import read_uff
 
 #: configuration names of a frequency table that mean the base configuration
@@ -71,6 +71,6 @@ def read_frequency_table(path, structure) -> list:
                                 f"{MAX_MODES}")
         if np.unique(nc).size < nc.size:
             raise TestDataError(f"{path.name}: configuration {name}: a mode number is given twice; give each mode once")
-        check_frequencies(fc, f"{path.name}: configuration {name}", nc)
+        check_frequencies(fc, f"{path.name}: configuration {name}", nc, floor=FILE_FLOOR_HZ)
         out.append((cfg, Modes.frequencies_only(fc, nc)))
     return out

@@ -30,6 +30,7 @@ import re
 import numpy as np
 
 from .data import (
+    FILE_FLOOR_HZ,
     Dofs,
     FRFs,
     Modes,
@@ -246,7 +247,7 @@ def _mode_from55(d: dict):
         return None
     if d["values"].shape[1] < 3:
         raise TestDataError("a mode shape needs 3 values per node (x, y, z); this one has fewer")
-    check_frequencies([freq], "record 8")
+    check_frequencies([freq], "record 8", floor=FILE_FLOOR_HZ)
     check_damping([zeta], 1, "record 8")
     nodes, counts = np.unique(d["nodes"], return_counts=True)
     if (counts > 1).any():

@@ -2,6 +2,7 @@
 pyuff, variants other tools write, and clear errors on files that cannot be read."""
 
 import os
+import re
 
 import numpy as np
 import pytest
@@ -217,6 +218,35 @@ def test_a_uff_mode_obeys_the_rules_of_modes(tmp_path, freq, zeta):
         assert ("artefact of the curve fit" in rule) == (freq > 0 and zeta < 0)
     else:
         assert read_uff(path, points=point).modes.damping.tolist() == [zeta]
+
+
+@pytest.mark.parametrize("freq, shape, fault", [
+    (150.0, "0.0E+00 0.0E+00 0.0E+00", "record 10: the mode shape is zero at every DOF"),
+    (1e-9, "1.0E+00 2.0E+00 3.0E+00", "record 8: frequency 1e-09 Hz is below 0.01 Hz"),
+    (0.00999, "1.0E+00 2.0E+00 3.0E+00", "record 8: frequency 0.00999 Hz is below 0.01 Hz")])
+def test_a_file_mode_without_motion_or_below_the_elastic_floor_is_refused(tmp_path, freq, shape, fault):
+    """A dataset 55 record whose shape is zero at every node, or whose frequency is positive but below the 0.01 Hz
+    floor of an elastic mode (a rigid-body mode, or kHz read as Hz), is refused naming the dataset and record,
+    while modes pcbdyn simulates keep their own rule (any frequency above 0, a zero shape allowed); at the
+    floor itself a mode reads."""
+    point = Points([1], np.zeros((1, 3)))
+    rec8 = f"{freq:13.5E}{0.0:13.5E}{0.01:13.5E}{0.0:13.5E}"
+    path = write_text(tmp_path / "m.uff", HEADER55.format(rec8=rec8) + f"         1\n {shape}\n    -1\n")
+    with pytest.raises(TestDataError, match=rf"m\.uff: dataset #1 \(type 55\): {re.escape(fault)}"):
+        read_uff(path, points=point)
+    values = [[float(v)] for v in shape.split()]
+    assert Modes(point, Dofs.from_codes([1, 1, 1], [1, 2, 3]), [freq], values).frequencies[0] == freq
+    at_floor = write_text(tmp_path / "f.uff", HEADER55.format(rec8=f"{0.01:13.5E}{0.0:13.5E}{0.01:13.5E}{0.0:13.5E}")
+                          + "         1\n 1.0E+00 2.0E+00 3.0E+00\n    -1\n")
+    assert read_uff(at_floor, points=point).modes.frequencies.tolist() == [0.01]
+
+
+def test_a_frequency_table_row_below_the_elastic_floor_is_refused(tmp_path):
+    from pcbdyn.testdata.measured import read_frequency_table
+
+    table = write_text(tmp_path / "freq.csv", "configuration,mode,frequency_hz\nbase,1,1e-9\nbase,2,250.0\n")
+    with pytest.raises(TestDataError, match=r"freq\.csv: configuration base: frequency 1e-09 Hz \(mode 1\) is below"):
+        read_frequency_table(table, None)
 
 
 def test_a_failed_write_leaves_the_old_file_untouched(tmp_path, monkeypatch):
