@@ -24,7 +24,7 @@ from pathlib import Path
 
 import click
 
-from .common import checked_outputs, done, fail, input_errors, library_option, parse_extra, parse_noise, step, test_arguments
+from .common import checked_outputs, done, fail, input_errors, library_option, parse_extra, parse_noise, step, test_arguments, units_option
 
 
 def names(text) -> list | None:
@@ -55,6 +55,7 @@ def names(text) -> list | None:
               help="write the families, before/after and the library written as JSON ('-': standard output)")
 @checked_outputs(folders=())
 @library_option(required=True, keep=True)
+@units_option
 def command(board_toml, test_uff, configs, freq_csv, joint_toml, families, with_, method, solver, noise, max_iter,
             tol_pct, mesh_size, mesh_error, json_path, library):
     """Calibrate part families' equivalent thicknesses from modal tests into a component library."""

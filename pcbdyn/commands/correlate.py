@@ -10,7 +10,7 @@ from pathlib import Path
 import click
 
 from ..domain import MAX_MODES
-from .common import PROBE_TOL, done, fail, folder_outputs, input_errors, library_option, solve_structure, step
+from .common import PROBE_TOL, done, fail, folder_outputs, input_errors, library_option, solve_structure, step, units_option
 
 @click.command("correlate")
 @click.argument("board_toml", type=click.Path(exists=True, dir_okay=False, path_type=Path))
@@ -23,6 +23,7 @@ from .common import PROBE_TOL, done, fail, folder_outputs, input_errors, library
 @folder_outputs("folder for pairs.csv, comac.csv and the PNG pictures",
                 "write pairs, unpaired test modes and COMAC as JSON", html=True)
 @library_option()
+@units_option
 def command(board_toml, test_uff, config, min_mac, n_modes, out, json_path, html):
     """Correlate a structure's model (board.toml or box.toml, one configuration) with a modal test (UFF with
     mode shapes): pairs by MAC, frequency differences, COMAC, pictures."""

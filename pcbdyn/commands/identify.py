@@ -10,7 +10,7 @@ from pathlib import Path
 
 import click
 
-from .common import checked_outputs, done, fail, number_pair, step
+from .common import checked_outputs, done, fail, number_pair, step, units_option
 
 
 def parse_select(text: str) -> list:
@@ -48,6 +48,7 @@ def _mac(v) -> float | None:
 @click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="write the modes (frequency_hz, damping_ratio, MAC to neighbours) as JSON")
 @checked_outputs(folders=(), files=("json_path", "out", "chart"))
+@units_option
 def command(frfs_uff, band, max_order, select, kind, out, chart, json_path):
     """Identify modes (frequency, damping, shape) from measured FRFs at one or several references."""
     from ..identification import identify

@@ -17,7 +17,7 @@ from pathlib import Path
 import click
 
 from .common import (PROBE_TOL, done, fail, folder_outputs, input_errors, library_option, parse_extra, parse_noise, result_path, step,
-                     test_arguments)
+                     test_arguments, units_option)
 
 
 @click.command("wedgelock")
@@ -39,6 +39,7 @@ from .common import (PROBE_TOL, done, fail, folder_outputs, input_errors, librar
                 "beside the board)", "write the extremes, the decision, the stiffness, before/after and the history as "
                 "JSON", force="replace an earlier board.updated.toml beside the board (default: a numbered name)")
 @library_option()
+@units_option
 def command(board_toml, test_uff, configs, freq_csv, per_guide, tol_pct, noise, min_mac, mesh_size, max_iter, out,
             force, json_path):
     """Fit wedge-lock guides in two steps: hinged and clamped extremes, then rotational springs. TEST_UFF

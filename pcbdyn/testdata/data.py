@@ -361,11 +361,14 @@ def excitations(frfs: FRFs) -> list:
 
 @dataclass
 class TestData:
-    """What one test file holds: points, and optionally modes, FRFs; datasets that were skipped."""
+    """What one test file holds: points, and optionally modes, FRFs; datasets that were skipped; the test's
+    wireframe (n, 2) of point ids (trace lines, element edges) and its elements [(descriptor, node ids)]."""
 
     points: Points
     modes: Modes | None = None
     frfs: FRFs | None = None
     skipped: list = field(default_factory=list)
+    wireframe: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int64))
+    elements: list = field(default_factory=list)
 
     __test__ = False
