@@ -96,6 +96,8 @@ def command(board_toml, test_uff, configs, freq_csv, joint_toml, families, with_
     click.echo(f"\n{rep.headline(cal, what['status'])}")
     for line in what["details"]:
         click.echo(f"  note: {line}")
+    for line in what["warnings"]:
+        click.echo(f"warning: {line}", err=True)
     click.echo(rep.format_families(fams))
     if cal.problem.names[len(cal.families):]:
         click.echo("\n" + rep.format_with(cal))
@@ -112,7 +114,8 @@ def command(board_toml, test_uff, configs, freq_csv, joint_toml, families, with_
         write_json(json_path, {
             "families": fams, "before": summary(cal.before), "after": summary(cal.after), "library": str(library),
             "with": rep.with_rows(cal), "method": method, "solver": solver, "noise": cal.noise,
-            "status": what["status"], "details": what["details"], "iterations": cal.result.iterations,
+            "status": what["status"], "details": what["details"], "warnings": what["warnings"],
+            "iterations": cal.result.iterations,
             "converged": bool(cal.result.converged), "reason": cal.result.reason,
             "boards": [str(it.structure.path) for it in cal.items],
             "tests": [{"board": it.structure.path.name, "configuration": c or "base", "file": str(p)}

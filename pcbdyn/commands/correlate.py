@@ -61,6 +61,8 @@ def command(board_toml, test_uff, config, min_mac, n_modes, out, json_path, html
     if pairing.unpaired_test:
         click.echo(f"unpaired test modes: {', '.join(str(i + 1) for i in pairing.unpaired_test)}")
     click.echo(comac_line(corr))
+    for line in pairing.warnings(modes.frequencies):
+        click.echo(f"warning: {line}", err=True)
     written = []
     if out is not None:
         from ..report.manifest import settle
@@ -82,6 +84,7 @@ def command(board_toml, test_uff, config, min_mac, n_modes, out, json_path, html
             "test_frequencies_hz": [float(f) for f in test_modes.frequencies],
             "model_frequencies_hz": [float(f) for f in modes.frequencies],
             "mac_matrix": pairing.mac.round(6).tolist(),
+            "automac": pairing.automac.round(6).tolist(),
             "files": written,
         })
         write_json(json_path, data)

@@ -113,6 +113,8 @@ def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping,
                f"{res.best_iteration})")
     for line in what["details"]:
         click.echo(f"  note: {line}")
+    for line in what["warnings"]:
+        click.echo(f"warning: {line}", err=True)
     click.echo(rep.format_parameters(rows))
     click.echo("")
     click.echo(rep.format_correlation(before, after))

@@ -80,6 +80,8 @@ def command(board_toml, test_uff, configs, freq_csv, per_guide, tol_pct, noise, 
     click.echo(f"\n{board.name}: guides {', '.join(result.guides)}")
     for text in tables.values():
         click.echo("\n" + text)
+    for line in d["warnings"]:
+        click.echo(f"warning: {line}", err=True)
     d["updated_board"] = None
     if d["decision"] == "springs":
         try:

@@ -36,8 +36,9 @@ def _save(fig, path) -> None:
     plt.close(fig)
 
 
-def mac_matrix(path, M, pairs, f_test, f_model) -> None:
-    """The MAC matrix (test modes down, model modes across) with values and the pairs framed."""
+def mac_matrix(path, M, pairs, f_test, f_model, title: str = "MAC (pairs framed in red)",
+               rows: str = "test mode") -> None:
+    """The MAC matrix (``rows`` modes down, model modes across) with values and the pairs framed."""
     plt = _plt()
     from matplotlib.patches import Rectangle
 
@@ -54,8 +55,8 @@ def mac_matrix(path, M, pairs, f_test, f_model) -> None:
     ax.set_xticks(range(na), [f"{j + 1}\n{f:.0f}" for j, f in enumerate(f_model)], fontsize=7)
     ax.set_yticks(range(nt), [f"{i + 1}: {f:.0f}" for i, f in enumerate(f_test)], fontsize=7)
     ax.set_xlabel("model mode / frequency [Hz]")
-    ax.set_ylabel("test mode: frequency [Hz]")
-    ax.set_title("MAC (pairs framed in red)")
+    ax.set_ylabel(f"{rows}: frequency [Hz]")
+    ax.set_title(title)
     fig.colorbar(im, ax=ax, fraction=0.046, pad=0.04)
     _save(fig, path)
 
