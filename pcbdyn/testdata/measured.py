@@ -29,6 +29,21 @@ def read_modes(path) -> Modes:
     return data.modes
 
 
+def read_geometry(path):
+    """The measurement points of a points CSV (point, x, y, z with units in the header) or of the geometry
+    of a UFF file (datasets 15, 2411), for test files that carry none."""
+    from .csvio import read_points_csv
+
+    path = Path(path)
+    if path.suffix.lower() == ".csv":
+        return read_points_csv(path)[0]
+    points = read_uff(path).points
+    if not len(points):
+        raise TestDataError(f"{path}: no geometry (UFF datasets 15 or 2411); give a points CSV (point, x [mm], "
+                            "y [mm], z [mm]) or a UFF file with the points")
+    return points
+
+
 def _configuration(structure, name, source) -> str:
     if name not in structure.configuration_names():
         known = ", ".join(structure.configuration_names()) or "none"

@@ -232,7 +232,8 @@ def parse2412(raw: bytes) -> dict:
         el, desc, n = (_whole(head[k], "record 1: a field") for k in (0, 1, 5))
         if desc in BEAMS:
             cur.take(3, f"element {el}, record 2 (orientation node, cross-sections)")
-        out.append((desc, [_whole(v, f"element {el}: a node label") for v in cur.take(n, f"element {el}'s node labels")]))
+        labels = cur.take(n, f"element {el}'s node labels")
+        out.append((desc, [_whole(v, f"element {el}: a node label") for v in labels]))
     return {"type": 2412, "elements": out}
 
 
