@@ -33,11 +33,12 @@ def command(board_toml, test_uff, config, min_mac, n_modes, out, json_path, html
     from ..report.correlation_report import comac_line, format_pairs, write_outputs
     from ..report.files import write_json
     from ..testdata import TestDataError
-    from ..testdata.measured import read_modes
+    from ..testdata.measured import read_test
 
     with input_errors():
         board = load_structure(board_toml)
-        test_modes = read_modes(test_uff)
+        test = read_test(test_uff)
+        test_modes = test.modes
         board.check_points(test_modes.measured_points(), test_uff)
         n_model = n_modes or min(MAX_MODES, max(board.analysis.modes, math.ceil(1.5 * test_modes.n_modes)))
         bm, modes, _, _ = solve_structure(board, config, n_modes=n_model)
@@ -68,7 +69,7 @@ def command(board_toml, test_uff, config, min_mac, n_modes, out, json_path, html
         from ..report.manifest import settle
 
         t0 = step(f"writing tables and pictures to {out}")
-        written = write_outputs(out, board, bm, modes, test_modes, corr)
+        written = write_outputs(out, board, bm, modes, test_modes, corr, test.wireframe)
         if html:
             from ..report.pages import correlate_page
 

@@ -173,9 +173,10 @@ def shape_overlays(out_dir, model, outline, pairs, test_xy, test_w, model_at_tes
     return names
 
 
-def comac_map(path, outline, xy, values, labels) -> None:
-    """COMAC per measured DOF at its point on the board outline (low = test and model disagree); on a
-    structure in 3-D (``outline`` None, ``xy`` the points (k, 3)) a 3-D map."""
+def comac_map(path, outline, xy, values, labels, lines=None) -> None:
+    """COMAC per measured DOF at its point on the board outline (low = test and model disagree), over the
+    test's wireframe ``lines`` (n, 2, 3) [m] when given; on a structure in 3-D (``outline`` None, ``xy`` the
+    points (k, 3)) a 3-D map."""
     plt = _plt()
     lo = min(0.9, float(np.min(values)))
     if outline is None:
@@ -188,6 +189,10 @@ def comac_map(path, outline, xy, values, labels) -> None:
     xy = np.asarray(xy) * 1e3
     fig, ax = plt.subplots(figsize=(6.0, 5.6))
     _outline(ax, outline)  # lo spreads the usual 0.9-1 range over the colours
+    if lines is not None:
+        from matplotlib.collections import LineCollection
+
+        ax.add_collection(LineCollection(np.asarray(lines)[:, :, :2] * 1e3, colors="0.55", linewidths=0.8, zorder=2))
     sc = ax.scatter(xy[:, 0], xy[:, 1], c=values, cmap="RdYlGn", vmin=lo, vmax=1.0, s=60, edgecolors="k", zorder=3)
     worst = np.argsort(values)[: min(5, len(values))]
     for i in worst:

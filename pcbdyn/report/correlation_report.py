@@ -45,8 +45,10 @@ def z_rows(test_modes):
     return rows, np.sign(d[rows, 2])
 
 
-def write_outputs(out: Path, board, bm, modes, test_modes, corr) -> list:
-    """CSV tables and PNG pictures under ``out``; returns the names written (relative to ``out``)."""
+def write_outputs(out: Path, board, bm, modes, test_modes, corr, wireframe=None) -> list:
+    """CSV tables and PNG pictures under ``out``; returns the names written (relative to ``out``).
+    ``wireframe`` (n, 2): the test's lines between point ids (UFF trace lines and elements), drawn under the
+    points."""
     pairing = corr.pairing
     written = ["pairs.csv", "comac.csv", "mac_matrix.png", "automac.png", "frequencies.png", "comac.png"]
     write_text(out / "pairs.csv", pairs_csv(pairing.pairs))
@@ -57,7 +59,10 @@ def write_outputs(out: Path, board, bm, modes, test_modes, corr) -> list:
                      "AutoMAC of the model at the test points (high off the diagonal: aliased)", "model mode")
     plots.frequency_plot(out / "frequencies.png", pairing.pairs)
     outline = getattr(board, "outline", None)  # a board's; a structure in 3-D has none
-    plots.comac_map(out / "comac.png", outline, xyz if outline is None else xyz[:, :2], corr.comac, corr.dof_labels)
+    pts = test_modes.points
+    lines = None if wireframe is None or not len(wireframe) else pts.xyz[pts.index(np.asarray(wireframe).ravel())]
+    plots.comac_map(out / "comac.png", outline, xyz if outline is None else xyz[:, :2], corr.comac, corr.dof_labels,
+                    None if lines is None else lines.reshape(-1, 2, 3))
     rows, sign = z_rows(test_modes)
     if rows.size and outline is not None:  # the overlays show w on a plate
         model_w = pairing.model_shapes(modes.shapes)[2::6]

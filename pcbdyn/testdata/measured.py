@@ -16,6 +16,12 @@ BASE_NAMES = ("base", "c1", "")
 
 def read_modes(path) -> Modes:
     """The measured modes of a UFF file; a clear error when there are none."""
+    return read_test(path).modes
+
+
+def read_test(path):
+    """What a UFF test file holds (:class:`.data.TestData`: its modes, points and wireframe), with a clear
+    error when it has no modes."""
     from ..domain import MAX_MODES
 
     data = read_uff(path)
@@ -26,7 +32,7 @@ def read_modes(path) -> Modes:
         what = " (it holds FRFs only: identify modes from them first)" if data.frfs is not None else ""
         raise TestDataError(f"{path}: no mode shapes (UFF dataset 55) in the file{what}; export the test's mode "
                             "shapes as dataset 55, or write a test with 'pcbdyn simulate-test'")
-    return data.modes
+    return data
 
 
 def read_geometry(path):

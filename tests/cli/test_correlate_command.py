@@ -282,3 +282,20 @@ def test_points_on_the_top_surface_read_the_mid_plane(card, tmp_path):
     assert modes[0] == modes[1]
     for key in ("mac", "df_pct"):
         np.testing.assert_allclose([p[key] for p in a["pairs"]], [p[key] for p in b["pairs"]], rtol=1e-9, atol=1e-9)
+
+
+def test_trace_lines_of_the_test_are_drawn_under_its_points(card, tmp_path):
+    """A test file with a trace line (UFF 82, as Test.Lab and ARTeMIS write the test's wireframe) reads it into
+    the test's wireframe, and correlate's COMAC map draws it: the picture differs from the one without."""
+    data = read_uff(card / "noisy.uff")
+    ids = data.points.ids[:4].tolist()
+    trace = ("    -1\n    82\n         1         5         8\nedge\n"
+             + "".join(f"{i:10d}" for i in ids + [0]) + "\n    -1\n")
+    (tmp_path / "traced.uff").write_text((card / "noisy.uff").read_text() + trace)
+    assert read_uff(tmp_path / "traced.uff").wireframe.tolist() == sorted(sorted(p) for p in zip(ids[:-1], ids[1:]))
+    for name in ("noisy", "traced"):
+        src = card / "noisy.uff" if name == "noisy" else tmp_path / "traced.uff"
+        res = run("correlate", card / "board.toml", src, "--out", tmp_path / name)
+        assert res.exit_code == 0, res.output
+    assert (tmp_path / "traced" / "comac.png").read_bytes() != (tmp_path / "noisy" / "comac.png").read_bytes()
+    assert (tmp_path / "traced" / "automac.png").stat().st_size > 5000
