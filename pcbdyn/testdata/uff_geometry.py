@@ -131,8 +131,10 @@ def parse_nodes(raw: bytes, t: int) -> dict:
     if part:
         raise TestDataError(f"node {int(part[0][0])} has no coordinates line (the dataset ends after its label line)")
     v = np.array(rows, dtype=float).reshape(-1, 7)
-    for n in v[:, 0]:
+    for n, a, b in v[:, :3]:
         label(n, "a node record")
+        _whole(a, f"node {int(n)}: its coordinate system")
+        _whole(b, f"node {int(n)}: its displacement coordinate system")
     return {"type": t, "node_nums": v[:, 0].astype(np.int64), "def_cs": v[:, 1].astype(np.int64),
             "disp_cs": v[:, 2].astype(np.int64), "xyz": v[:, 4:7]}
 
@@ -154,8 +156,9 @@ def parse164(raw: bytes) -> dict:
 
 
 def _whole(v: float, what: str) -> int:
-    if v != int(v):
-        raise TestDataError(f"{what} {v:g} is not a whole number")
+    """A record's integer field: a whole number from 0 to 2^31 - 1 (the standard's I10)."""
+    if not (v == int(v) and 0 <= v < 2**31):
+        raise TestDataError(f"{what} {v:g} is not a whole number from 0 to 2147483647")
     return int(v)
 
 
@@ -219,7 +222,7 @@ def parse82(raw: bytes) -> dict:
     vals = [v for k, line in enumerate(lines[4:], start=5) for v in numbers(line, f"record 3, line {k} of the dataset")]
     if len(vals) < n or any(vals[n:]):
         raise TestDataError(f"record 3 holds {len(vals)} node labels; record 1 announces {n}")
-    return {"type": 82, "nodes": [_whole(v, "record 3: node label") for v in vals[:n]]}
+    return {"type": 82, "nodes": [label(v, "record 3") if v else 0 for v in vals[:n]]}
 
 
 def parse2412(raw: bytes) -> dict:
@@ -233,7 +236,7 @@ def parse2412(raw: bytes) -> dict:
         if desc in BEAMS:
             cur.take(3, f"element {el}, record 2 (orientation node, cross-sections)")
         labels = cur.take(n, f"element {el}'s node labels")
-        out.append((desc, [_whole(v, f"element {el}: a node label") for v in labels]))
+        out.append((desc, [label(v, f"element {el}") for v in labels]))
     return {"type": 2412, "elements": out}
 
 

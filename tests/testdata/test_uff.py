@@ -2,6 +2,7 @@
 pyuff, variants other tools write, and clear errors on files that cannot be read."""
 
 import os
+from pathlib import Path
 import re
 
 import numpy as np
@@ -288,3 +289,24 @@ def test_binary_58b_with_a_stray_line_break_before_the_end_tag_reads(tmp_path):
     path.write_bytes(raw[:end] + b"\r\n" + raw[end:])
     back = read_uff(path)
     assert rel(back.frfs.H, data.frfs.H) < 1e-12
+
+
+def test_node_coordinate_systems_place_points_and_turn_directions_global():
+    """tests/data/uff/node_systems.uff (written by hand, checked by hand): SYS1 (dataset 18: origin at x = 10 mm,
+    +x towards the origin, xz point below) has axes -X, +Y, -Z; SYS2 is defined in SYS1 (its origin, +x along
+    SYS1's y, xz point on SYS1's x) and has axes +Y, -Z, -X; CS3 (dataset 2420, rows the axes) is a quarter
+    turn about z: +Y, -X, +Z. Node 1's displacements refer to SYS1, node 2's to SYS2, node 3's coordinates
+    and displacements to CS3, node 4 is global. Each measured value keeps its number and takes its axis' global
+    direction; the trace line and the elements give the wireframe's edges once each."""
+    data = read_uff(Path(__file__).resolve().parents[1] / "data" / "uff" / "node_systems.uff")
+    np.testing.assert_allclose(data.points.xyz, [[0, 0, 0], [0.1, 0, 0], [-0.1, 0.1, 0], [0, 0.1, 0]], atol=1e-15)
+    m = data.modes
+    want = {1: ([[-1, 0, 0], [0, 1, 0], [0, 0, -1]], [1.0, 2.0, 3.0]), 2: ([[-1, 0, 0]], [1.0]),
+            3: ([[0, 1, 0], [-1, 0, 0], [0, 0, 1]], [-1.0, 0.5, 2.0]), 4: ([[0, 0, 1]], [-1.0])}
+    scale = m.shapes[0, 0]  # the real shape keeps the file's values up to one factor
+    for node, (axes, values) in want.items():
+        rows = np.flatnonzero(m.dofs.point_ids == node)
+        np.testing.assert_array_equal(m.dofs.directions[rows], axes)
+        np.testing.assert_allclose(m.shapes[rows, 0] / scale, values, rtol=1e-6)
+    assert data.wireframe.tolist() == [[1, 2], [1, 3], [1, 4], [2, 3], [3, 4]]
+    assert data.elements == [(44, [1, 2, 3, 4]), (11, [1, 3])]
