@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from data_files import realdata
+from uff_helpers import HEADER55
 
 from pcbdyn.testdata import Points, TestDataError, read_uff
 from pcbdyn.testdata.uff_geometry import stated_units
@@ -102,18 +103,7 @@ def test_the_testlab_units_and_trace_lines():
     np.testing.assert_allclose(data.points.xyz[data.points.index([1, 36])], [[-2.4, -0.95, 0.0], [1.2, 8.4, 0.0]])
 
 
-HEADER55 = """    -1
-    55
-NONE
-NONE
-NONE
-NONE
-NONE
-         1         2         2         8         2         3
-         2         4         1         1
-  1.50000E+02  0.00000E+00  1.00000E-02  0.00000E+00
-{nodes}    -1
-"""
+REC8 = "  1.50000E+02  0.00000E+00  1.00000E-02  0.00000E+00"
 
 HEADER58 = """    -1
     58
@@ -139,7 +129,7 @@ def test_testlab_node_systems_turn_modes_and_frfs_into_global_directions(tmp_pat
     point at Y - 1): x = +Z, y = -X, z = -Y. A mode measured at nodes 1 and 7 with local values (1, 2, 3) and an
     FRF from node 7 +x to node 1 +z must come back along those global directions, values unchanged."""
     nodes = "".join(f"{n:10d}\n  1.00000E+00  2.00000E+00  3.00000E+00\n" for n in (1, 7))
-    text = (PYUFF / TESTLAB).read_text(encoding="latin-1") + HEADER55.format(nodes=nodes) + \
+    text = (PYUFF / TESTLAB).read_text(encoding="latin-1") + HEADER55.format(rec8=REC8) + nodes + "    -1\n" + \
         HEADER58.format(rn=1, rd=3, fn=7, fd=1)
     path = tmp_path / "testlab_with_data.uff"  # the file as a user adds measured data to it
     path.write_text(text, encoding="latin-1")

@@ -8,7 +8,7 @@ import re
 import numpy as np
 import pytest
 import pyuff
-from uff_helpers import E13, E20, fixed
+from uff_helpers import E13, E20, HEADER55, fixed
 
 from pcbdyn.correlation import mac
 from pcbdyn.testdata import Dofs, FRFs, Modes, Points, TestData, TestDataError, read_uff, real_modes, write_uff
@@ -118,18 +118,6 @@ def write_text(path, text):
     path.write_text(text)
     return path
 
-
-HEADER55 = """    -1
-    55
-NONE
-NONE
-NONE
-NONE
-NONE
-         1         2         2         8         2         3
-         2         4         1         1
-{rec8}
-"""
 
 
 def test_dataset_55_with_fields_run_together_and_d_exponents_reads(tmp_path):
