@@ -15,7 +15,7 @@ from pathlib import Path
 import click
 
 from ..diagnosis import KINDS
-from .common import done, folder_outputs, input_errors, library_option, measured_configurations, parse_noise, result_path, step
+from .common import done, folder_outputs, input_errors, library_option, measured_configurations, parse_noise, result_path, step, units_option
 
 
 @click.command("diagnose")
@@ -42,6 +42,7 @@ from .common import done, folder_outputs, input_errors, library_option, measured
                 "write effects, before/after and statistics as JSON",
                 force="replace an earlier <board>.diagnosed.toml beside the board (default: a numbered name)")
 @library_option()
+@units_option
 def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size, quick, workers, scheduler, out, force,
             json_path):
     """Find the effects a board model lacks from modal tests: TEST_UFF (with mode shapes) of the base
