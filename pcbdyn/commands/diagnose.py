@@ -15,7 +15,7 @@ from pathlib import Path
 import click
 
 from ..diagnosis import KINDS
-from .common import done, folder_outputs, input_errors, library_option, measured_configurations, parse_noise, result_path, step
+from .common import done, folder_outputs, input_errors, library_option, measured_configurations, parse_noise, result_path, step, units_option
 
 #: the correlation summaries of a diagnosis (JSON: max error, mean MAC, pairs per configuration)
 STATES = ("before", "parameters_only", "after")
@@ -45,12 +45,12 @@ STATES = ("before", "parameters_only", "after")
                 "write effects, before/after and statistics as JSON",
                 force="replace an earlier <board>.diagnosed.toml beside the board (default: a numbered name)")
 @library_option()
+@units_option
 def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size, quick, workers, scheduler, out, force,
             json_path):
     """Find the effects a board model lacks from modal tests: TEST_UFF (with mode shapes) of the base
     configuration and NAME=FILE for each perturbed configuration of board.toml (e.g. c2=test2.uff)."""
     from ..diagnosis.pipeline import diagnose
-    from ..domain import StructureError
     from ..problems import load_structure
     from ..report import diagnosis_report as rep
     from ..report.files import write_json, write_text
@@ -83,28 +83,41 @@ def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size,
     click.echo(rep.format_effects(d.effects))
     click.echo("")
     click.echo(rep.format_states(d.before, d.parameters_only, d.after))
-    enriched = None
-    if d.effects:
-        try:
-            enriched = board.write_enriched(rep.enriched_effects(d), result_path(out, board_toml, "diagnosed", force))
-            click.echo(f"\nboard with the effects declared written to {enriched}", err=True)
-        except StructureError as exc:
-            click.echo(f"\nnote: the enriched board.toml was not written: {exc}", err=True)
-    if json_path is not None:  # first: pictures that fail must not lose the findings
-        write_json(json_path, {
-            "complete": True, "effects": d.effects, "noise_only": d.noise_only, "message": d.message,
-            "before": rep.summary(d.before), "parameters_only": rep.summary(d.parameters_only),
-            "after": rep.summary(d.after), "parameters": d.parameters, "statistics": d.statistics,
-            "enriched_board": None if enriched is None else str(enriched),
-        })
-    if out is not None:
-        from ..report.manifest import settle
 
-        written = [] if enriched is None else [enriched]
-        written += [out / "effects.txt", out / "correlation.txt"]
-        write_text(written[-2], rep.format_effects(d.effects) + "\n")
-        write_text(written[-1], rep.format_states(d.before, d.parameters_only, d.after) + "\n")
-        if d.evidence:
-            written.append(out / "evidence.png")
-            rep.plot_evidence(written[-1], board, d.evidence, d.effects)
-        settle(out, written, "pcbdyn diagnose")
+    def findings(enriched) -> None:  # written first: pictures that fail must not lose them
+        if json_path is not None:
+            write_json(json_path, {
+                "complete": True, "effects": d.effects, "noise_only": d.noise_only, "message": d.message,
+                "before": rep.summary(d.before), "parameters_only": rep.summary(d.parameters_only),
+                "after": rep.summary(d.after), "parameters": d.parameters, "statistics": d.statistics,
+                "enriched_board": None if enriched is None else str(enriched),
+            })
+
+    if out is None:
+        findings(_enriched(board, d, result_path(None, board_toml, "diagnosed", force)))
+    else:
+        from ..report.manifest import replacing
+
+        with replacing(out, "pcbdyn diagnose") as run:  # the earlier --out stays whole until all is written
+            findings(_enriched(board, d, result_path(run.path, board_toml, "diagnosed"), run.final))
+            write_text(run.path / "effects.txt", rep.format_effects(d.effects) + "\n")
+            write_text(run.path / "correlation.txt", rep.format_states(d.before, d.parameters_only, d.after) + "\n")
+            if d.evidence:
+                rep.plot_evidence(run.path / "evidence.png", board, d.evidence, d.effects)
+
+
+def _enriched(board, d, path, final=lambda p: p):
+    """The board with the effects found declared, written to ``path`` (None when there are none, or when it
+    cannot be written: said why); returns where it ends up (``final`` of the path written)."""
+    from ..domain import StructureError
+    from ..report import diagnosis_report as rep
+
+    if not d.effects:
+        return None
+    try:
+        enriched = final(board.write_enriched(rep.enriched_effects(d), path))
+    except StructureError as exc:
+        click.echo(f"\nnote: the enriched board.toml was not written: {exc}", err=True)
+        return None
+    click.echo(f"\nboard with the effects declared written to {enriched}", err=True)
+    return enriched
