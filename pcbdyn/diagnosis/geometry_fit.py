@@ -4,15 +4,23 @@ not span the board, nor run along x or y, and it carries its mass).
 The search places a stiffener on one of the lines it tries (across the whole plate in a few
 directions, :mod:`.stiffener`), embedded in the cells it crosses. A glued bar stops short of the
 edges, runs at its own angle and has its own section; and embedded in coarse cells a rib is stiffer
-than on a row of nodes (the cells' rotations are interpolated under it: on a 8 mm mesh a diagonal bar
-raised the first frequencies by 3 %, chi^2 300000 at the bar's place against 5000 meshed along it).
-So its two ends (four coordinates) and ln h (its mass per length is 12 rho EI / (E h^2),
-:meth:`.stiffener._Stiffener.mass`) are fitted with the declared parameters (ln p) and every
-magnitude by the one fitting engine's bounded Gauss-Newton (thesis ch. 4), each trial on the
-structure meshed along the ribs (:func:`.conforming.remeshed`), where chi^2 is smooth in the ends
-and sharp at the bar (a millimetre across it: x4). The geometry's columns are forward differences
-(:data:`STEP`), each a re-mesh and re-solve run as a job of the :class:`.scan.Runner`; the others'
-are every fit's.
+than on a row of nodes (the cells' rotations are interpolated under it: on an 8 mm mesh a diagonal
+bar raised the first frequencies by 3 %, chi^2 300000 at the bar's place against 5000 meshed along
+it). So each rib is moved in five ways on meshes along it (:func:`.conforming.remeshed`): across
+itself, turned about its middle, each end along its line (extended or trimmed), and its section
+height (its mass per length is 12 rho EI / (E h^2), :meth:`.stiffener._Stiffener.mass`). Each move
+is a line search: the declared parameters and all magnitudes fitted by the one fitting engine
+(:func:`.fitting.estimate`, thesis ch. 4) at two places either side, and the rib taken to the vertex
+of the parabola through the three chi^2 (:func:`vertex`); its step grows while the vertex lies
+beyond the outer places and shrinks once it lies between them. Each place is a mesh of its own, so
+chi^2 carries the mesh's changes as noise (a few % of it on a card with parts: 906 at the bar's line,
+950 and 960 a quarter of a millimetre to either side); a parabola through places an element apart
+reads through it where finite differences at a fraction of an element would not. The line searches
+polish; the long way from the search's full-span line to a bar that stops short of the edges at its
+own angle is covered first by the bounded Gauss-Newton (thesis ch. 4) on the ends and ln h with the
+declared parameters and magnitudes, the geometry's columns by forward differences an eighth of an
+element long (:data:`STEP`), each a re-mesh run as a job; where the mesh's noise defeats it (its
+first step raises chi^2), the line searches start from the search's line.
 """
 
 from __future__ import annotations
@@ -25,12 +33,23 @@ from ..domain import StructureError
 from ..updating.gauss_newton import gauss_newton
 from . import conforming
 from .catalogue import kind
-from .fitting import UPPER, Fit
+from .fitting import UPPER, Fit, estimate
+from .stiffener import normal
 
-#: [element sizes] the forward-difference step of an end coordinate (and, in ln h, of the height)
+#: the moves of a rib and their first steps ([element sizes]; the height's in ln h)
+MOVES = {"across": 0.25, "turn": 0.25, "end0": 0.5, "end1": 0.5, "height": 0.25}
+#: a move's step grows and shrinks within these multiples of its first step
+STEP_RANGE = (0.25, 8.0)
+#: rounds over all moves (a round that improves nothing ends the search)
+ROUNDS = 2
+#: [element sizes] the forward-difference step of an end coordinate (and, in ln h, of the height): on
+#: the plate of tests/diagnosis/test_geometry_fit.py 0.125 took the bar from chi^2 950000 to 38000,
+#: 0.25 to 200000 (the rows are far from linear in the ends over a quarter element there)
 STEP = 0.125
 #: Gauss-Newton steps (each 1 + 5 re-meshed solves per rib, and halvings)
-STEPS = 6
+GN_STEPS = 12
+#: Gauss-Newton steps of each trial fit (from the values at the present place)
+TRIAL_STEPS = 3
 #: [m] bounds of the section height (a foil to a deep frame member)
 HEIGHT = (0.5e-3, 30e-3)
 #: [element sizes] the shortest rib (shorter, an end pair collapses into a point effect)
@@ -41,12 +60,75 @@ MIN_LENGTH = 2.0
 class Ribs:
     """What the fit ends on: the structure's ``models`` meshed along the ribs, the residual ``res``
     there, the effects ``placed`` on it (ribs at their fitted ends and sections), and the ``fit`` of
-    (ln p, magnitudes)."""
+    (declared parameters, magnitudes)."""
 
     models: object
     res: object
     placed: list
     fit: Fit
+
+
+def moved(rib, move: str, amount: float, h: float):
+    """``rib`` moved by ``amount`` ([m]; ln h for the height) in one of :data:`MOVES` (None where it
+    would end shorter than :data:`MIN_LENGTH` elements or its height leave :data:`HEIGHT`)."""
+    path = np.asarray(rib.geometry["path"], float)[[0, -1]]
+    d = (path[1] - path[0]) / np.linalg.norm(path[1] - path[0])
+    n = normal(path)
+    height = rib.data.get("height", kind("stiffener").section.h)
+    if move == "across":
+        path = path + amount * n
+    elif move == "turn":
+        path = path + np.array([-amount, amount])[:, None] * n
+    elif move == "end0":
+        path[0] -= amount * d
+    elif move == "end1":
+        path[1] += amount * d
+    else:
+        height = height * np.exp(amount)
+        if not HEIGHT[0] <= height <= HEIGHT[1]:
+            return None
+    if np.linalg.norm(path[1] - path[0]) < MIN_LENGTH * h:
+        return None
+    return kind("stiffener").along(replace(rib, data={**rib.data, "height": float(height)}), path)
+
+
+def vertex(offsets, chi2) -> float:
+    """The offset of the least chi^2 on the parabola through three (offset, chi^2) points equally
+    spaced (the best of them where the parabola opens down), kept between the outer two."""
+    (a, b, c), d = chi2, offsets[2] - offsets[1]
+    curve = a - 2.0 * b + c
+    if not (curve > 0.0 and np.isfinite(curve)):
+        return float(offsets[int(np.argmin(chi2))])
+    return float(np.clip(offsets[1] + 0.5 * d * (a - c) / curve, offsets[0], offsets[2]))
+
+
+def _fit_at(base, observations, effects, p, values, steps: int):
+    """(models, residual, placed, :class:`.fitting.Fit`) of the structure meshed along ``effects``'
+    ribs, the declared parameters and magnitudes fitted from ``p``, ``values``; None where it cannot
+    be meshed there (a line too close to a part's outline) or the fit cannot start."""
+    try:
+        models, res, placed = conforming.remeshed(*base, observations, effects)
+        fit = estimate(res, p, placed, values, steps, models.bounds)
+    except (StructureError, ValueError, ArithmeticError, np.linalg.LinAlgError):
+        return None
+    return None if fit.state is None else (models, res, placed, fit)
+
+
+def _trial(_, effects, shared) -> float:
+    """One place of a line search (a job): its chi^2 (infinite where it cannot be meshed or fitted)."""
+    base, observations, p, values = shared
+    out = None if effects is None else _fit_at(base, observations, effects, p, values, TRIAL_STEPS)
+    return np.inf if out is None else out[3].chi2
+
+
+def _solve(base, observations, effects, p, values):
+    """(models, residual, placed, state) of the structure meshed along ``effects``' ribs at ``p`` and
+    magnitudes ``values``, or None where it cannot be meshed there."""
+    try:
+        models, res, placed = conforming.remeshed(*base, observations, effects)
+        return models, res, placed, res.evaluate(p, placed, values)
+    except (StructureError, ValueError, ArithmeticError, np.linalg.LinAlgError):
+        return None
 
 
 def _with_geometry(chosen, ribs, g, h):
@@ -62,16 +144,6 @@ def _with_geometry(chosen, ribs, g, h):
     return out
 
 
-def _solve(base, observations, effects, p, values):
-    """(models, residual, placed, state) of the structure meshed along ``effects``' ribs, or None
-    where it cannot be meshed there (a line too close to a part's outline)."""
-    try:
-        models, res, placed = conforming.remeshed(*base, observations, effects)
-        return models, res, placed, res.evaluate(p, placed, values)
-    except (StructureError, ValueError, ArithmeticError, np.linalg.LinAlgError):
-        return None
-
-
 def _difference(_, g, shared):
     """One forward difference (a job): the residual rows at geometry ``g`` (None: not meshed there)."""
     base, observations, chosen, ribs, h, p, values = shared
@@ -80,30 +152,23 @@ def _difference(_, g, shared):
     return None if out is None else out[3].r
 
 
-def fit_ribs(structure, configs, names, h: float, observations, chosen: list, p, values, bounds, runner,
-             steps: int = STEPS) -> Ribs | None:
-    """The stiffeners of ``chosen`` fitted at their ends and sections with the declared parameters
-    ``p`` and all magnitudes ``values`` (module doc); None where ``chosen`` has no stiffener or the
-    structure cannot be meshed along them."""
-    ribs = [k for k, c in enumerate(chosen) if c.kind == "stiffener"]
-    if not ribs:
-        return None
-    base = (structure, configs, names, h)
-    p = np.asarray(p, float)
+def _gauss_newton(base, observations, chosen, ribs, h, fit, bounds, runner, steps: int = GN_STEPS):
+    """(chosen, (models, res, placed, Fit)) after the bounded Gauss-Newton on (ln p, magnitudes, the
+    ribs' ends and ln h) from ``fit`` (module doc); None where it cannot start."""
+    p = np.asarray(fit.p, float)
     npar, ne = p.size, len(chosen)
-    spec = kind("stiffener")
     g0 = np.concatenate([np.r_[np.asarray(chosen[k].geometry["path"], float)[[0, -1]].ravel(),
-                               np.log(chosen[k].data.get("height", spec.section.h))] for k in ribs])
-    lo_xy = np.min([np.asarray(c.geometry["path"], float).min(axis=0) for c in (chosen[k] for k in ribs)], axis=0)
-    hi_xy = np.max([np.asarray(c.geometry["path"], float).max(axis=0) for c in (chosen[k] for k in ribs)], axis=0)
-    layout_lo, layout_hi = structure_extent(structure, lo_xy, hi_xy)
+                               np.log(chosen[k].data.get("height", kind("stiffener").section.h))] for k in ribs])
+    outline = getattr(base[0], "outline", None)
+    ends = np.asarray(outline.vertices if outline is not None else g0[:4].reshape(2, 2), float)
+    lo_xy, hi_xy = ends.min(axis=0), ends.max(axis=0)
     v_lo = np.array([c.spec.lower for c in chosen], float)
     v_hi = UPPER * np.array([c.spec.scale for c in chosen], float)
     lo_p, hi_p = bounds if bounds is not None else (np.zeros(npar), np.full(npar, np.inf))
-    lo_p = np.maximum(lo_p, 1e-6 * np.abs(p))
     with np.errstate(divide="ignore"):
-        lower = np.r_[np.log(lo_p), v_lo, np.tile(np.r_[layout_lo, layout_lo, np.log(HEIGHT[0])], len(ribs))]
-        upper = np.r_[np.log(hi_p), v_hi, np.tile(np.r_[layout_hi, layout_hi, np.log(HEIGHT[1])], len(ribs))]
+        lower = np.r_[np.log(np.maximum(lo_p, 1e-6 * np.abs(p))), v_lo,
+                      np.tile(np.r_[lo_xy, lo_xy, np.log(HEIGHT[0])], len(ribs))]
+        upper = np.r_[np.log(hi_p), v_hi, np.tile(np.r_[hi_xy, hi_xy, np.log(HEIGHT[1])], len(ribs))]
     scale = np.r_[np.ones(npar), [c.spec.scale for c in chosen], np.tile([h, h, h, h, 1.0], len(ribs))]
     step = np.tile(np.r_[np.full(4, STEP * h), STEP], len(ribs))
     kept: dict = {}
@@ -111,39 +176,66 @@ def fit_ribs(structure, configs, names, h: float, observations, chosen: list, p,
     def evaluate(y):
         effects = _with_geometry(chosen, ribs, y[npar + ne:], h)
         out = None if effects is None else _solve(base, observations, effects, np.exp(y[:npar]), y[npar:npar + ne])
-        if out is None:
-            return None
-        st = out[3]
-        kept[id(st)] = (y.copy(), out)
-        return st
+        if out is not None:
+            kept[id(out[3])] = (y.copy(), effects, out)
+        return None if out is None else out[3]
 
     def jacobian(st):
-        y, (_, res, placed, _) = kept[id(st)]
-        g = y[npar + ne:]
-        jobs = [(g + step[j] * np.eye(step.size)[j],) for j in range(step.size)]
-        shared = (base, observations, chosen, ribs, h, np.exp(y[:npar]), y[npar:npar + ne])
-        rows = runner.map(_difference, jobs, shared, "re-meshed trials of the ribs' ends")
+        y, _, (_, res, placed, _) = kept[id(st)]
+        jobs = [(y[npar + ne:] + step[j] * np.eye(step.size)[j],) for j in range(step.size)]
+        rows = runner.map(_difference, jobs, (base, observations, chosen, ribs, h, np.exp(y[:npar]), y[npar:npar + ne]),
+                          "re-meshed trials of the ribs' ends")
         fd = np.column_stack([np.zeros(st.r.size) if r is None or r.size != st.r.size else -(r - st.r) / step[j]
                               for j, r in enumerate(rows)])
-        cols = [res.param_columns(st)] if npar else []
-        return np.hstack(cols + [res.effect_columns(st, placed), fd])
+        return np.hstack(([res.param_columns(st)] if npar else []) + [res.effect_columns(st, placed), fd])
 
-    y0 = np.r_[np.log(p), np.clip(np.asarray(values, float), v_lo, v_hi), g0]
+    y0 = np.r_[np.log(p), np.clip(np.asarray(fit.values, float), v_lo, v_hi), g0]
     gn = gauss_newton(evaluate, jacobian, y0, lower, upper, scale, steps,
-                      lambda y: np.r_[1e-4 * np.ones(npar), 1e-4 * np.maximum(np.abs(y[npar:npar + ne]),
-                                                                               scale[npar:npar + ne]), 0.1 * step])
+                      lambda y: np.r_[1e-4 * np.ones(npar), 1e-4 * scale[npar:npar + ne], 0.05 * step])
     if gn.state is None:
         return None
-    y, (models, res, placed, st) = kept[id(gn.state)]
+    y, effects, (models, res, placed, st) = kept[id(gn.state)]
     n = npar + ne
-    return Ribs(models, res, placed, Fit(np.exp(y[:npar]), y[npar:n], st, gn.cov[:n, :n]))
+    return effects, (models, res, placed, Fit(np.exp(y[:npar]), y[npar:n], st, gn.cov[:n, :n]))
 
 
-def structure_extent(structure, lo, hi) -> tuple:
-    """(lower, upper) corners [m] the ribs' ends may take: the structure's outline's box where it has
-    one (a board), else the box of the ribs as found."""
-    outline = getattr(structure, "outline", None)
-    if outline is None:
-        return np.asarray(lo, float), np.asarray(hi, float)
-    v = np.asarray(outline.vertices, float)
-    return v.min(axis=0), v.max(axis=0)
+def fit_ribs(structure, configs, names, h: float, observations, chosen: list, p, values, runner, say=None,
+             rounds: int = ROUNDS) -> Ribs | None:
+    """The stiffeners of ``chosen`` moved to where they fit best (module doc), from the declared
+    parameters ``p`` and all magnitudes ``values``; None where ``chosen`` has no stiffener or the
+    structure cannot be meshed along them. ``runner`` runs the re-meshed trials."""
+    ribs = [k for k, c in enumerate(chosen) if c.kind == "stiffener"]
+    base = (structure, configs, names, h)
+    here = _fit_at(base, observations, chosen, p, values, conforming.STEPS) if ribs else None
+    if here is None:
+        return None
+    gn = _gauss_newton(base, observations, chosen, ribs, h, here[3], here[0].bounds, runner)
+    if gn is not None and gn[1][3].chi2 < here[3].chi2:
+        chosen, here = gn
+        if say:
+            say(f"  ends and sections by Gauss-Newton: chi^2 {here[3].chi2:.5g}")
+    step = {(k, m): s for k in ribs for m, s in MOVES.items()}
+    for _ in range(rounds):
+        improved = False
+        for k in ribs:
+            for m in MOVES:
+                scale = 1.0 if m == "height" else h
+                d = step[(k, m)] * scale
+                sides = [moved(chosen[k], m, -d, h), moved(chosen[k], m, d, h)]
+                fit = here[3]
+                chi2 = runner.map(_trial, [(None if s is None else [*chosen[:k], s, *chosen[k + 1:]],) for s in sides],
+                                  (base, observations, fit.p, fit.values), f"places of {chosen[k].name}")
+                x = vertex([-d, 0.0, d], [chi2[0], fit.chi2, chi2[1]])
+                lo, hi = (MOVES[m] * f for f in STEP_RANGE)
+                step[(k, m)] = float(np.clip(step[(k, m)] * (2.0 if abs(x) >= d * (1 - 1e-9) else 0.5), lo, hi))
+                there = None if x == 0.0 else moved(chosen[k], m, x, h)
+                trial = None if there is None else _fit_at(base, observations, [*chosen[:k], there, *chosen[k + 1:]],
+                                                           fit.p, fit.values, conforming.STEPS)
+                if trial is not None and trial[3].chi2 < fit.chi2:
+                    chosen, here, improved = [*chosen[:k], there, *chosen[k + 1:]], trial, True
+                    if say:
+                        by = f"{x:+.3g} in ln h" if m == "height" else f"{1e3 * x:+.3g} mm"
+                        say(f"  {chosen[k].name}: {m} {by}, chi^2 {trial[3].chi2:.5g}")
+        if not improved:
+            break
+    return Ribs(*here)

@@ -13,8 +13,8 @@ from ..fe.probe import ProbeError
 from .catalogue import kind
 
 #: [element sizes] how far a stiffener's line moves across itself in one step of the local search
-#: (:func:`.pipeline._on_lines` then walks it to a fraction of this on meshes along it; the bar of
-#: ``ho_al_bar``, found as two lines, took 22 s of local search in quarter steps, 13 s in halves)
+#: (:mod:`.geometry_fit` then moves it on meshes along it; the bar of ``ho_al_bar``, found as two
+#: lines, took 22 s of local search in quarter steps, 13 s in halves)
 LINE_STEP = 0.5
 #: [element sizes] how far a point between nodes moves in one step of the local search
 POINT_STEP = 0.25

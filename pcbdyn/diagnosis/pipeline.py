@@ -5,16 +5,14 @@ whether what remains is noise, and otherwise find, place and size the effects th
    MAC, residual rows in units of noise (:mod:`.residual`). A free model's test mode of rigid-body
    shape that no elastic mode resembles shows a support it lacks: a spring to ground is placed and
    sized from it (:mod:`.support`) and held through the search.
-2. Noise: the stated levels (uniform bounds as in thesis eqs. 5.72-5.73, so a standard deviation
-   of p / sqrt(3)), or, for shapes without a stated level, the part of each measured shape that no
-   combination of the model's modes can represent (a measured shape projected on the span of as
-   many modes as half the points; what is left over is noise). Model discretisation: the paired
-   frequencies are corrected to a converged mesh by Richardson extrapolation from the two
-   coarsest meshes (the model's, twice, four times as fine) that resolve the mode (an O(h^2)
-   element); what that leaves uncertain, and the shapes' change (4/3 of it), is added to the
-   noise in quadrature, so that a coarse mesh is neither mistaken for an effect nor left in the
-   error reported after. So is the plate theory's gap on the finest mesh (Mindlin against
-   Kirchhoff: the board's transverse shear stiffness is a guess; :mod:`.model_form`).
+2. The error budget (:mod:`.budget`, its rules :mod:`pcbdyn.problems.error_budget`'s): the noise
+   stated, or for shapes without a stated level the part of each measured shape that no
+   combination of the model's modes can represent; the paired frequencies corrected to a converged
+   mesh by Richardson extrapolation from the coarsest meshes that resolve the mode, what that leaves
+   uncertain (and the shapes' change) added to the noise in quadrature, so that a coarse mesh is
+   neither mistaken for an effect nor left in the error reported after; so is the plate theory's
+   gap on the finest mesh (Mindlin against Kirchhoff: the board's transverse shear stiffness is a
+   guess; :mod:`.model_form`).
 3. The declared parameters alone are fitted; if chi^2 is within what noise gives (chi-square
    test, probability ``alpha``) the data lie in the range of the model (thesis section 5.2.3) and
    nothing is invented.
@@ -24,9 +22,10 @@ whether what remains is noise, and otherwise find, place and size the effects th
    rectangular regions are walked to where they fit best (:func:`.select.refine`,
    :class:`.moves.LocalMoves`) and a mass with an inertia beside it refitted as one body
    (:mod:`.bodies`). The masses (and supports) found are then put on the finer meshes and the mesh
-   correction measured again (:func:`_with_carried`: they change the shapes it depends on); where
+   correction measured again (:func:`.budget.with_carried`: they change the shapes it depends on); where
    stiffeners were found, the structure is meshed along their lines first, every effect carried,
-   and the lines walked there (:func:`_on_lines`, :mod:`.conforming`). Last, the plate
+   and the ribs' ends and sections fitted there (:func:`_on_lines`, :mod:`.conforming`,
+   :mod:`.geometry_fit`). Last, the plate
    theory's share is fitted with the effects found (:func:`.model_form.fit_plate_share`; kept
    only where significant).
 """
@@ -39,27 +38,23 @@ import numpy as np
 from scipy.stats import chi2 as chi2_dist
 
 from ..domain import StructureError
-from ..fe.modal import solve_modes
 from ..parallel import spare_cores
-from ..problems.error_budget import noise_sigma
-from ..problems.models import StructureModels, parameter_values
+from ..problems.models import StructureModels
 from .bodies import as_bodies
 from .catalogue import KINDS, generate, kind
 from .evidence import evidence
 from .layout import from_structure
 from .merge import MERGE_REACH, groups, mean_path, merged
 from .moves import LocalMoves, movable
-from . import conforming, finer, geometry_fit
-from .model_form import MESH_LEVELS, discretisation, fit_plate_share, kirchhoff_shift
-from .residual import ModalResidual, Observation, reading
+from . import conforming, geometry_fit
+from .budget import MASS_KINDS, observations, set_noise, with_carried
+from .model_form import MESH_LEVELS, fit_plate_share
+from .residual import ModalResidual
 from .fitting import estimate
 from .scan import Runner
 from .select import ALPHA, adopt, penalty, refine, search, without_vanished
 from .support import supports
 from .uncertainty import jackknife_cov
-
-#: kinds whose effects :func:`_with_carried` carries onto the finer meshes
-MASS_KINDS = ("point_mass", "point_inertia", "line_mass")
 
 #: where candidates go: sides cut into 16 pieces (every run of consecutive pieces is a candidate);
 #: stiffener rows and columns every element (``path_spacing`` in element sizes)
@@ -91,118 +86,6 @@ class Diagnosis:
     candidates: list = field(default_factory=list)
 
 
-def _noise_sigmas(ob: Observation, freq_pct, shape_pct, basis_shapes):
-    """Per-mode relative standard deviations of the frequencies and of a shape component
-    (``basis_shapes``: the model's modes at the points, needed only where the shape noise is not stated)."""
-    m = ob.f.size
-    sf = np.full(m, noise_sigma(0.2 if freq_pct is None else freq_pct))
-    if ob.shapes is None:
-        return sf, None
-    if shape_pct is not None:
-        return sf, np.full(m, noise_sigma(shape_pct))
-    n_pts = ob.shapes.shape[0]
-    k = min(basis_shapes.shape[1], max(n_pts // 2, 1))
-    Q, _ = np.linalg.qr(basis_shapes[:, :k])
-    left = ob.shapes - Q @ (Q.T @ ob.shapes)
-    rms = np.sqrt(np.mean(ob.shapes**2, axis=0))
-    var = np.sum(left**2, axis=0) / max(n_pts - k, 1)
-    return sf, np.maximum(np.sqrt(np.mean(var)) / rms, 1e-4)
-
-
-def _observations(tests, models) -> list:
-    """An Observation per test [(configuration, Modes)], read on its configuration's built model."""
-    obs = []
-    for (c, mm), pm in zip(tests, models):
-        ob = Observation(c, mm, np.ones(mm.n_modes))
-        if mm.shapes is not None:
-            ob.read = reading(pm.model, mm.xyz, mm.directions)
-            ob.sigma_s = np.ones(mm.n_modes)  # until the noise is known
-        obs.append(ob)
-    return obs
-
-
-def _requests(ob, cs, h, levels: int, carried=(), kirchhoff: bool = False) -> list:
-    """The finer-mesh solves (:func:`.finer.solve`) of observation ``ob``, paired on the model's mesh
-    as ``cs``: the meshes twice, four times, ... as fine as ``h`` (``levels`` of them), carrying
-    ``carried`` (effects that are the same on any mesh: [(candidate, value)]), and with
-    ``kirchhoff`` the finest again as a Kirchhoff plate."""
-    points = None if ob.shapes is None else (ob.modes.xyz, ob.modes.directions)
-    n_modes = int(cs.pairs.max()) + finer.SPARE_MODES
-    out = [(ob.name, h / 2**j, False, tuple(carried), n_modes, points) for j in range(1, levels + 1)]
-    return out + [(ob.name, h / 2**levels, True, tuple(carried), n_modes, points)] if kirchhoff else out
-
-
-@dataclass
-class _Form:
-    """What one observation's model form leaves: ``shift`` (the Kirchhoff limit's relative change
-    per mode), ``measured`` (the measurement's frequency sigmas), ``plain`` (with the mesh's
-    uncertainty, without the plate theory's gap) and ``resolved`` (the modes the mesh resolves)."""
-
-    shift: np.ndarray
-    measured: np.ndarray
-    plain: np.ndarray = None
-    resolved: list = None
-
-
-def _correct(ob, cs, solved, form: _Form):
-    """Sets ``ob``'s frequency correction from ``solved`` (the modes on the finer meshes,
-    :func:`.model_form.discretisation`) and its frequency sigmas (measurement, the correction's
-    uncertainty and the plate theory's gap in quadrature), and ``form``'s ``plain`` and
-    ``resolved``; returns the shapes' relative error."""
-    ob.f_scale, df, ds, ok = discretisation(solved, ob, cs)
-    form.plain, form.resolved = np.sqrt(form.measured**2 + df**2), ok.tolist()
-    ob.sigma_f = np.sqrt(form.plain**2 + form.shift**2)
-    return ds
-
-
-def _set_noise(models, h, obs, state, freq_pct, shape_pct, levels: int, runner, support=()) -> list:
-    """Each observation's discretisation correction of the model frequencies, and its sigmas:
-    measurement noise, what remains of the discretisation error and the plate theory's gap, in
-    quadrature (:mod:`.model_form`), from ``levels`` finer meshes (solved where ``runner`` says)
-    that carry the ``support`` springs of ``state`` ([(candidate, value)], :mod:`.support`).
-    Returns a :class:`_Form` per observation."""
-    sigmas = []
-    for ob, cs in zip(obs, state.configs):
-        basis = None
-        if ob.shapes is not None and shape_pct is None:  # rigid-body modes first: a free board's shapes hold them
-            wide = solve_modes(cs.model, n_modes=ob.shapes.shape[0] // 2)
-            basis = np.asarray(ob.read @ np.column_stack([wide.rigid_shapes, wide.shapes]))
-        sigmas.append(_noise_sigmas(ob, freq_pct, shape_pct, basis))
-    requests = [r for ob, cs in zip(obs, state.configs) for r in _requests(ob, cs, h, levels, support, kirchhoff=True)]
-    p0 = parameter_values(models.models[0], models.names, models.p0)
-    solved = iter(finer.solve(runner, models.structure, p0, requests))
-    forms = []
-    for ob, cs, (sf, ss) in zip(obs, state.configs, sigmas):
-        meshes = [next(solved) for _ in range(levels)]
-        forms.append(_Form(kirchhoff_shift(meshes[-1], next(solved), ob, cs), sf))
-        ds = _correct(ob, cs, meshes, forms[-1])
-        ob.sigma_s = None if ss is None else np.sqrt(ss**2 + ds**2)
-    return forms
-
-
-def _with_carried(models, res, p, carried, forms, h, levels: int, runner, kirchhoff: bool = False) -> None:
-    """The mesh correction measured again at the fitted parameters ``p`` on the model carrying the
-    masses and supports found (``carried``: [(candidate, value)], of :data:`MASS_KINDS` or between
-    nodes), on its own mesh and placed on the ``levels`` finer ones: a mass changes the shapes, and
-    so what the mesh does to the frequencies, of the modes it sits on (a connector along an edge: a
-    third less on the modes it localises). Masses only, and springs at a point between nodes (a
-    support), as they are the same on any mesh; a stiffness effect found on the model's mesh is
-    partly its discretisation, and is left out on both sides of the comparison (a stiffener on a
-    mesh along its line is not: :func:`_on_lines`). ``kirchhoff``: the plate theory's gap measured
-    again too, on the finest mesh (a rib makes modes of other shapes, whose gap differs: 0.61 %
-    against 0.13 % on the fourth mode of a card with a bar across it).
-    Sets the observations' ``f_scale`` and frequency sigmas and the ``forms``."""
-    ref = res.evaluate(p, [c for c, _ in carried], [v for _, v in carried])
-    requests = [r for ob, cs in zip(res.observations, ref.configs) for r in _requests(ob, cs, h, levels, carried, kirchhoff)]
-    at = parameter_values(models.models[0], models.names, p)
-    solved = iter(finer.solve(runner, models.structure, at, requests))
-    for ob, cs, form in zip(res.observations, ref.configs, forms):
-        meshes = [next(solved) for _ in range(levels)]
-        if kirchhoff:
-            form.shift = kirchhoff_shift(meshes[-1], next(solved), ob, cs)
-        _correct(ob, cs, meshes, form)
-
-
 def _on_lines(models, res, cands, sel, forms, h, levels: int, runner, alpha, say):
     """(models, residual, candidates, selection) after :mod:`.conforming`'s stage, or None where the
     structure cannot be meshed along the lines found: parallel stiffeners fitted as shares of one
@@ -230,17 +113,17 @@ def _on_lines(models, res, cands, sel, forms, h, levels: int, runner, alpha, say
     except StructureError as exc:
         say(f"  not meshed along them ({exc}): the stiffeners stay embedded in the model's cells")
         return None
-    _with_carried(models, res, sel.p, list(zip(placed, values)), forms, h, levels, runner, kirchhoff=True)
+    with_carried(models, res, sel.p, list(zip(placed, values)), forms, h, levels, runner, kirchhoff=True)
     fit = estimate(res, sel.p, placed, values, conforming.STEPS, models.bounds)
     say("fitting the stiffeners' ends, directions and sections on meshes along them")
-    ribs = geometry_fit.fit_ribs(*base, res.observations, placed, fit.p, fit.values, models.bounds, runner)
+    ribs = geometry_fit.fit_ribs(*base, res.observations, placed, fit.p, fit.values, runner, say)
     if ribs is not None and ribs.fit.chi2 < fit.chi2:
         moved = max(float(np.abs(np.asarray(a.geometry["path"]) - np.asarray(b.geometry["path"])).max())
                     for a, b in zip(placed, ribs.placed) if a.kind == "stiffener")
         models, res, placed, fit = ribs.models, ribs.res, ribs.placed, ribs.fit
         if moved > conforming.REMEASURE * h:
             say("  the mesh correction measured where the stiffeners went")
-            _with_carried(models, res, fit.p, list(zip(placed, fit.values)), forms, h, levels, runner, kirchhoff=True)
+            with_carried(models, res, fit.p, list(zip(placed, fit.values)), forms, h, levels, runner, kirchhoff=True)
             fit = estimate(res, fit.p, placed, fit.values, conforming.STEPS, models.bounds)
     out = list(cands)
     for i, c in zip(idx, placed):
@@ -303,7 +186,7 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
     say("building the models")
     models = StructureModels(structure, [c for c, _ in tests], mesh_size=h, shared_mesh=True)
     names, p0 = models.names, models.p0
-    obs = _observations(tests, models.models)
+    obs = observations(tests, models.models)
     res = ModalResidual.of_models(models, obs)
     say("solving the model as given")
     before = res.evaluate(p0)
@@ -325,7 +208,7 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
     levels = 1 if quick else MESH_LEVELS
     say("  finer meshes: " + ", ".join(f"level {j} of {levels} ({1e3 * h / 2**j:.3g} mm)" for j in range(1, levels + 1)))
     seed = res.evaluate(p0, [c for c, _ in support], [v for _, v in support]) if support else before
-    forms = _set_noise(models, h, obs, seed, freq_noise_pct, shape_noise_pct, levels, runner, support)
+    forms = set_noise(models, h, obs, seed, freq_noise_pct, shape_noise_pct, levels, runner, support)
     before = res.evaluate(p0)
     say(f"fitting the {len(names)} declared parameter(s)" if names else "no declared parameters")
     # the declared parameters alone, on the modes they can pair (a support's bounce has no partner without it)
@@ -380,7 +263,7 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
         obs = res.observations
     elif carried and not quick:
         say("measuring the mesh correction again with the masses (and supports) found on the finer meshes")
-        _with_carried(models, res, sel.p, carried, forms, h, levels, runner)
+        with_carried(models, res, sel.p, carried, forms, h, levels, runner)
         sel = adopt(sel, sel.chosen, estimate(res, sel.p, [cands[i] for i in sel.chosen], sel.values, 8, models.bounds),
                     penalty(res.n_rows, len(cands), alpha))
     if lined is not None or (carried and not quick):

@@ -7,7 +7,7 @@ import pytest
 import scipy.sparse as sp
 
 from pcbdyn import diagnosis as dg
-from pcbdyn.diagnosis.pipeline import _noise_sigmas
+from pcbdyn.diagnosis.budget import noise_sigmas
 from pcbdyn.diagnosis.residual import ModalResidual, Observation
 from pcbdyn.fe import EdgeSpringProperty, MassProperty, Model, ShellProperty
 from pcbdyn.fe.assembly import assemble
@@ -107,7 +107,7 @@ def test_shape_noise_estimate(plate, pct):
     basis = np.asarray(read @ wide.shapes)
     phi = np.asarray(read @ modes.shapes)
     noisy = Observation(None, measured(ob.f, noisy_shapes(phi, pct, seed=4)), ob.sigma_f, read, None)
-    _, ss = _noise_sigmas(noisy, 0.2, None, basis)
+    _, ss = noise_sigmas(noisy, 0.2, None, basis)
     assert np.mean(ss) == pytest.approx(pct / 100 / np.sqrt(3), rel=0.25)
 
 
