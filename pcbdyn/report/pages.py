@@ -10,27 +10,41 @@ import pandas as pd
 from .html import Page, describe_file
 
 
-def build_page(out: Path, board_toml, board, results: list) -> Path:
-    """report.html in ``out`` from :func:`pcbdyn.commands.build.analyse` results (one per
-    configuration) and the mode pictures it wrote to ``out/png``."""
+def build_page(out: Path, board_toml, board, solved: list) -> Path:
+    """report.html in ``out`` from :func:`pcbdyn.commands.build.analyse` results (one per configuration):
+    the model, the modes table, an animated 3-D view of the modes and the mode pictures in ``out/png``."""
+    from .modes import free_note
+    from .view3d import MAX_BYTES, Scene, mode_view
+
+    results = [r["summary"] for r in solved]
     page = Page(f"pcbdyn build: {board.name}",
                 subtitle=", ".join(f"[{r['configuration']}] first mode {r['modes'][0]['frequency_hz']:.1f} Hz"
                                    for r in results if r["modes"]))
     page.items("Inputs", {"board": describe_file(board_toml),
                           "configurations": ", ".join(r["configuration"] for r in results),
                           "mesh size": f"{board.mesh_size * 1e3:g} mm"})
-    for r in results:
-        label = r["configuration"]
+    for r, s in zip(results, solved):
+        label, modes = r["configuration"], s["modes"]
         page.items(f"Model [{label}]", {"mass": f"{r['mass_kg'] * 1e3:.2f} g", "DOFs": r["dofs"],
-                                        "rigid-body modes": r["rigid_body_modes"]})
-        table = pd.DataFrame([{"mode": m["n"], "frequency [Hz]": m["frequency_hz"],
-                               "eff. mass z [%]": 100.0 * m["eff_mass_z"], "shape": m["shape"]} for m in r["modes"]])
-        page.table(f"Modes [{label}]", table)
+                                        "rigid-body modes": r["rigid_body_modes"],
+                                        "centre of mass [mm]": ", ".join(f"{1e3 * c:.1f}" for c in r["centre_of_mass_m"])})
+        page.table(f"Modes [{label}]", s["table"],
+                   note=free_note(modes.n_rigid) or "effective mass: each mode's share of the mass moved by a rigid "
+                   "translation along x, y, z and of the moment of inertia about the axes rx, ry, rz through the "
+                   "centre of mass; sum: the running sum over the modes")
+        if modes.frequencies.size:
+            scene = Scene.of_model(f"{board.name} [{label}]", s["model"].model, board.outlines(s["config"]))
+            for k in range(modes.frequencies.size):
+                scene.add_mode(modes.shapes[:, k])
+            page.view3d(f"Modes in 3-D [{label}]", mode_view(
+                [scene], [f"mode {m['n']}: {m['frequency_hz']:.1f} Hz, {m['shape']}" for m in r["modes"]],
+                max_bytes=MAX_BYTES // len(solved)))
         shown = [(out / "png" / f"modes_{label}_{m['n']:02d}.png", m) for m in r["modes"]]
         shown = [(png, m) for png, m in shown if png.is_file()]  # none with --no-pictures
         if shown:
             page.pictures(f"Mode shapes [{label}]", [png for png, _ in shown],
-                          [f"mode {m['n']}: {m['frequency_hz']:.1f} Hz, {m['shape']}" for _, m in shown])
+                          [f"mode {m['n']}: {m['frequency_hz']:.1f} Hz, {m['shape']}" for _, m in shown],
+                          optional=True)
     return page.write(out / "report.html")
 
 

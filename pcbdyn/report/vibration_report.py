@@ -36,10 +36,13 @@ def parts_table(a) -> pd.DataFrame:
 
 
 def modes_table(a) -> pd.DataFrame:
+    """One row per mode: frequency, damping, effective masses in percent (:func:`.modes.mass_columns`)."""
+    from .modes import mass_columns
+
     be = a.excitation
     return pd.DataFrame({"mode": np.arange(1, be.frequencies.size + 1), "frequency [Hz]": be.frequencies,
-                         "damping ratio": be.zeta, "Q": 0.5 / be.zeta,
-                         "eff. mass [%]": 100.0 * be.effective_mass_fraction, "damping from": a.damping_source})
+                         "damping ratio": be.zeta, "Q": 0.5 / be.zeta, **mass_columns(a.effective_mass),
+                         "damping from": a.damping_source})
 
 
 def format_table(df: pd.DataFrame) -> str:
@@ -51,8 +54,7 @@ def summary_lines(a) -> list:
     lines = [f"input: {a.psd.name}, {a.input_grms:.2f} grms along {a.axis} ({a.psd.source})",
              f"damping: {a.damping.describe()}",
              f"modes: {a.excitation.frequencies.size} up to {a.excitation.frequencies[-1]:.0f} Hz, "
-             f"{100 * a.excitation.effective_mass_fraction.sum():.1f} % of the moving mass (static residual added "
-             "for the rest)",
+             f"{100 * a.mass_share:.2f} % of the mass moved along {a.axis} (static residual added for the rest)",
              f"largest RMS relative displacement on the board: {a.z_peak_m * 1e3:.4g} mm"]
     if a.duration is not None:
         lines.append(f"duration: {a.duration:g} s per axis")

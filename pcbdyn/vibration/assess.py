@@ -21,12 +21,16 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..fe.curvature import curvature_matrix
+from ..fe.effective_mass import EffectiveMass, effective_mass
 from ..fe.probe import model_probe
 from . import steinberg
 from .base_excitation import AXES, BaseExcitation, base_excitation
 from .damping import Damping, modal_damping
 from .parts import judged_parts
 from .spectra import G, Psd, SineSweep, VibrationError, frequency_grid
+
+#: below this share of the mass moved along the shaken axis, the modes used are reported as too few
+MASS_SHARE = 0.90
 
 
 @dataclass
@@ -82,9 +86,16 @@ class Assessment:
     grid: np.ndarray
     part_accel_psd: np.ndarray  # (n_grid, n_parts) absolute acceleration [(m/s^2)^2/Hz]
     part_z_psd: np.ndarray  # (n_grid, n_parts) relative displacement [m^2/Hz]
+    effective_mass: EffectiveMass | None = None
     octave: dict | None = None
     sine: SineSweep | None = None
     notes: list = field(default_factory=list)
+
+    @property
+    def mass_share(self) -> float:
+        """The share of the mass moved along the shaken axis that the modes used carry (0..1)."""
+        return float(self.effective_mass.cumulative[-1, AXES.index(self.axis)]) if self.excitation.frequencies.size \
+            else 0.0
 
     @property
     def input_grms(self) -> float:
@@ -107,10 +118,10 @@ class Assessment:
             "duration_s": self.duration,
             "damping": self.damping.describe(),
             "modes": [{"n": i + 1, "frequency_hz": float(f), "damping_ratio": float(z), "damping_source": s,
-                       "effective_mass_fraction": float(m)}
+                       "effective_mass": m}
                       for i, (f, z, s, m) in enumerate(zip(be.frequencies, be.zeta, self.damping_source,
-                                                           be.effective_mass_fraction))],
-            "effective_mass_fraction": float(be.effective_mass_fraction.sum()),
+                                                           self.effective_mass.as_dicts()))],
+            "effective_mass_fraction": self.mass_share,
             "z_peak_rms_m": self.z_peak_m,
             "parts": [p.to_dict() for p in self.parts],
             "octave_rule": self.octave,
@@ -170,7 +181,14 @@ def assess(board, bm, modes, K, M, psd: Psd, damping: Damping, *, axis: str = "z
     node_z = np.full(model.nodes.shape[0], np.nan)
     node_z[nodes] = np.sqrt(be.variance(be.basis[6 * nodes + 2], C0))
     z_peak = float(np.nanmax(node_z))
+    em = effective_mass(model.nodes, M, modes.shapes)
     notes = []
+    share = float(em.cumulative[-1, AXES.index(axis)]) if modes.frequencies.size else 0.0
+    if share < MASS_SHARE:
+        top = f" (up to {modes.frequencies[-1]:.0f} Hz)" if modes.frequencies.size else ""
+        notes.append(f"the {modes.frequencies.size} modes used{top} carry {100 * share:.1f} % of the mass moved along "
+                     f"{axis} (< {100 * MASS_SHARE:.0f} %): the rest, in higher modes and at the supports, enters as "
+                     "the static residual, without resonance")
     if be.frequencies[-1] < psd.f[-1]:
         notes.append(f"the modes found reach {be.frequencies[-1]:.0f} Hz, below the top of the spectrum "
                      f"({psd.f[-1]:.0f} Hz): the modes above respond statically only")
@@ -203,4 +221,4 @@ def assess(board, bm, modes, K, M, psd: Psd, damping: Damping, *, axis: str = "z
     order = np.argsort([r.margin for r in results], kind="stable")
     octave = None if chassis_hz is None else steinberg.octave_rule(float(be.frequencies[0]), chassis_hz)
     return Assessment(psd, damping, axis, duration, be, source, [results[i] for i in order],
-                      node_z, grid, accel_psd[:, order], z_psd[:, order], octave, sine, notes)
+                      node_z, grid, accel_psd[:, order], z_psd[:, order], em, octave, sine, notes)

@@ -1,0 +1,133 @@
+"""The animated 3-D mode views of the HTML pages (pcbdyn.report.view3d, templates/view3d.js with the
+plotly.js of the plotly wheel) in headless Chromium with the network blocked (tests/browser.py): on the
+build pages of the example box and card the view is drawn with the structure's parts, fixtures, ribs and
+masses, it moves (two screenshots apart in time differ; paused, they do not), its colours carry the sign
+of the motion, the mode picker lists every mode, and the page asks nothing of the network. A picture
+opens at full size on a click."""
+
+import io
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from browser import chromium, requests_made
+from click.testing import CliRunner
+
+from pcbdyn.cli import main
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture(scope="module")
+def browser():
+    with chromium() as driver:
+        yield driver
+
+
+def build(example: str, out: Path, *extra) -> dict:
+    js = out.parent / f"{out.name}.json"
+    res = CliRunner().invoke(main, ["build", str(ROOT / "examples" / example), "--out", str(out), "--html",
+                                    "--json", str(js), *map(str, extra)])
+    assert res.exit_code == 0, res.output
+    return json.loads(js.read_text())
+
+
+def pixels(png: bytes) -> np.ndarray:
+    import matplotlib.image
+
+    return matplotlib.image.imread(io.BytesIO(png), format="png")[..., :3]
+
+
+def open_view(browser, page: Path, frames: int = 3):
+    """Load ``page``, wait for ``frames`` frames of its first view; return the view's element."""
+    from selenium.webdriver.common.by import By
+    from selenium.webdriver.support.ui import WebDriverWait
+
+    browser.get(page.resolve().as_uri())
+    view = browser.find_element(By.CSS_SELECTOR, ".view3d")
+    WebDriverWait(browser, 60).until(lambda d: int(view.get_attribute("data-frames") or 0) >= frames)
+    browser.execute_script("arguments[0].scrollIntoView()", view)
+    return view
+
+
+def drawn(browser, view) -> dict:
+    """What the view's plot holds now: trace names, the surface's colours, the phase, the mode options."""
+    return browser.execute_script("""
+        const v = arguments[0], plot = v.querySelector('.plot'), mesh = plot.data.find(t => t.type === 'mesh3d');
+        return {names: plot.data.map(t => t.name).filter(n => n), phase: parseFloat(v.dataset.phase),
+                lo: Math.min(...mesh.intensity), hi: Math.max(...mesh.intensity),
+                options: Array.from(v.querySelectorAll('select.mode option')).map(o => o.textContent),
+                canvases: plot.querySelectorAll('canvas').length, frames: parseInt(v.dataset.frames)};""", view)
+
+
+def shot(browser, view) -> np.ndarray:
+    """The view's pixels, cut from a screenshot of the window (quicker than an element's screenshot)."""
+    r = browser.execute_script("return arguments[0].getBoundingClientRect().toJSON()", view)
+    top, left = max(int(r["top"]), 0), max(int(r["left"]), 0)
+    return pixels(browser.get_screenshot_as_png())[top:int(r["bottom"]), left:int(r["right"])]
+
+
+def moves(browser, view) -> float:
+    """The share of the view's pixels that differ between two screenshots 0.3 s apart."""
+    a = shot(browser, view)
+    time.sleep(0.3)
+    b = shot(browser, view)
+    assert a.shape == b.shape and a.size > 100_000
+    return float(np.mean(np.abs(a - b).max(axis=2) > 0.05))
+
+
+def check_animates(browser, view) -> None:
+    assert moves(browser, view) > 0.002  # the shape moves
+    view.find_element("css selector", "button.pause").click()
+    time.sleep(0.3)
+    assert moves(browser, view) == 0.0  # paused: still (the difference above is the animation's)
+    view.find_element("css selector", "button.pause").click()
+
+
+def test_box_build_page_animates_its_modes(browser, tmp_path):
+    data = build("ribbed_box/box.toml", tmp_path / "out", "--no-pictures")
+    view = open_view(browser, tmp_path / "out" / "report.html")
+    state = drawn(browser, view)
+    assert state["canvases"] >= 1  # plotly drew with WebGL
+    assert {"beams (ribs)", "plates", "stiffeners", "fixtures", "masses"} <= set(state["names"]), state["names"]
+    assert state["options"] == [f"mode {m['n']}: {m['frequency_hz']:.1f} Hz, {m['shape']}" for m in data["modes"]]
+    check_animates(browser, view)
+    assert requests_made(browser) == []  # nothing asked of the (blocked) network
+    assert browser.execute_script("return performance.getEntriesByType('resource').length") == 0
+
+
+def test_card_build_page_signed_colours_mode_picker_and_full_size_pictures(browser, tmp_path):
+    data = build("six_part_card/board.toml", tmp_path / "out")
+    view = open_view(browser, tmp_path / "out" / "report.html")
+    state = drawn(browser, view)
+    assert {"board outline", "parts", "masses"} <= set(state["names"]), state["names"]
+    assert len(state["options"]) == len(data["modes"])
+    check_animates(browser, view)
+    # mode 2, (0,2) nodal lines: the colours (normal displacement) take both signs, scaled by the phase
+    browser.execute_script("const s = arguments[0].querySelector('select.mode'); s.value = '1';"
+                           "s.dispatchEvent(new Event('change'));", view)
+    time.sleep(0.5)
+    for _ in range(50):
+        state = drawn(browser, view)
+        if abs(state["phase"]) > 0.5:
+            break
+        time.sleep(0.05)
+    assert abs(state["phase"]) > 0.5
+    assert state["lo"] < -0.2 * abs(state["phase"]) and state["hi"] > 0.2 * abs(state["phase"]), state
+    assert max(-state["lo"], state["hi"]) == pytest.approx(abs(state["phase"]), rel=0.02)
+    # a picture opens at its full size on a click, and closes on another
+    figure = browser.find_element("css selector", "figure img")
+    browser.execute_script("arguments[0].scrollIntoView()", figure)
+    figure.click()
+    big = browser.execute_script("""
+        const box = document.getElementById('lightbox'), img = box.querySelector('img');
+        return [box.hidden, img.naturalWidth, img.getBoundingClientRect().width, arguments[0].naturalWidth,
+                arguments[0].getBoundingClientRect().width];""", figure)
+    hidden, natural, shown, small_natural, small_shown = big
+    assert not hidden and natural == small_natural and shown == pytest.approx(natural, abs=1)
+    assert small_shown < 0.8 * natural  # the page shows it smaller
+    browser.find_element("id", "lightbox").click()
+    assert browser.execute_script("return document.getElementById('lightbox').hidden")
+    assert requests_made(browser) == []
