@@ -5,7 +5,8 @@ the catalogue of effects (point masses and inertias, ground springs, edge stiffn
 stiffness, stiffeners, line masses) for the fewest that explain it, estimated together with the
 parameters (:func:`pcbdyn.diagnosis.pipeline.diagnose`). Prints the effects and the correlation as
 given / parameters only / with the effects; writes ``<board>.diagnosed.toml`` declaring them next
-to the original, the evidence map and tables in ``--out``, and JSON.
+to the original, the evidence map and tables in ``--out`` (with ``--html``, a page showing the effects
+on the modes of the model that declares them), and JSON.
 """
 
 from __future__ import annotations
@@ -15,7 +16,8 @@ from pathlib import Path
 import click
 
 from ..diagnosis import KINDS
-from .common import done, folder_outputs, input_errors, library_option, measured_configurations, parse_noise, result_path, step
+from .common import (done, folder_outputs, input_errors, library_option, measured_configurations, parse_noise, result_path,
+                     solve_structure, step)
 
 
 @click.command("diagnose")
@@ -39,11 +41,11 @@ from .common import done, folder_outputs, input_errors, library_option, measured
               help="a Dask scheduler address (tcp://host:8786): the finer-mesh solves and the full trial fits run "
                    "on that cluster, the rest on local processes (the findings do not depend on where they run)")
 @folder_outputs("folder for the board with the effects declared, the evidence map and tables",
-                "write effects, before/after and statistics as JSON",
+                "write effects, before/after and statistics as JSON", html=True,
                 force="replace an earlier <board>.diagnosed.toml beside the board (default: a numbered name)")
 @library_option()
 def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size, quick, workers, scheduler, out, force,
-            json_path):
+            json_path, html):
     """Find the effects a board model lacks from modal tests: TEST_UFF (with mode shapes) of the base
     configuration and NAME=FILE for each perturbed configuration of board.toml (e.g. c2=test2.uff)."""
     from ..diagnosis.pipeline import diagnose
@@ -90,6 +92,13 @@ def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size,
         if d.evidence:
             written.append(out / "evidence.png")
             rep.plot_evidence(written[-1], board, d.evidence, d.effects)
+        if html:
+            shown = load_structure(enriched) if enriched is not None else board
+            bm, modes, _, _ = solve_structure(shown, None)
+            title = f"{board.name}{' with the effects' if enriched is not None else ''}"
+            written.append(rep.html_page(out, board_toml, board, d, (title, bm, modes, shown.outlines(None)),
+                                         out / "evidence.png" if d.evidence else None))
+            click.echo(f"page written to {written[-1]}", err=True)
         settle(out, written, "pcbdyn diagnose")
     if json_path is not None:
         write_json(json_path, {

@@ -48,8 +48,15 @@ def build_page(out: Path, board_toml, board, solved: list) -> Path:
     return page.write(out / "report.html")
 
 
-def correlate_page(out: Path, board_toml, test_uff, board, label: str, pairing, comac: dict, written: list) -> Path:
-    """report.html in ``out`` from a correlation and the pictures :func:`write_outputs` made."""
+def correlate_page(out: Path, board_toml, test_uff, board, config, corr, written: list, bm, modes,
+                   test_modes) -> Path:
+    """report.html in ``out`` from a correlation ``corr`` of ``test_modes`` with the model ``bm`` of the
+    configuration ``config`` (None: the base) and its ``modes``: the tables, test and model side by side in 3-D through the pairs, and the pictures
+    :func:`write_outputs` made."""
+    from .view3d import pair_view
+
+    pairing, label = corr.pairing, config or "base"
+    comac = dict(zip(corr.dof_labels, corr.comac.tolist()))
     page = Page(f"pcbdyn correlate: {board.name} [{label}] against {Path(test_uff).name}",
                 subtitle=f"{len(pairing.pairs)} pair(s); unpaired test modes: "
                          f"{', '.join(str(i + 1) for i in pairing.unpaired_test) or 'none'}")
@@ -63,6 +70,13 @@ def correlate_page(out: Path, board_toml, test_uff, board, label: str, pairing, 
     page.table("Lowest COMAC", pd.DataFrame([{"DOF": k, "COMAC": v} for k, v in lowest]),
                note="COMAC per measured DOF over the pairs (thesis eq. 2.4); low values mark where test and model "
                     "differ")
+    if pairing.pairs:
+        page.view3d("Test and model in 3-D", pair_view(
+            bm.model, pairing.model_shapes(modes.shapes), board.outlines(config),
+            test_modes, pairing.model_shapes(corr.model_at_test), pairing.pairs),
+            note="left: the model's shape with the test points on it; right: the measured shape at the test "
+                 "points (scaled by its modal scale factor against the model, so both move in phase) over the "
+                 "model at rest")
     main = [n for n in ("mac_matrix.png", "frequencies.png", "comac.png") if n in written]
     page.pictures("MAC matrix, frequencies and COMAC", [out / n for n in main],
                   ["MAC matrix (pairs framed)", "model against test frequency", "COMAC per point"])

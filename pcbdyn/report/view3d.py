@@ -129,14 +129,16 @@ class Scene:
 
     @staticmethod
     def _mode(u, normals, p) -> dict:
+        """One mode's data: the surface's motion and colours over its largest motion, and the points'
+        motion on the same scale (on their own where the surface is still)."""
         out = {}
+        scale = float(np.abs(u).max() if u is not None else 0.0) or float(np.abs(p).max() if p is not None else 0.0)
+        scale = scale or 1.0
         if u is not None:
-            scale = float(np.abs(u).max()) or 1.0
             out["u"] = _b64(np.round(u / scale * 32767), np.int16)
             out["s"] = _b64(np.round(np.einsum("ij,ij->i", u, normals) / scale * 127), np.int8)
         if p is not None:
-            scale = float(np.abs(p).max()) or 1.0
-            out["p"] = _b64(np.round(p / scale * 32767), np.int16)
+            out["p"] = _b64(np.round(np.clip(p / scale, -1.0, 1.0) * 32767), np.int16)
         return out
 
 
@@ -150,6 +152,36 @@ def mode_view(scenes, labels, amplitude: float = 0.1, max_bytes: int = MAX_BYTES
     budget = max_bytes // max(len(scenes), 1)
     return {"scenes": [s.payload(budget) for s in scenes], "labels": list(labels), "amplitude": amplitude,
             "colour": QUANTITY_3D}
+
+
+def point_motion(values, dof_points, directions, n_points: int) -> np.ndarray:
+    """(n_points, 3): the motion of each point from the values (n_dof,) measured along ``directions``
+    (n_dof, 3) at the points ``dof_points`` (n_dof,) (indices into the points)."""
+    out = np.zeros((n_points, 3))
+    np.add.at(out, np.asarray(dof_points), np.asarray(values)[:, None] * np.asarray(directions))
+    return out
+
+
+def pair_view(model, model_shapes, outlines, test_modes, at_test, pairs) -> dict:
+    """Test and model side by side through the ``pairs`` (:class:`pcbdyn.correlation.pairing.Pair`):
+    the model's surface and the test points moving with it (``model_shapes`` full-length, one column
+    per pair; ``at_test`` the same read at the test DOFs), and the test points moving with the measured
+    shape over the model at rest, the test shape turned by its modal scale factor against the model so
+    that both move in phase."""
+    pts = test_modes.measured_points()
+    idx = pts.index(test_modes.dofs.point_ids)
+    dirs = test_modes.dofs.directions
+    model_scene = Scene.of_model("model", model, outlines, points=pts.xyz, point_labels=pts.ids)
+    test_scene = Scene.of_model("test", model, outlines, points=pts.xyz, point_labels=pts.ids,
+                                surface_opacity=0.25)
+    for j, p in enumerate(pairs):
+        t, m = test_modes.shapes[:, p.test], at_test[:, j]
+        msf = np.vdot(t, m) / (np.vdot(t, t) or 1.0)
+        model_scene.add_mode(model_shapes[:, j], point_motion(m, idx, dirs, len(pts.xyz)))
+        test_scene.add_mode(None, point_motion(np.real(t * msf), idx, dirs, len(pts.xyz)))
+    labels = [f"test {p.test + 1} ({p.f_test:.1f} Hz) / model {p.model + 1} ({p.f_model:.1f} Hz), MAC {p.mac_combined:.2f}"
+              for p in pairs]
+    return mode_view([model_scene, test_scene], labels)
 
 
 def scripts() -> list:

@@ -2,9 +2,10 @@
 plotly.js of the plotly wheel) in headless Chromium with the network blocked (tests/browser.py): on the
 build pages of the example box and card the view is drawn with the structure's parts, fixtures, ribs and
 masses, it moves (two screenshots apart in time differ; paused, they do not), its colours carry the sign
-of the motion, the mode picker lists every mode, and the page asks nothing of the network. A picture
-opens at full size on a click."""
+of the motion, the mode picker lists every mode, and the page asks nothing of the network; on the
+correlate page test and model move side by side, in phase."""
 
+import base64
 import io
 import json
 import time
@@ -98,8 +99,8 @@ def test_box_build_page_animates_its_modes(browser, tmp_path):
     assert browser.execute_script("return performance.getEntriesByType('resource').length") == 0
 
 
-def test_card_build_page_signed_colours_mode_picker_and_full_size_pictures(browser, tmp_path):
-    data = build("six_part_card/board.toml", tmp_path / "out")
+def test_card_build_page_signed_colours_and_mode_picker(browser, tmp_path):
+    data = build("six_part_card/board.toml", tmp_path / "out", "--no-pictures")
     view = open_view(browser, tmp_path / "out" / "report.html")
     state = drawn(browser, view)
     assert {"board outline", "parts", "masses"} <= set(state["names"]), state["names"]
@@ -117,17 +118,36 @@ def test_card_build_page_signed_colours_mode_picker_and_full_size_pictures(brows
     assert abs(state["phase"]) > 0.5
     assert state["lo"] < -0.2 * abs(state["phase"]) and state["hi"] > 0.2 * abs(state["phase"]), state
     assert max(-state["lo"], state["hi"]) == pytest.approx(abs(state["phase"]), rel=0.02)
-    # a picture opens at its full size on a click, and closes on another
-    figure = browser.find_element("css selector", "figure img")
-    browser.execute_script("arguments[0].scrollIntoView()", figure)
-    figure.click()
-    big = browser.execute_script("""
-        const box = document.getElementById('lightbox'), img = box.querySelector('img');
-        return [box.hidden, img.naturalWidth, img.getBoundingClientRect().width, arguments[0].naturalWidth,
-                arguments[0].getBoundingClientRect().width];""", figure)
-    hidden, natural, shown, small_natural, small_shown = big
-    assert not hidden and natural == small_natural and shown == pytest.approx(natural, abs=1)
-    assert small_shown < 0.8 * natural  # the page shows it smaller
-    browser.find_element("id", "lightbox").click()
-    assert browser.execute_script("return document.getElementById('lightbox').hidden")
+    assert requests_made(browser) == []
+
+
+def test_correlate_page_shows_test_and_model_moving_in_phase(browser, tmp_path):
+    """Test and model side by side: both scenes carry the test points; at one instant the points' motion
+    in the model scene (the model's shape there) and in the test scene (the measured shape, 2 % noise,
+    turned by its modal scale factor) point the same way."""
+    card = ROOT / "examples" / "six_part_card"
+    uff = tmp_path / "t.uff"
+    for args in (["simulate-test", card / "board.toml", "--points", card / "points.csv", "--excite", "135,63.57",
+                  "--modes", 4, "--noise", "shape=2", "--seed", 3, "--out", uff],
+                 ["correlate", card / "board.toml", uff, "--out", tmp_path / "out", "--html"]):
+        res = CliRunner().invoke(main, [str(a) for a in args])
+        assert res.exit_code == 0, res.output
+    view = open_view(browser, tmp_path / "out" / "report.html")
+    assert len(drawn(browser, view)["options"]) == 4
+    check_animates(browser, view)
+    for _ in range(50):
+        now = browser.execute_script("""
+            const v = arguments[0], plot = v.querySelector('.plot');
+            return {phase: parseFloat(v.dataset.phase), scenes: plot.data.filter(t => t.name === 'test points')
+                    .map(t => [t.scene, t.z])};""", view)
+        if abs(now["phase"]) > 0.5:
+            break
+        time.sleep(0.05)
+    (s1, z_model), (s2, z_test) = now["scenes"]
+    assert (s1, s2) == ("scene", "scene2")
+    payload = json.loads(browser.execute_script("return arguments[0].querySelector('script.view-data').textContent",
+                                                view))
+    rest = np.frombuffer(base64.b64decode(payload["scenes"][0]["points"]), np.float32).reshape(-1, 3)
+    dm, dt = np.asarray(z_model) - rest[:, 2], np.asarray(z_test) - rest[:, 2]
+    assert dm @ dt / (np.linalg.norm(dm) * np.linalg.norm(dt)) > 0.95  # in phase (MAC ~ 1, same sign)
     assert requests_made(browser) == []

@@ -1,6 +1,6 @@
 """The HTML pages of vibe, build and correlate, opened in real headless Chromium (tests/browser.py:
-the network blocked) driven by Selenium: every picture loads, every table is there, nothing is
-fetched from outside the page, and a screenshot is not blank. The page builder's escaping and its
+the network blocked) driven by Selenium: every picture loads (and opens at full size on a click),
+every table is there, nothing is fetched from outside the page, and a screenshot is not blank. The page builder's escaping and its
 refusal of a missing picture are checked without a browser."""
 
 import io
@@ -67,6 +67,17 @@ def test_vibe_page(browser, tmp_path):
     assert state["title"] == "pcbdyn vibe: simply supported plate"
     check(state, 2, ["Inputs", "Parts, worst margin first", "Modes", "Versions"])
     assert dict(state["tables"])["Parts, worst margin first"] == 3  # header and two parts
+    # a picture opens at its full size on a click, and closes on another
+    figure = browser.find_element("css selector", "figure img")
+    figure.click()
+    hidden, natural, shown, small_natural, small_shown = browser.execute_script("""
+        const box = document.getElementById('lightbox'), img = box.querySelector('img');
+        return [box.hidden, img.naturalWidth, img.getBoundingClientRect().width, arguments[0].naturalWidth,
+                arguments[0].getBoundingClientRect().width];""", figure)
+    assert not hidden and natural == small_natural and shown == pytest.approx(natural, abs=1)
+    assert small_shown < 0.9 * natural  # the page shows it smaller
+    browser.find_element("id", "lightbox").click()
+    assert browser.execute_script("return document.getElementById('lightbox').hidden")
 
 
 def test_build_page(browser, tmp_path):

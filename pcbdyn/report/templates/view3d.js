@@ -151,7 +151,22 @@
     button.addEventListener("click", function () {
       state.running = !state.running; button.textContent = state.running ? "pause" : "play";
     });
-    draw(state.t0).then(function () { requestAnimationFrame(tick); });
+    draw(state.t0).then(function () {
+      if (scenes.length > 1) {  // turning one scene turns the others with it
+        plot.on("plotly_relayout", function (e) {
+          var moved = Object.keys(e).filter(function (k) { return /^scene\d*\.camera$/.test(k); })[0];
+          if (!moved || state.syncing) return;
+          var update = {};
+          scenes.forEach(function (sc, i) {
+            var name = (i ? "scene" + (i + 1) : "scene") + ".camera";
+            if (name !== moved) update[name] = e[moved];
+          });
+          state.syncing = true;
+          Plotly.relayout(plot, update).then(function () { state.syncing = false; });
+        });
+      }
+      requestAnimationFrame(tick);
+    });
   }
 
   function start() { document.querySelectorAll(".view3d").forEach(setup); }
