@@ -76,7 +76,7 @@ def command(board_toml, psd_text, sine_csv, sweep_rate, sweeps, damping_text, du
                       "axis": axis, "duration": None if seconds is None else f"{seconds:g} s",
                       "chassis frequency": None if chassis is None else f"{chassis:g} Hz",
                       "excluded parts": ", ".join(exclude) or None}
-            written.append(report.html_page(out, board_toml, board, a, inputs).name)
+            written.append(report.html_page(out, board_toml, board, a, inputs, bm.model, config).name)
         from ..report.manifest import settle
 
         settle(out, [out / w for w in written], "pcbdyn vibe")

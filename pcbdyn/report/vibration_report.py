@@ -130,9 +130,11 @@ def write_outputs(out: Path, board, model, a) -> list:
     return ["parts.csv", "modes.csv", "response_psd.csv", "board_map.png", "response_psd.png"]
 
 
-def html_page(out: Path, board_toml, board, a, inputs: dict) -> Path:
-    """report.html in ``out`` (after :func:`write_outputs`): verdicts, tables, pictures, inputs."""
+def html_page(out: Path, board_toml, board, a, inputs: dict, model=None, config=None) -> Path:
+    """report.html in ``out`` (after :func:`write_outputs`): verdicts, tables, pictures, inputs, and, given
+    the FE ``model`` (of the configuration ``config``), an animated 3-D view of the modes used."""
     from .html import Page, describe_file
+    from .view3d import Scene, mode_view
 
     failing = [p.ref for p in a.parts if not p.ok]
     verdict = f"{len(failing)} of {len(a.parts)} part(s) fail: {', '.join(failing)}" if failing else \
@@ -148,5 +150,14 @@ def html_page(out: Path, board_toml, board, a, inputs: dict) -> Path:
                     "technique and Miner's rule at the zero up-crossing rate nu0.")
     page.pictures("Board map and response spectra", [out / "board_map.png", out / "response_psd.png"],
                   ["margin per part over the RMS relative displacement", "input and response acceleration PSDs"])
-    page.table("Modes", modes_table(a))
+    page.table("Modes", modes_table(a), note="effective mass: each mode's share of the mass moved by a rigid "
+               "translation along x, y, z and of the moment of inertia about the axes rx, ry, rz through the centre of "
+               "mass; sum: the running sum over the modes")
+    be = a.excitation
+    if model is not None and be.frequencies.size:
+        scene = Scene.of_model(board.name, model, board.outlines(config))
+        for k in range(be.frequencies.size):
+            scene.add_mode(be.basis[:, k])
+        page.view3d("Modes in 3-D", mode_view([scene], [f"mode {k + 1}: {f:.1f} Hz, Q = {0.5 / z:.3g}"
+                                                         for k, (f, z) in enumerate(zip(be.frequencies, be.zeta))]))
     return page.write(out / "report.html")

@@ -38,6 +38,7 @@ def open_page(browser, page: Path, shot: Path) -> dict:
           tables: Array.from(document.querySelectorAll('table')).map(t => [t.dataset.title, t.rows.length]),
           fetched: performance.getEntriesByType('resource').map(e => e.name).filter(n => !n.startsWith('data:')),
           title: document.title,
+          views: document.querySelectorAll('.view3d').length,
         };""")
     state["requested"] = requests_made(browser)
     png = browser.get_screenshot_as_png()
@@ -67,6 +68,7 @@ def test_vibe_page(browser, tmp_path):
     assert state["title"] == "pcbdyn vibe: simply supported plate"
     check(state, 2, ["Inputs", "Parts, worst margin first", "Modes", "Versions"])
     assert dict(state["tables"])["Parts, worst margin first"] == 3  # header and two parts
+    assert state["views"] == 1  # the modes used, in 3-D
     # a picture opens at its full size on a click, and closes on another
     figure = browser.find_element("css selector", "figure img")
     figure.click()
@@ -86,6 +88,7 @@ def test_build_page(browser, tmp_path):
     run("build", board, "--out", tmp_path / "out", "--html")
     state = open_page(browser, tmp_path / "out" / "report.html", tmp_path / "build.png")
     check(state, 3, ["Inputs", "Model [base]", "Modes [base]", "Versions"])
+    assert state["views"] == 1
 
 
 def test_correlate_page(browser, tmp_path):
@@ -100,6 +103,7 @@ def test_correlate_page(browser, tmp_path):
     n_pairs = len(json.loads(js.read_text())["pairs"])
     state = open_page(browser, tmp_path / "out" / "report.html", tmp_path / "correlate.png")
     check(state, 3 + n_pairs, ["Inputs", "Mode pairs", "Lowest COMAC", "Versions"])
+    assert state["views"] == 1  # test and model side by side
 
 
 def test_page_escapes_text_and_refuses_a_missing_picture(tmp_path):
