@@ -101,6 +101,10 @@ def test_box_build_page_animates_its_modes(browser, tmp_path):
 
 def test_card_build_page_signed_colours_and_mode_picker(browser, tmp_path):
     data = build("six_part_card/board.toml", tmp_path / "out", "--no-pictures")
+    # the card is free: its elastic modes carry no effective mass, and the page and JSON say why
+    assert max(v for m in data["modes"] for v in m["effective_mass"].values()) < 1e-9
+    assert "mass-orthogonal to every rigid motion" in data["effective_mass_note"]
+    assert data["effective_mass_note"] in (tmp_path / "out" / "report.html").read_text()
     view = open_view(browser, tmp_path / "out" / "report.html")
     state = drawn(browser, view)
     assert {"board outline", "parts", "masses"} <= set(state["names"]), state["names"]
