@@ -18,6 +18,8 @@ mass-normalised columns)::
     em.fractions        # (n_modes, 6) shares in AXES order
     em.cumulative       # running sums over the modes
     em.as_dicts()       # [{"x": .., "y": .., "z": .., "rx": .., "ry": .., "rz": ..}] per mode
+    em.share("z")       # what all of them carry along z
+    shortfall(em, "z", frequencies)   # the note a base-excitation or shock analysis prints, or None
 """
 
 from __future__ import annotations
@@ -30,6 +32,8 @@ from .mesh import NDOF
 
 #: the rigid-body motions, in the order of every array here
 AXES = ("x", "y", "z", "rx", "ry", "rz")
+#: below this share of the mass moved along an excited axis, the modes used are too few to say nothing
+ENOUGH = 0.90
 
 
 def centre_of_mass(nodes, M) -> np.ndarray:
@@ -89,10 +93,28 @@ class EffectiveMass:
         """Running sums of :attr:`fractions` over the modes (n_modes, 6)."""
         return np.cumsum(self.fractions, axis=0)
 
+    def share(self, axis: str) -> float:
+        """The share all the modes carry along ``axis`` (one of :data:`AXES`); 0 without modes."""
+        return float(self.fractions[:, AXES.index(axis)].sum())
+
     def as_dicts(self) -> list:
         """One {"x", "y", "z", "rx", "ry", "rz"} dict of fractions per mode (the JSON contract
         ``modes[].effective_mass``)."""
         return [{a: float(v) for a, v in zip(AXES, row)} for row in self.fractions]
+
+
+def shortfall(em: EffectiveMass, axis: str, frequencies, enough: float = ENOUGH) -> str | None:
+    """The note an analysis by modal superposition along ``axis`` prints when its modes (of
+    ``frequencies`` [Hz]) carry less than ``enough`` of the mass moved along it; None when they carry
+    enough."""
+    share = em.share(axis)
+    if share >= enough:
+        return None
+    top = f" (up to {max(frequencies):.0f} Hz)" if len(frequencies) else ""
+    n = len(frequencies)
+    return (f"the {n} mode{'' if n == 1 else 's'} used{top} carry {100 * share:.1f} % of the mass moved along {axis} "
+            f"(< {100 * enough:.0f} %): the rest, in higher modes and at the supports, is missing from the modal "
+            "sum")
 
 
 def effective_mass(nodes, M, shapes) -> EffectiveMass:

@@ -21,16 +21,13 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..fe.curvature import curvature_matrix
-from ..fe.effective_mass import EffectiveMass, effective_mass
+from ..fe.effective_mass import EffectiveMass, effective_mass, shortfall
 from ..fe.probe import model_probe
 from . import steinberg
 from .base_excitation import AXES, BaseExcitation, base_excitation
 from .damping import Damping, modal_damping
 from .parts import judged_parts
 from .spectra import G, Psd, SineSweep, VibrationError, frequency_grid
-
-#: below this share of the mass moved along the shaken axis, the modes used are reported as too few
-MASS_SHARE = 0.90
 
 
 @dataclass
@@ -94,8 +91,7 @@ class Assessment:
     @property
     def mass_share(self) -> float:
         """The share of the mass moved along the shaken axis that the modes used carry (0..1)."""
-        return float(self.effective_mass.cumulative[-1, AXES.index(self.axis)]) if self.excitation.frequencies.size \
-            else 0.0
+        return self.effective_mass.share(self.axis)
 
     @property
     def input_grms(self) -> float:
@@ -182,13 +178,9 @@ def assess(board, bm, modes, K, M, psd: Psd, damping: Damping, *, axis: str = "z
     node_z[nodes] = np.sqrt(be.variance(be.basis[6 * nodes + 2], C0))
     z_peak = float(np.nanmax(node_z))
     em = effective_mass(model.nodes, M, modes.shapes)
-    notes = []
-    share = float(em.cumulative[-1, AXES.index(axis)]) if modes.frequencies.size else 0.0
-    if share < MASS_SHARE:
-        top = f" (up to {modes.frequencies[-1]:.0f} Hz)" if modes.frequencies.size else ""
-        notes.append(f"the {modes.frequencies.size} modes used{top} carry {100 * share:.1f} % of the mass moved along "
-                     f"{axis} (< {100 * MASS_SHARE:.0f} %): the rest, in higher modes and at the supports, enters as "
-                     "the static residual, without resonance")
+    notes, short = [], shortfall(em, axis, modes.frequencies)
+    if short:
+        notes.append(f"{short} (vibe adds it back as the static residual, without resonance)")
     if be.frequencies[-1] < psd.f[-1]:
         notes.append(f"the modes found reach {be.frequencies[-1]:.0f} Hz, below the top of the spectrum "
                      f"({psd.f[-1]:.0f} Hz): the modes above respond statically only")

@@ -49,11 +49,13 @@
   function traces(sc, k, phase, name, first) {
     var m = sc.modes[k], out = [], f = phase * sc.amp, P = moved(sc.xyz, m.u, f);
     if (sc.tris.length) {
-      var ii = [], jj = [], kk = [];
-      for (var t = 0; t < sc.tris.length; t += 3) { ii.push(sc.tris[t]); jj.push(sc.tris[t + 1]); kk.push(sc.tris[t + 2]); }
+      if (!sc.ijk) {
+        sc.ijk = [[], [], []];
+        for (var t = 0; t < sc.tris.length; t++) sc.ijk[t % 3].push(sc.tris[t]);
+      }
       var inten = new Array(P[0].length);
       for (var q = 0; q < inten.length; q++) inten[q] = m.s ? m.s[q] / 127 * phase : 0;
-      out.push({type: "mesh3d", scene: name, x: P[0], y: P[1], z: P[2], i: ii, j: jj, k: kk, intensity: inten,
+      out.push({type: "mesh3d", scene: name, x: P[0], y: P[1], z: P[2], i: sc.ijk[0], j: sc.ijk[1], k: sc.ijk[2], intensity: inten,
                 colorscale: COOL, cmin: -1, cmax: 1, opacity: sc.opacity, showscale: first, hoverinfo: "skip",
                 flatshading: false, lighting: {ambient: 0.65, diffuse: 0.5, specular: 0.05},
                 colorbar: {title: {text: "normal displacement<br>(outward, / max |u|)", side: "right"}, len: 0.6}});
