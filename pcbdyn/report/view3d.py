@@ -60,24 +60,32 @@ class Scene:
         self.tris = np.asarray(tris, np.int64).reshape(-1, 3)
         self.lines = np.zeros((0, 2), np.int64) if lines is None else np.asarray(lines, np.int64).reshape(-1, 2)
         self.used = np.unique(np.concatenate([self.tris.ravel(), self.lines.ravel()]))
+        self._kd = None
         self.outlines = [self._attach(o) for o in outlines]
         self.points = None if points is None else np.asarray(points, float).reshape(-1, 3)
         self.point_labels = [str(p) for p in (point_labels if point_labels is not None else [])]
         self.normals = outward_normals(self.xyz, self.tris)
         self.node_modes, self.point_modes = [], []
-        self.cluster = None
 
     @classmethod
     def of_model(cls, title: str, model, outlines=(), **kw) -> "Scene":
         tris, lines = surface_cells(model)
         return cls(title, model.nodes, tris, lines, outlines, **kw)
 
+    def _tree(self):
+        """A k-d tree of the drawn nodes (made once)."""
+        if self._kd is None:
+            from scipy.spatial import cKDTree
+
+            self._kd = cKDTree(self.xyz[self.used])
+        return self._kd
+
     def _attach(self, item) -> dict:
         pts = np.asarray(item.get("xyz", item.get("xy", [])), float)
         pts = pts.reshape(-1, 3) if "xyz" in item else pts.reshape(-1, 2)
         if pts.shape[1] == 2:
             pts = np.column_stack([pts, np.full(len(pts), float(np.mean(self.xyz[self.used, 2])))])
-        near = self.used[np.argmin(((pts[:, None, :] - self.xyz[None, self.used, :]) ** 2).sum(axis=2), axis=1)]
+        near = self.used[self._tree().query(pts)[1]] if len(pts) else np.zeros(0, np.int64)
         return {"kind": item.get("kind", ""), "label": item.get("label") or "", "closed": bool(item.get("closed")),
                 "xyz": pts, "node": near}
 
