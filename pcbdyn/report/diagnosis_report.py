@@ -135,7 +135,7 @@ def html_page(out, board_toml, board, d, shown_model, evidence_png=None):
     import pandas as pd
 
     from .html import Page, describe_file
-    from .view3d import Scene, mode_view
+    from .view3d import shapes_view
 
     page = Page(f"pcbdyn diagnose: {board.name}", subtitle=d.message)
     page.items("Inputs", {"board": describe_file(board_toml)})
@@ -153,12 +153,10 @@ def html_page(out, board_toml, board, d, shown_model, evidence_png=None):
                states_table(d.before, d.parameters_only, d.after))
     title, built, modes, outlines = shown_model
     if modes.frequencies.size:
-        scene = Scene.of_model(title, built.model, list(outlines) + effect_outlines(d.effects))
-        for k in range(modes.frequencies.size):
-            scene.add_mode(modes.shapes[:, k])
-        page.view3d("Effects found, on the modes of the model", mode_view(
-            [scene], [f"mode {k + 1}: {f:.1f} Hz" for k, f in enumerate(modes.frequencies)]),
-            note="red: the effects found, labelled with their size")
+        page.view3d("Effects found, on the modes of the model", shapes_view(
+            title, built.model, list(outlines) + effect_outlines(d.effects), modes.shapes,
+            [f"mode {k + 1}: {f:.1f} Hz" for k, f in enumerate(modes.frequencies)]),
+            note="red: the effects found, labelled with their size (hover over them)")
     if evidence_png is not None:
         page.pictures("Evidence", [evidence_png], ["chi^2 a point effect at each node would remove"])
     return page.write(out / "report.html")

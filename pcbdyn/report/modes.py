@@ -46,6 +46,12 @@ def mass_columns(em) -> dict:
     return cols
 
 
+#: what the effective-mass columns of a table are
+MASS_NOTE = ("effective mass: each mode's share of the mass moved by a rigid translation along x, y, z and of the "
+             "moment of inertia about the axes rx, ry, rz through the centre of mass; sum: the running sum over the "
+             "modes")
+
+
 def free_note(n_rigid: int) -> str | None:
     """Why the elastic modes of a free structure show no effective mass (None when it is held)."""
     if not n_rigid:

@@ -13,8 +13,8 @@ from .html import Page, describe_file
 def build_page(out: Path, board_toml, board, solved: list) -> Path:
     """report.html in ``out`` from :func:`pcbdyn.commands.build.analyse` results (one per configuration):
     the model, the modes table, an animated 3-D view of the modes and the mode pictures in ``out/png``."""
-    from .modes import free_note
-    from .view3d import MAX_BYTES, Scene, mode_view
+    from .modes import MASS_NOTE, free_note
+    from .view3d import MAX_BYTES, shapes_view
 
     results = [r["summary"] for r in solved]
     page = Page(f"pcbdyn build: {board.name}",
@@ -28,17 +28,12 @@ def build_page(out: Path, board_toml, board, solved: list) -> Path:
         page.items(f"Model [{label}]", {"mass": f"{r['mass_kg'] * 1e3:.2f} g", "DOFs": r["dofs"],
                                         "rigid-body modes": r["rigid_body_modes"],
                                         "centre of mass [mm]": ", ".join(f"{1e3 * c:.1f}" for c in r["centre_of_mass_m"])})
-        page.table(f"Modes [{label}]", s["table"],
-                   note=free_note(modes.n_rigid) or "effective mass: each mode's share of the mass moved by a rigid "
-                   "translation along x, y, z and of the moment of inertia about the axes rx, ry, rz through the "
-                   "centre of mass; sum: the running sum over the modes")
+        page.table(f"Modes [{label}]", s["table"], note=free_note(modes.n_rigid) or MASS_NOTE)
         if modes.frequencies.size:
-            scene = Scene.of_model(f"{board.name} [{label}]", s["model"].model, board.outlines(s["config"]))
-            for k in range(modes.frequencies.size):
-                scene.add_mode(modes.shapes[:, k])
-            page.view3d(f"Modes in 3-D [{label}]", mode_view(
-                [scene], [f"mode {m['n']}: {m['frequency_hz']:.1f} Hz, {m['shape']}" for m in r["modes"]],
-                max_bytes=MAX_BYTES // len(solved)))
+            page.view3d(f"Modes in 3-D [{label}]", shapes_view(
+                f"{board.name} [{label}]", s["model"].model, board.outlines(s["config"]), modes.shapes,
+                [f"mode {m['n']}: {m['frequency_hz']:.1f} Hz, {m['shape']}" for m in r["modes"]],
+                MAX_BYTES // len(solved)))
         shown = [(out / "png" / f"modes_{label}_{m['n']:02d}.png", m) for m in r["modes"]]
         shown = [(png, m) for png, m in shown if png.is_file()]  # none with --no-pictures
         if shown:
@@ -51,8 +46,8 @@ def build_page(out: Path, board_toml, board, solved: list) -> Path:
 def correlate_page(out: Path, board_toml, test_uff, board, config, corr, written: list, bm, modes,
                    test_modes) -> Path:
     """report.html in ``out`` from a correlation ``corr`` of ``test_modes`` with the model ``bm`` of the
-    configuration ``config`` (None: the base) and its ``modes``: the tables, test and model side by side in 3-D through the pairs, and the pictures
-    :func:`write_outputs` made."""
+    configuration ``config`` (None: the base) and its ``modes``: the tables, test and model side by side
+    in 3-D through the pairs, and the pictures :func:`write_outputs` made."""
     from .view3d import pair_view
 
     pairing, label = corr.pairing, config or "base"

@@ -134,7 +134,8 @@ def html_page(out: Path, board_toml, board, a, inputs: dict, model=None, config=
     """report.html in ``out`` (after :func:`write_outputs`): verdicts, tables, pictures, inputs, and, given
     the FE ``model`` (of the configuration ``config``), an animated 3-D view of the modes used."""
     from .html import Page, describe_file
-    from .view3d import Scene, mode_view
+    from .modes import MASS_NOTE
+    from .view3d import shapes_view
 
     failing = [p.ref for p in a.parts if not p.ok]
     verdict = f"{len(failing)} of {len(a.parts)} part(s) fail: {', '.join(failing)}" if failing else \
@@ -150,14 +151,9 @@ def html_page(out: Path, board_toml, board, a, inputs: dict, model=None, config=
                     "technique and Miner's rule at the zero up-crossing rate nu0.")
     page.pictures("Board map and response spectra", [out / "board_map.png", out / "response_psd.png"],
                   ["margin per part over the RMS relative displacement", "input and response acceleration PSDs"])
-    page.table("Modes", modes_table(a), note="effective mass: each mode's share of the mass moved by a rigid "
-               "translation along x, y, z and of the moment of inertia about the axes rx, ry, rz through the centre of "
-               "mass; sum: the running sum over the modes")
+    page.table("Modes", modes_table(a), note=MASS_NOTE)
     be = a.excitation
     if model is not None and be.frequencies.size:
-        scene = Scene.of_model(board.name, model, board.outlines(config))
-        for k in range(be.frequencies.size):
-            scene.add_mode(be.basis[:, k])
-        page.view3d("Modes in 3-D", mode_view([scene], [f"mode {k + 1}: {f:.1f} Hz, Q = {0.5 / z:.3g}"
-                                                         for k, (f, z) in enumerate(zip(be.frequencies, be.zeta))]))
+        page.view3d("Modes in 3-D", shapes_view(board.name, model, board.outlines(config), be.basis, [
+            f"mode {k + 1}: {f:.1f} Hz, Q = {0.5 / z:.3g}" for k, (f, z) in enumerate(zip(be.frequencies, be.zeta))]))
     return page.write(out / "report.html")

@@ -162,6 +162,14 @@ def mode_view(scenes, labels, amplitude: float = 0.1, max_bytes: int = MAX_BYTES
             "colour": QUANTITY_3D}
 
 
+def shapes_view(title: str, model, outlines, shapes, labels, max_bytes: int = MAX_BYTES) -> dict:
+    """A view of one model through its mode ``shapes`` (full-length columns, one per label)."""
+    scene = Scene.of_model(title, model, outlines)
+    for k in range(len(labels)):
+        scene.add_mode(shapes[:, k])
+    return mode_view([scene], labels, max_bytes=max_bytes)
+
+
 def point_motion(values, dof_points, directions, n_points: int) -> np.ndarray:
     """(n_points, 3): the motion of each point from the values (n_dof,) measured along ``directions``
     (n_dof, 3) at the points ``dof_points`` (n_dof,) (indices into the points)."""
