@@ -69,26 +69,29 @@
       out.push({type: "scatter3d", mode: "lines", scene: name, x: lx, y: ly, z: lz, name: "beams (ribs)",
                 line: {color: "#222222", width: 5}, hoverinfo: "skip", showlegend: first});
     }
-    var kinds = {};
-    sc.outlines.forEach(function (o) { (kinds[o.kind] = kinds[o.kind] || []).push(o); });
-    Object.keys(kinds).forEach(function (kind) {
-      var xs = [], ys = [], zs = [], text = [], single = true;
-      kinds[kind].forEach(function (o) {
+    var groups = {}, listed = {};  // per kind, the single points (markers with their labels) apart from the lines
+    sc.outlines.forEach(function (o) {
+      var key = o.kind + (o.xyz.length > 1 ? "|lines" : "|points");
+      (groups[key] = groups[key] || []).push(o);
+    });
+    Object.keys(groups).forEach(function (key) {
+      var kind = key.split("|")[0], single = key.split("|")[1] === "points", xs = [], ys = [], zs = [], text = [];
+      groups[key].forEach(function (o) {
         var pts = o.xyz.map(function (p, r) {
           var nd = o.node[r], d = m.u ? f / 32767 : 0;
           return [p[0] + d * (m.u ? m.u[3 * nd] : 0), p[1] + d * (m.u ? m.u[3 * nd + 1] : 0),
                   p[2] + d * (m.u ? m.u[3 * nd + 2] : 0)];
         });
-        if (pts.length > 1) single = false;
         if (o.closed && pts.length > 2) pts.push(pts[0]);
         pts.forEach(function (p) { xs.push(p[0]); ys.push(p[1]); zs.push(p[2]); text.push(o.label); });
-        xs.push(null); ys.push(null); zs.push(null); text.push("");
+        if (!single) { xs.push(null); ys.push(null); zs.push(null); text.push(""); }
       });
       var colour = STYLE[kind] || "#555555";
       out.push({type: "scatter3d", scene: name, x: xs, y: ys, z: zs, text: text, name: NAMES[kind] || kind,
-                mode: single ? "markers+text" : "lines", textposition: "top center",
+                legendgroup: kind, mode: single ? "markers+text" : "lines", textposition: "top center",
                 marker: {size: 6, color: colour, symbol: "diamond"}, line: {color: colour, width: 4},
-                hovertemplate: "%{text}<extra>" + kind + "</extra>", showlegend: first});
+                hovertemplate: "%{text}<extra>" + kind + "</extra>", showlegend: first && !listed[kind]});
+      listed[kind] = true;
     });
     if (sc.points) {
       var PP = moved(sc.points, m.p, f);
