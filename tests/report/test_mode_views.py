@@ -48,8 +48,8 @@ def open_view(browser, page: Path, frames: int = 3):
 
     browser.get(page.resolve().as_uri())
     view = browser.find_element(By.CSS_SELECTOR, ".view3d")
+    browser.execute_script("arguments[0].scrollIntoView()", view)  # a view out of sight does not draw
     WebDriverWait(browser, 60).until(lambda d: int(view.get_attribute("data-frames") or 0) >= frames)
-    browser.execute_script("arguments[0].scrollIntoView()", view)
     return view
 
 

@@ -148,8 +148,12 @@
       });
     }
     function tick(now) {
-      if (state.running && !state.busy && now - state.last >= FRAME) { state.last = now; draw(now); }
+      if (state.running && state.visible && !state.busy && now - state.last >= FRAME) { state.last = now; draw(now); }
       requestAnimationFrame(tick);
+    }
+    state.visible = true;
+    if (window.IntersectionObserver) {  // a view scrolled out of sight stops drawing (a page may hold several)
+      new IntersectionObserver(function (seen) { state.visible = seen[0].isIntersecting; }).observe(plot);
     }
     pick.addEventListener("change", function () { state.k = parseInt(pick.value, 10); if (!state.running) draw(state.t0); });
     slider.addEventListener("input", function () { if (!state.running) draw(state.t0); });
