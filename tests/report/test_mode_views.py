@@ -144,7 +144,7 @@ def test_card_build_page_signed_colours_and_mode_picker(browser, tmp_path):
 def test_correlate_page_shows_test_and_model_moving_in_phase(browser, tmp_path):
     """Test and model side by side: both scenes carry the test points; at one instant the points' motion
     in the model scene (the model's shape there) and in the test scene (the measured shape, 2 % noise,
-    turned by its modal scale factor) point the same way."""
+    turned by its modal scale factor) point the same way; turning one scene turns the other."""
     card = ROOT / "examples" / "six_part_card"
     uff = tmp_path / "t.uff"
     for args in (["simulate-test", card / "board.toml", "--points", card / "points.csv", "--excite", "135,63.57",
@@ -170,4 +170,9 @@ def test_correlate_page_shows_test_and_model_moving_in_phase(browser, tmp_path):
     rest = np.frombuffer(base64.b64decode(payload["scenes"][0]["points"]), np.float32).reshape(-1, 3)
     dm, dt = np.asarray(z_model) - rest[:, 2], np.asarray(z_test) - rest[:, 2]
     assert dm @ dt / (np.linalg.norm(dm) * np.linalg.norm(dt)) > 0.95  # in phase (MAC ~ 1, same sign)
+    eye = browser.execute_async_script("""  // turning the model turns the test with it
+        const done = arguments[arguments.length - 1], plot = arguments[0].querySelector('.plot');
+        Plotly.relayout(plot, {'scene.camera': {eye: {x: 2, y: 0.5, z: 0.3}}})
+          .then(() => setTimeout(() => done(plot.layout.scene2.camera.eye), 500));""", view)
+    assert eye == pytest.approx({"x": 2, "y": 0.5, "z": 0.3})
     assert requests_made(browser) == []

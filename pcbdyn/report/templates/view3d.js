@@ -102,7 +102,7 @@
     return out;
   }
 
-  function layout(scenes, amp) {
+  function layout(scenes) {
     var lay = {margin: {l: 0, r: 0, t: 30, b: 0}, uirevision: "keep", showlegend: true,
                legend: {orientation: "h", x: 0, y: 0}, annotations: []};
     scenes.forEach(function (sc, i) {
@@ -130,7 +130,7 @@
     });
     slider.value = data.amplitude;
     var state = {k: 0, running: true, busy: false, last: 0, t0: performance.now()};
-    var lay = layout(scenes, data.amplitude);
+    var lay = layout(scenes);
     root.dataset.frames = "0";
 
     function draw(now) {
@@ -163,12 +163,12 @@
     draw(state.t0).then(function () {
       if (scenes.length > 1) {  // turning one scene turns the others with it
         plot.on("plotly_relayout", function (e) {
-          var moved = Object.keys(e).filter(function (k) { return /^scene\d*\.camera$/.test(k); })[0];
-          if (!moved || state.syncing) return;
+          var turned = Object.keys(e).filter(function (k) { return /^scene\d*\.camera$/.test(k); })[0];
+          if (!turned || state.syncing) return;
           var update = {};
           scenes.forEach(function (sc, i) {
             var name = (i ? "scene" + (i + 1) : "scene") + ".camera";
-            if (name !== moved) update[name] = e[moved];
+            if (name !== turned) update[name] = e[turned];
           });
           state.syncing = true;
           Plotly.relayout(plot, update).then(function () { state.syncing = false; });
