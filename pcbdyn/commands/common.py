@@ -51,10 +51,13 @@ def input_errors(*more):
         fail(" ".join(str(exc).strip("'\"").split()))  # one line, whatever a library put in the text
 
 
-def solve_structure(structure, config: str | None, n_modes: int | None = None, f_max: float | None = None):
+def solve_structure(structure, config: str | None, n_modes: int | None = None, f_max: float | None = None,
+                    min_modes: int = 0):
     """Build the FE model of one configuration of ``structure`` and solve its modes, with progress.
 
-    Returns (built model, modes, K, M). ``n_modes``/``f_max`` default to the structure's [analysis].
+    Returns (built model, modes, K, M). ``n_modes``/``f_max`` default to the structure's [analysis];
+    at least the first ``min_modes`` are returned even when they lie above ``f_max`` (a response to an
+    input below the fundamental still needs its modes and static residual).
     """
     from ..fe.assembly import assemble
     from ..fe.modal import solve_modes
@@ -68,6 +71,8 @@ def solve_structure(structure, config: str | None, n_modes: int | None = None, f
     t0 = step(f"[{label}] solving {pm.model.n_dof} DOFs for {n_modes} modes")
     K, M = assemble(pm.model)
     modes = solve_modes(pm.model, n_modes=n_modes, f_max=f_max, K=K, M=M)
+    if modes.frequencies.size < min_modes:
+        modes = solve_modes(pm.model, n_modes=min_modes, K=K, M=M)
     done(t0)
     return pm, modes, K, M
 

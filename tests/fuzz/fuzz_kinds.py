@@ -163,6 +163,16 @@ def joint_seed() -> tuple:
 
 
 @cache
+def history_seed() -> tuple:
+    import tempfile
+
+    folder = Path(tempfile.mkdtemp(prefix="pcbdyn-fuzz-seeds-"))
+    (folder / "history.csv").write_text("# a sampled shock\ntime [ms],acceleration [g]\n0,0\n0.05,463\n0.1,882\n"
+                                        "0.15,1214\n0.2,1427\n0.25,1500\n0.3,1427\n0.35,1214\n0.4,882\n0.5,0\n")
+    return (folder / "history.csv",)
+
+
+@cache
 def psd_seed() -> tuple:
     import tempfile
 
@@ -241,6 +251,7 @@ def kinds(folder: Path) -> list:
     from pcbdyn.targets import parse
     from pcbdyn.testdata import read_points_csv
     from pcbdyn.testdata.measured import read_frequency_table
+    from pcbdyn.vibration.pulses import read_history, read_srs
     from pcbdyn.vibration.spectra import read_psd_csv
 
     points = tuple(EXAMPLES.glob("*/points.csv"))
@@ -257,6 +268,9 @@ def kinds(folder: Path) -> list:
         *csv_kind("frequencies.csv", lambda: tables, lambda p: read_frequency_table(p, six_part_card()),
                   "frequencies.csv", ("mode", "frequency_hz"), True),
         *csv_kind("psd.csv", psd_seed, read_psd_csv, "psd.csv", ("frequency", "psd"), False),
+        *csv_kind("history.csv", history_seed, read_history, "history.csv", ("time", "acceleration"), False),
+        *csv_kind("srs.csv", lambda: (EXAMPLES / "jedec_drop" / "jesd22_b111_srs.csv",), lambda p: read_srs(p, 10.0),
+                  "srs.csv", ("frequency", "acceleration"), False),
         Kind("test.uff", uff_seeds, lambda s, src, f: _uff(s, src, f), _read_uff),
         Kind("test.uff bytes", uff_seeds, lambda s, src, f: _raw(s, src, f, "test.uff", utf8=False), _read_uff),
         Kind("kicad bytes", lambda: (EXAMPLES / "kicad_board" / "board.kicad_pcb",),
