@@ -70,6 +70,16 @@ def to_si(value, unit: str, where: str = "value") -> float:
     return _finite(factor(number), value, unit, where)
 
 
+#: the unit a quantity read in the key's unit is printed in, where that reads badly in a table (a modulus in
+#: Pa: 2.6e+10)
+PRINTED = {"Pa": "GPa"}
+
+
+def printed_unit(unit: str) -> str:
+    """The unit tables print a quantity read in ``unit`` in (``PRINTED``, else ``unit`` itself)."""
+    return PRINTED.get(unit, unit)
+
+
 def from_si(value: float, unit: str) -> float:
     """A SI value expressed in ``unit`` (e.g. 0.0035 -> 3.5 for "mm"); "1" leaves it as it is."""
     if unit in ("1", "dimensionless"):

@@ -172,7 +172,8 @@ def check_writable(path: Path, option: str, folder: bool, shown=None) -> None:
 
 def checked_outputs(folders=("out",), files=("json_path",)):
     """A command decorator: its output options (keywords ``folders`` for folders, ``files`` for files)
-    are checked before any work (and ``--html`` needs ``--out``), so that a run never fails after its
+    are checked before any work (and ``--html`` needs ``--out``; a folder must be one a run may replace
+    whole, :func:`pcbdyn.report.manifest.unreplaceable`), so that a run never fails after its
     computation for want of a place to write; ``--json -`` writes the JSON to the standard output and the
     report to stderr."""
 
@@ -185,6 +186,12 @@ def checked_outputs(folders=("out",), files=("json_path",)):
                 for key in keys:
                     if kwargs.get(key) is not None and str(kwargs[key]) != "-":
                         check_writable(Path(kwargs[key]), OPTION_NAMES.get(key, f"--{key}"), folder)
+            for key in folders:
+                if kwargs.get(key) is not None:
+                    from ..report.manifest import unreplaceable
+
+                    if (why := unreplaceable(kwargs[key])) is not None:
+                        raise click.UsageError(f"{OPTION_NAMES.get(key, f'--{key}')} {kwargs[key]}: {why}")
             if str(kwargs.get("json_path")) == "-":
                 from ..report.files import json_to_stdout
 

@@ -62,16 +62,16 @@ def command(board_toml, test_uff, config, min_mac, n_modes, out, json_path, html
     click.echo(comac_line(corr))
     written = []
     if out is not None:
-        from ..report.manifest import settle
+        from ..report.manifest import replacing
 
         t0 = step(f"writing tables and pictures to {out}")
-        written = write_outputs(out, board, bm, modes, test_modes, corr)
-        if html:
-            from ..report.pages import correlate_page
+        with replacing(out, "pcbdyn correlate") as run:  # the earlier --out stays whole until all is written
+            written = write_outputs(run.path, board, bm, modes, test_modes, corr)
+            if html:
+                from ..report.pages import correlate_page
 
-            written.append(correlate_page(out, board_toml, test_uff, board, config, corr, written, bm, modes,
-                                          test_modes).name)
-        settle(out, [out / w for w in written], "pcbdyn correlate")
+                written.append(correlate_page(run.path, board_toml, test_uff, board, config, corr, written, bm,
+                                              modes, test_modes).name)
         done(t0)
         click.echo(f"results written to {out}/ ({len(written)} files)", err=True)
     if json_path is not None:

@@ -49,7 +49,6 @@ def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size,
     """Find the effects a board model lacks from modal tests: TEST_UFF (with mode shapes) of the base
     configuration and NAME=FILE for each perturbed configuration of board.toml (e.g. c2=test2.uff)."""
     from ..diagnosis.pipeline import diagnose
-    from ..domain import StructureError
     from ..problems import load_structure
     from ..report import diagnosis_report as rep
     from ..report.files import write_json, write_text
@@ -75,31 +74,21 @@ def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size,
     click.echo(rep.format_effects(d.effects))
     click.echo("")
     click.echo(rep.format_states(d.before, d.parameters_only, d.after))
-    enriched, written = None, []
-    if d.effects:
-        try:
-            enriched = board.write_enriched(rep.enriched_effects(d), result_path(out, board_toml, "diagnosed", force))
-            written.append(enriched)
-            click.echo(f"\nboard with the effects declared written to {enriched}", err=True)
-        except StructureError as exc:
-            click.echo(f"\nnote: the enriched board.toml was not written: {exc}", err=True)
-    if out is not None:
-        from ..report.manifest import settle
+    if out is None:
+        enriched = _enriched(board, d, result_path(None, board_toml, "diagnosed", force))
+    else:
+        from ..report.manifest import replacing
 
-        written += [out / "effects.txt", out / "correlation.txt"]
-        write_text(written[-2], rep.format_effects(d.effects) + "\n")
-        write_text(written[-1], rep.format_states(d.before, d.parameters_only, d.after) + "\n")
-        if d.evidence:
-            written.append(out / "evidence.png")
-            rep.plot_evidence(written[-1], board, d.evidence, d.effects)
-        if html:
-            shown = load_structure(enriched) if enriched is not None else board
-            bm, modes, _, _ = solve_structure(shown, None)
-            title = f"{board.name}{' with the effects' if enriched is not None else ''}"
-            written.append(rep.html_page(out, board_toml, board, d, (title, bm, modes, shown.outlines(None)),
-                                         out / "evidence.png" if d.evidence else None))
-            click.echo(f"page written to {written[-1]}", err=True)
-        settle(out, written, "pcbdyn diagnose")
+        with replacing(out, "pcbdyn diagnose") as run:  # the earlier --out stays whole until all is written
+            staged = result_path(run.path, board_toml, "diagnosed")
+            enriched = _enriched(board, d, staged, run.final)
+            write_text(run.path / "effects.txt", rep.format_effects(d.effects) + "\n")
+            write_text(run.path / "correlation.txt", rep.format_states(d.before, d.parameters_only, d.after) + "\n")
+            if d.evidence:
+                rep.plot_evidence(run.path / "evidence.png", board, d.evidence, d.effects)
+            if html:
+                page = run.final(_page(run.path, board_toml, board, d, staged if enriched is not None else None))
+                click.echo(f"page written to {page}", err=True)
     if json_path is not None:
         write_json(json_path, {
             "effects": d.effects, "noise_only": d.noise_only, "message": d.message,
@@ -107,3 +96,40 @@ def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size,
             "after": rep.summary(d.after), "parameters": d.parameters, "statistics": d.statistics,
             "enriched_board": None if enriched is None else str(enriched),
         })
+
+
+def _page(folder, board_toml, board, d, enriched):
+    """report.html in ``folder``: the effects on the modes of the board that declares them (``enriched``,
+    its file; the board as given when there is none or it cannot be read)."""
+    from ..domain import StructureError
+    from ..problems import load_structure
+    from ..report import diagnosis_report as rep
+
+    shown = board
+    if enriched is not None:
+        try:
+            shown = load_structure(enriched)
+        except StructureError as exc:
+            click.echo(f"note: the page shows the model as given: {exc}", err=True)
+    bm, modes, _, _ = solve_structure(shown, None)
+    title = board.name + (" with the effects" if shown is not board else "")
+    evidence = folder / "evidence.png"
+    return rep.html_page(folder, board_toml, board, d, (title, bm, modes, shown.outlines(None)),
+                         evidence if evidence.is_file() else None)
+
+
+def _enriched(board, d, path, final=lambda p: p):
+    """The board with the effects found declared, written to ``path`` (None when there are none, or when it
+    cannot be written: said why); returns where it ends up (``final`` of the path written)."""
+    from ..domain import StructureError
+    from ..report import diagnosis_report as rep
+
+    if not d.effects:
+        return None
+    try:
+        enriched = final(board.write_enriched(rep.enriched_effects(d), path))
+    except StructureError as exc:
+        click.echo(f"\nnote: the enriched board.toml was not written: {exc}", err=True)
+        return None
+    click.echo(f"\nboard with the effects declared written to {enriched}", err=True)
+    return enriched

@@ -119,20 +119,19 @@ def command(structure_toml, candidates_csv, spacing, n_sensors, directions, n_mo
                                 entries, box)
         written = []
         if out is not None:
-            from ..report.manifest import settle
+            from ..report.manifest import replacing
 
-            out.mkdir(parents=True, exist_ok=True)
-            rep.write_sensor_points(out / "points.csv", cand, sensors)
-            rep.write_candidates_csv(out / "candidates.csv", cand)
-            rep.pretest_map(out / "pretest_map.png", cand, data, box)
-            written = ["points.csv", "candidates.csv", "pretest_map.png"]
-            if entries:
-                dst = result_path(out, structure_toml, "pretest")
-                write_configurations(structure, entries, dst, load_structure)
-                written.append(dst.name)
-            if html:
-                written.append(rep.pretest_page(out, structure_toml, data, written).name)
-            settle(out, [out / w for w in written], "pcbdyn pretest")
+            with replacing(out, "pcbdyn pretest") as run:  # the earlier --out stays whole until all is written
+                rep.write_sensor_points(run.path / "points.csv", cand, sensors)
+                rep.write_candidates_csv(run.path / "candidates.csv", cand)
+                rep.pretest_map(run.path / "pretest_map.png", cand, data, box)
+                written = ["points.csv", "candidates.csv", "pretest_map.png"]
+                if entries:
+                    dst = result_path(run.path, structure_toml, "pretest")
+                    write_configurations(structure, entries, dst, load_structure)
+                    written.append(dst.name)
+                if html:
+                    written.append(rep.pretest_page(run.path, structure_toml, data, written).name)
             data["files"] = written
     click.echo("\n" + rep.summary(data))
     if n_configs and not params:

@@ -54,7 +54,7 @@ def parse_frf_freqs(text) -> list:
 @click.option("--solver", type=click.Choice(["ls", "tls", "bayes", "bounded"]), default="bounded", show_default=True)
 @click.option("--params", default=None, help="comma-separated parameter names (default: all [[parameters]])")
 @click.option("--max-iter", type=click.IntRange(min=1), default=20, show_default=True)
-@click.option("--tol", "tol_pct", type=float, default=0.1, show_default=True,
+@click.option("--tol", "tol_pct", type=float, default=0.1, show_default=True,  # problems.run.TOL_FREQ_PCT
               help="stop when the max frequency error is below this percentage (eq. 7.2)")
 @click.option("--mesh-size", default=None, help="override board.mesh_size, e.g. '10 mm'")
 @folder_outputs("folder for board.updated.toml, the iteration plot and tables (default: board.updated.toml beside "
@@ -105,9 +105,27 @@ def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping,
                                  progress=lambda h: click.echo(rep.progress_line(h), err=True))
         done(t0)
         what = outcome(problem, res, before, after)
-        dst = problem.write_updated(res.p, result_path(out, board_toml, "updated", force), source=(
-            f"pcbdyn update ({what['status']})"))
-    rows = rep.parameter_rows(problem, res.p)
+        rows = rep.parameter_rows(problem, res.p)
+        source = f"pcbdyn update ({what['status']})"
+        if out is None:
+            dst = problem.write_updated(res.p, result_path(None, board_toml, "updated", force), source=source)
+        else:
+            from ..report.manifest import replacing
+
+            with replacing(out, "pcbdyn update") as staged:  # the earlier --out stays whole until all is written
+                dst = staged.final(problem.write_updated(res.p, result_path(staged.path, board_toml, "updated"),
+                                                         source=source))
+                rep.plot_iterations(staged.path / "iterations.png", problem, res)
+                write_text(staged.path / "parameters.txt", rep.format_parameters(rows) + "\n")
+                write_text(staged.path / "correlation.txt", rep.format_correlation(before, after) + "\n")
+                if html:
+                    from ..fe.modal import solve_modes
+
+                    built = problem.system(None).at(res.p)
+                    modes = solve_modes(built.model, n_modes=board.analysis.modes, f_max=board.analysis.f_max)
+                    page = staged.final(rep.html_page(staged.path, board_toml, board, rows, before, after, what,
+                                                      (built, modes), staged.path / "iterations.png"))
+                    click.echo(f"page written to {page}", err=True)
     click.echo(f"\n{board.name}: {what['status']} after {res.iterations} iteration(s) ({res.reason}; best iterate "
                f"{res.best_iteration})")
     for line in what["details"]:
@@ -116,21 +134,5 @@ def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping,
     click.echo("")
     click.echo(rep.format_correlation(before, after))
     click.echo(f"\nupdated board written to {dst}", err=True)
-    if out is not None:
-        from ..report.manifest import settle
-
-        written = [dst, out / "iterations.png", out / "parameters.txt", out / "correlation.txt"]
-        rep.plot_iterations(written[1], problem, res)
-        write_text(written[2], rep.format_parameters(rows) + "\n")
-        write_text(written[3], rep.format_correlation(before, after) + "\n")
-        if html:
-            from ..fe.modal import solve_modes
-
-            built = problem.system(None).at(res.p)
-            modes = solve_modes(built.model, n_modes=board.analysis.modes, f_max=board.analysis.f_max)
-            written.append(rep.html_page(out, board_toml, board, rows, before, after, what, (built, modes),
-                                         written[1]))
-            click.echo(f"page written to {written[-1]}", err=True)
-        settle(out, written, "pcbdyn update")
     if json_path is not None:
         write_json(json_path, rep.update_json(problem, res, rows, before, after, what, method, solver, dst))

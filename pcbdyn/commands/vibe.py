@@ -83,13 +83,13 @@ def report_verdict(name: str, report, result, board_toml, board, model, input_na
     click.echo("\n" + report.format_table(report.parts_table(result)))
     written = []
     if out is not None:
-        from ..report.manifest import settle
+        from ..report.manifest import replacing
 
         t0 = step(f"writing tables and pictures to {out}")
-        written = report.write_outputs(out, board, model, result)
-        if html:
-            written.append(report.html_page(out, board_toml, board, result, inputs, model, config).name)
-        settle(out, [out / w for w in written], f"pcbdyn {name}")
+        with replacing(out, f"pcbdyn {name}") as run:  # the earlier --out stays whole until all is written
+            written = report.write_outputs(run.path, board, model, result)
+            if html:
+                written.append(report.html_page(run.path, board_toml, board, result, inputs, model, config).name)
         done(t0)
         click.echo(f"results written to {out}/ ({len(written)} files)", err=True)
     if json_path is not None:

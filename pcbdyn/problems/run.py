@@ -11,6 +11,10 @@ import numpy as np
 from ..updating.iteration import build_equations, update
 from ..updating.solvers import RankDeficiencyWarning
 
+#: the frequency criterion (thesis eq. 7.2, max |df| in %) an update stops at unless told otherwise: the
+#: API's and ``pcbdyn update --tol``'s (tests/docs/test_readme_api.py keeps them one)
+TOL_FREQ_PCT = 0.1
+
 
 def correlation_state(configs, p) -> list:
     """Per configuration at ``p``: the pairs (as in ``pcbdyn correlate``: test_mode, model_mode
@@ -35,9 +39,11 @@ def run(problem, configs, solver: str = "ls", check=None, **kwargs):
     (UpdateResult, before, after), before/after from :func:`correlation_state` on ``check`` (default
     ``configs``; give the full-model configurations of :meth:`~.problem.UpdateProblem.configuration`
     when updating on :meth:`~.problem.UpdateProblem.mode_configurations`). ``kwargs`` go to
-    :func:`pcbdyn.updating.iteration.update` (``progress``, ``max_iter``, ...). The solvers' warnings
+    :func:`pcbdyn.updating.iteration.update` (``progress``, ``max_iter``, ``tol_freq_pct``: default
+    :data:`TOL_FREQ_PCT`, as the command line's, ...). The solvers' warnings
     are not printed: :func:`outcome` says what they meant with the parameters named."""
     check = configs if check is None else check
+    kwargs.setdefault("tol_freq_pct", TOL_FREQ_PCT)
     before = correlation_state(check, problem.p0)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RankDeficiencyWarning)

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from .files import atomic_path
+from .labels import place_labels
 
 CMAP = "coolwarm"
 
@@ -188,12 +189,11 @@ def comac_map(path, outline, xy, values, labels) -> None:
     fig, ax = plt.subplots(figsize=(6.0, 5.6))
     _outline(ax, outline)  # lo spreads the usual 0.9-1 range over the colours
     sc = ax.scatter(xy[:, 0], xy[:, 1], c=values, cmap="RdYlGn", vmin=lo, vmax=1.0, s=60, edgecolors="k", zorder=3)
-    worst = np.argsort(values)[: min(5, len(values))]
-    for i in worst:
-        ax.annotate(f"{labels[i]}\n{values[i]:.2f}", xy[i], textcoords="offset points", xytext=(6, 4), fontsize=7)
     ax.set_aspect("equal")
     ax.set_xlabel("x [mm]")
     ax.set_ylabel("y [mm]")
     ax.set_title("COMAC per point over the pairs (five lowest labelled)")
     fig.colorbar(sc, ax=ax, fraction=0.046, pad=0.04, label="COMAC")
+    worst = np.argsort(values)[: min(5, len(values))]
+    place_labels(ax, xy[worst], [f"{labels[i]}\n{values[i]:.2f}" for i in worst], fontsize=7)
     _save(fig, path)
