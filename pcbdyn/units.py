@@ -24,6 +24,10 @@ _UNIT_TOKEN = re.compile(r"\s*(?:(?P<name>[^\W\d]\w*|%)|(?P<op>\*\*|[*/·^()])|(
 _NOT_FINITE = re.compile(r"\s*[-+]?(?:nan|inf)", re.IGNORECASE)
 
 
+#: length units of measured-data files (the points CSV's columns, a UFF file without dataset 164): metres per unit
+LENGTHS = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "um": 1e-6, "in": 0.0254, "ft": 0.3048}
+
+
 class UnitError(ValueError):
     """A quantity that is missing its unit, cannot be parsed, or has the wrong dimension."""
 

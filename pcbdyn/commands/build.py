@@ -32,9 +32,10 @@ def analyse(board, config, stds: dict | None = None) -> dict:
     click.echo(f"\n{board.name} [{label}]: {mass * 1e3:.2f} g, {bm.model.n_dof} DOFs, "
                f"{sum(len(es.conn) for es in bm.model.sets.values() if es.etype in ('quad4', 'tri3'))} shells"
                + (f", {modes.n_rigid} rigid-body modes" if modes.n_rigid else ""))
-    click.echo(format_table(table) + "\n")
+    warning = empty_band(board, bm, modes, K, M)
+    click.echo(f"warning: {warning}\n" if warning else format_table(table) + "\n")
     note = free_note(modes.n_rigid)
-    if note:
+    if note and not warning:
         click.echo(f"note: {note}\n")
     summary = {
         "configuration": label,
@@ -47,8 +48,22 @@ def analyse(board, config, stds: dict | None = None) -> dict:
         "dofs": int(bm.model.n_dof),
         "rigid_body_modes": int(modes.n_rigid),
         **({"effective_mass_note": note} if note else {}),
+        **({"warning": warning} if warning else {}),
     }
     return {"config": config, "model": bm, "modes": modes, "table": table, "summary": summary}
+
+
+def empty_band(board, bm, modes, K, M) -> str | None:
+    """What to say when no elastic mode lies below [analysis] f_max (an empty band is an answer, not an
+    error): the first mode above it, solved alone."""
+    f_max = board.analysis.f_max
+    if modes.frequencies.size or f_max is None:
+        return None
+    from ..fe.modal import solve_modes
+
+    first = solve_modes(bm.model, n_modes=1, K=K, M=M).frequencies
+    above = f"the first is at {first[0]:.4g} Hz" if first.size else "the model has none"
+    return f"no mode below [analysis] f_max = {f_max:g} Hz ({above}); raise f_max in {board.path.name} to see modes"
 
 
 def write_results(board, solved: dict, out: Path, pictures: bool = True) -> None:

@@ -260,3 +260,20 @@ def library_option(required: bool = False, keep: bool = False):
                             default=None, help=help_text)(wrapper)
 
     return decorate
+
+
+def units_option(command):
+    """The ``--units`` option of every command that reads test data: the length unit of UFF files that state
+    none (no dataset 164), for the whole command (:func:`pcbdyn.testdata.uff_geometry.stated_units`); a file
+    without one whose grid is too wide for metres is refused, naming this option."""
+    from ..units import LENGTHS
+
+    @functools.wraps(command)
+    def wrapper(*args, units=None, **kwargs):
+        from ..testdata.uff_geometry import stated_units
+
+        with stated_units(units):
+            return command(*args, **kwargs)
+
+    return click.option("--units", type=click.Choice(list(LENGTHS)), default=None,
+                        help="length unit of test files (UFF) that state none (no dataset 164); default m")(wrapper)

@@ -17,7 +17,7 @@ import click
 
 from ..diagnosis import KINDS
 from .common import (done, folder_outputs, input_errors, library_option, measured_configurations, parse_noise, result_path,
-                     solve_structure, step)
+                     solve_structure, step, units_option)
 
 
 @click.command("diagnose")
@@ -44,6 +44,7 @@ from .common import (done, folder_outputs, input_errors, library_option, measure
                 "write effects, before/after and statistics as JSON", html=True,
                 force="replace an earlier <board>.diagnosed.toml beside the board (default: a numbered name)")
 @library_option()
+@units_option
 def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size, quick, workers, scheduler, out, force,
             json_path, html):
     """Find the effects a board model lacks from modal tests: TEST_UFF (with mode shapes) of the base

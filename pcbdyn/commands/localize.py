@@ -16,7 +16,7 @@ from pathlib import Path
 
 import click
 
-from .common import done, folder_outputs, input_errors, library_option, measured_configurations, parse_extra, parse_noise, step
+from .common import done, folder_outputs, input_errors, library_option, measured_configurations, parse_extra, parse_noise, step, units_option
 
 METHOD_CHOICES = ["tls-qrf", "svd-qr", "qr", "min-norm"]
 
@@ -40,6 +40,7 @@ METHOD_CHOICES = ["tls-qrf", "svd-qr", "qr", "min-norm"]
 @folder_outputs("folder for the evidence figure and the FBM map (PNG)",
                 "write the selection and its evidence as JSON")
 @library_option()
+@units_option
 def command(board_toml, test_uff, config_tests, method, eq_type, params, rank, alpha, noise, matching, out,
             json_path):
     """Localise model errors among a structure's [[parameters]] from modal tests: TEST_UFF of the base

@@ -27,7 +27,7 @@ from __future__ import annotations
 import click
 
 from .common import (done, fail, folder_outputs, input_errors, library_option, measured_configurations, parse_extra, result_path,
-                     step, test_arguments)
+                     step, test_arguments, units_option)
 
 def parse_frf_freqs(text) -> list:
     """'150,230 Hz' or '150,230' -> frequencies [Hz]."""
@@ -61,6 +61,7 @@ def parse_frf_freqs(text) -> list:
                 "the board)", "write parameters, status, before/after and history as JSON", html=True,
                 force="replace an earlier board.updated.toml beside the board (default: a numbered name)")
 @library_option()
+@units_option
 def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping, solver, params, max_iter, tol_pct,
             mesh_size, out, force, json_path, html):
     """Update a structure's [[parameters]] against modal tests: TEST_UFF for the base configuration and
@@ -130,6 +131,8 @@ def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping,
                f"{res.best_iteration})")
     for line in what["details"]:
         click.echo(f"  note: {line}")
+    for line in what["warnings"]:
+        click.echo(f"warning: {line}", err=True)
     click.echo(rep.format_parameters(rows))
     click.echo("")
     click.echo(rep.format_correlation(before, after))

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import click
 
-from .common import PROBE_TOL, done, fail, folder_outputs, library_option, solve_structure, step
+from .common import PROBE_TOL, done, fail, folder_outputs, library_option, solve_structure, step, units_option
 
 #: at most this many modes are computed (all of them up to twice the top input frequency otherwise)
 MAX_MODES = 150
@@ -37,6 +37,7 @@ MIN_MODES = 3
 @folder_outputs("folder for parts.csv, modes.csv, response_psd.csv, board_map.png, response_psd.png",
                 "write input_grms, modes[] and parts[] (ref, z_rms_m, z_allow_m, ratio, life_h, ...) as JSON", html=True)
 @library_option()
+@units_option
 def command(board_toml, psd_text, sine_csv, sweep_rate, sweeps, damping_text, duration, axis, chassis_freq, config,
             exclude, out, json_path, html):
     """Judge a board under a random (and sine) vibration specification: RMS responses at every part,

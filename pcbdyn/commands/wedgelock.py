@@ -15,7 +15,7 @@ from __future__ import annotations
 import click
 
 from .common import (PROBE_TOL, done, fail, folder_outputs, input_errors, library_option, parse_extra, parse_noise, result_path, step,
-                     test_arguments)
+                     test_arguments, units_option)
 
 
 @click.command("wedgelock")
@@ -37,6 +37,7 @@ from .common import (PROBE_TOL, done, fail, folder_outputs, input_errors, librar
                 "beside the board)", "write the extremes, the decision, the stiffness, before/after and the history as "
                 "JSON", force="replace an earlier board.updated.toml beside the board (default: a numbered name)")
 @library_option()
+@units_option
 def command(board_toml, test_uff, configs, freq_csv, per_guide, tol_pct, noise, min_mac, mesh_size, max_iter, out,
             force, json_path):
     """Fit wedge-lock guides in two steps: hinged and clamped extremes, then rotational springs. TEST_UFF
@@ -76,6 +77,8 @@ def command(board_toml, test_uff, configs, freq_csv, per_guide, tol_pct, noise, 
     click.echo(f"\n{board.name}: guides {', '.join(result.guides)}")
     for text in tables.values():
         click.echo("\n" + text)
+    for line in d["warnings"]:
+        click.echo(f"warning: {line}", err=True)
     springs = d["decision"] == "springs"
     if out is None:
         d["updated_board"] = _updated(result, result_path(None, board_toml, "updated", force)) if springs else None

@@ -104,7 +104,7 @@ def update_json(problem, res, rows, before, after, what: dict, method: str, solv
                        for r, v0, v in zip(rows, problem.p0, res.p)},
         "before": _summary(before), "after": _summary(after), "iterations": res.iterations,
         "converged": bool(res.converged), "reason": res.reason, "status": what["status"],
-        "status_details": what["details"], "method": method, "solver": solver,
+        "status_details": what["details"], "warnings": what["warnings"], "method": method, "solver": solver,
         "history": [{"iteration": h["iteration"], "p": np.asarray(h["p"]).tolist(),
                      "max_freq_error_pct": h["max_freq_error_pct"], "condition_stacked": _finite(h["condition_stacked"]),
                      "rank": h.get("rank"), "set_aside": h.get("set_aside", [])} for h in res.history],

@@ -129,3 +129,17 @@ def test_an_interrupt_while_pictures_are_drawn_leaves_the_earlier_run_whole(tmp_
     listed = json.loads((out / MANIFEST).read_text())["files"]
     assert len(listed) == 4 and all(hashlib.sha256((out / r).read_bytes()).hexdigest() == d for r, d in listed.items())
     assert sorted(p.name for p in tmp_path.iterdir()) == ["board.toml", "out"]
+
+
+def test_a_band_below_the_first_mode_is_an_answer_with_a_warning(tmp_path):
+    """[analysis] f_max below the first mode: exit 0, no modes, and the console and the JSON name the first
+    frequency above the band (the plate formula's (1,1) mode), not a silent empty table."""
+    board = write_board(tmp_path, PLATE.replace("[analysis]", '[analysis]\nf_max = "100 Hz"'))
+    js = tmp_path / "modes.json"
+    res = CliRunner().invoke(main, ["build", str(board), "--json", str(js)])
+    assert res.exit_code == 0, res.output
+    data = json.loads(js.read_text())
+    assert data["modes"] == []
+    first = float(data["warning"].split("the first is at ")[1].split(" Hz")[0])
+    assert first == pytest.approx(navier(1, 1), rel=0.01) and first > 100.0
+    assert f"warning: {data['warning']}" in res.output

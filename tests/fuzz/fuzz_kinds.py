@@ -5,6 +5,7 @@ makes a mutated input file in a folder and reads it; :func:`outcome.classify` ju
 from __future__ import annotations
 
 import math
+import shutil
 import tomllib
 from dataclasses import dataclass
 from functools import cache
@@ -110,7 +111,8 @@ def _library_value(doc, src):
 @cache
 def uff_seeds() -> tuple:
     """Two UFF files written by pcbdyn (units, points and six modes on the six-part card's grid; one with
-    FRFs too), in a folder of their own."""
+    FRFs too) and a test geometry with coordinate systems, trace lines and elements
+    (tests/data/uff/node_systems.uff), in a folder of their own."""
     import tempfile
 
     from pcbdyn.testdata import FRFs, Modes, TestData, read_points_csv, write_uff
@@ -130,7 +132,8 @@ def uff_seeds() -> tuple:
     resp = Dofs(pts.ids[:2], np.tile([0.0, 0.0, 1.0], (2, 1)))
     frfs = FRFs(pts, f, H, "receptance", resp, Dofs(pts.ids[:1], [0.0, 0.0, 1.0]))
     write_uff(folder / "frfs.uff", TestData(pts, modes.subset([0, 1]), frfs), binary=False)
-    return folder / "modes.uff", folder / "frfs.uff"
+    shutil.copy(Path(__file__).resolve().parents[1] / "data" / "uff" / "node_systems.uff", folder / "geometry.uff")
+    return folder / "modes.uff", folder / "frfs.uff", folder / "geometry.uff"
 
 
 @cache

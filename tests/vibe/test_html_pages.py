@@ -102,7 +102,7 @@ def test_correlate_page(browser, tmp_path):
     run("correlate", board, tmp_path / "t.uff", "--out", tmp_path / "out", "--json", js, "--html")
     n_pairs = len(json.loads(js.read_text())["pairs"])
     state = open_page(browser, tmp_path / "out" / "report.html", tmp_path / "correlate.png")
-    check(state, 3 + n_pairs, ["Inputs", "Mode pairs", "Lowest COMAC", "Versions"])
+    check(state, 4 + n_pairs, ["Inputs", "Mode pairs", "Lowest COMAC", "Versions"])  # MAC, AutoMAC, f, COMAC
     assert state["views"] == 1  # test and model side by side
 
 
