@@ -4,8 +4,8 @@ page must stay under 15 MB. Prints the page, its 3-D view's data and its picture
 of the build. Run: python benchmarks/bench_report_size.py
 
 Measured (49 626 DOF): 12 modes 8.56 MB (view data 1.33 MB, pictures 2.40 MB, plotly.js and the rest
-4.84 MB); 40 modes 14.38 MB (view 3.49 MB, 27 of the 40 pictures 6.04 MB: the 13 that would pass the
-page's 14.5 MB are left out and named; the 3-D view shows every mode).
+4.84 MB); 40 modes 14.38 MB (view 3.49 MB, pictures 6.04 MB: the last ones, which would pass the page's
+14.5 MB, are left out and named; the 3-D view shows every mode).
 """
 
 from __future__ import annotations
