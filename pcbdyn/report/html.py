@@ -37,7 +37,7 @@ from .files import write_text
 #: the size a page keeps under by leaving out optional pictures [bytes]
 PAGE_BYTES = 14_500_000
 #: the libraries whose versions a page records
-VERSIONED = ("pcbdyn", "numpy", "scipy", "pandas", "matplotlib", "pint", "pyuff", "jinja2")
+VERSIONED = ("pcbdyn", "numpy", "scipy", "pandas", "matplotlib", "pint", "pyuff", "jinja2", "plotly")
 
 
 def _cell(v) -> str:

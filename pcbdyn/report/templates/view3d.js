@@ -58,7 +58,7 @@
       out.push({type: "mesh3d", scene: name, x: P[0], y: P[1], z: P[2], i: sc.ijk[0], j: sc.ijk[1], k: sc.ijk[2], intensity: inten,
                 colorscale: COOL, cmin: -1, cmax: 1, opacity: sc.opacity, showscale: first, hoverinfo: "skip",
                 flatshading: false, lighting: {ambient: 0.65, diffuse: 0.5, specular: 0.05},
-                colorbar: {title: {text: "normal displacement<br>(outward, / max |u|)", side: "right"}, len: 0.6}});
+                colorbar: {title: {text: sc.colour, side: "right"}, len: 0.6}});
     }
     if (sc.lines.length) {
       var lx = [], ly = [], lz = [];
@@ -123,6 +123,7 @@
   function setup(root) {
     var data = JSON.parse(root.querySelector("script.view-data").textContent);
     var scenes = data.scenes.map(prepare), plot = root.querySelector(".plot");
+    scenes.forEach(function (sc) { sc.colour = data.colour.replace(" (", "<br>("); });
     var pick = root.querySelector("select.mode"), slider = root.querySelector("input.amplitude");
     var button = root.querySelector("button.pause"), shown = root.querySelector("output.amplitude");
     data.labels.forEach(function (label, k) {
