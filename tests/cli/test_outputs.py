@@ -61,10 +61,15 @@ def test_update_reports_bounds_and_worse_configurations_on_the_thesis_data(card,
     """Table 7.2 data, four parameters: two end on their bounds and configuration c3 ends worse than it
     started: the status says so instead of "converged" (it said converged before)."""
     js = tmp_path / "u.json"
-    r = run(["update", card, "--frequencies", TABLE, "--out", tmp_path / "out", "--json", js])
+    r = run(["update", card, "--frequencies", TABLE, "--out", tmp_path / "out", "--json", js, "--html"])
     assert r.exit_code == 0, r.output
     data = json.loads(js.read_text())
     assert data["status"] == "error grew"
+    page = (tmp_path / "out" / "report.html").read_text()  # the page animates the updated model's modes
+    assert 'data-title="Parameters"' in page and 'data-title="Correlation before and after"' in page
+    view = json.loads(re.search(r'class="view-data">(.*?)</script>', page, re.S).group(1))
+    base = next(c for c in data["after"]["configurations"] if c["configuration"] == "base")
+    assert view["labels"][0] == f"mode 1: {base['pairs'][0]['f_model_hz']:.1f} Hz"
     details = " ".join(data["status_details"])
     assert "t_PGA stopped at its lower bound" in details and "E_board stopped at its upper bound" in details
     assert "configuration c3: max |df| grew" in details
