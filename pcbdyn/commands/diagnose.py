@@ -19,9 +19,9 @@ from ..diagnosis import KINDS
 from .common import (done, folder_outputs, input_errors, library_option, measured_configurations, parse_noise, result_path,
                      solve_structure, step, units_option)
 
-
 #: the correlation summaries of a diagnosis (JSON: max error, mean MAC, pairs per configuration)
 STATES = ("before", "parameters_only", "after")
+
 
 @click.command("diagnose")
 @click.argument("board_toml", type=click.Path(exists=True, dir_okay=False, path_type=Path))
