@@ -87,9 +87,9 @@ def _correct(ob, cs, solved, form: Form):
 def set_noise(models, h, obs, state, freq_pct, shape_pct, levels: int, runner, support=()) -> list:
     """Each observation's discretisation correction of the model frequencies, and its sigmas:
     measurement noise, what remains of the discretisation error and the plate theory's gap, in
-    quadrature (:mod:`.model_form`), from ``levels`` finer meshes (solved where ``runner`` says)
-    that carry the ``support`` springs of ``state`` ([(candidate, value)], :mod:`.support`).
-    Returns a :class:`Form` per observation."""
+    quadrature (:mod:`.model_form`), from ``levels`` finer meshes (solved where ``runner`` says) at the
+    declared parameters of ``state`` (the paired start), carrying its ``support`` springs ([(candidate,
+    value)], :mod:`.support`). Returns a :class:`Form` per observation."""
     sigmas = []
     for ob, cs in zip(obs, state.configs):
         basis = None
@@ -98,8 +98,8 @@ def set_noise(models, h, obs, state, freq_pct, shape_pct, levels: int, runner, s
             basis = np.asarray(ob.read @ np.column_stack([wide.rigid_shapes, wide.shapes]))
         sigmas.append(noise_sigmas(ob, freq_pct, shape_pct, basis))
     requests = [r for ob, cs in zip(obs, state.configs) for r in _requests(ob, cs, h, levels, support, kirchhoff=True)]
-    p0 = parameter_values(models.models[0], models.names, models.p0)
-    solved = iter(finer.solve(runner, models.structure, p0, requests))
+    at = parameter_values(models.models[0], models.names, state.p)
+    solved = iter(finer.solve(runner, models.structure, at, requests))
     forms = []
     for ob, cs, (sf, ss) in zip(obs, state.configs, sigmas):
         meshes = [next(solved) for _ in range(levels)]
