@@ -67,34 +67,52 @@ def make(seed: int, cache: Path | None = None) -> Path:
     return folder
 
 
-def _solve_and_write(case: Case, folder: Path) -> list:
+def truth_modes(case: Case, truth_toml: Path) -> tuple:
+    """(frequencies [Hz], z shapes at the case's points (points x modes)) of the truth in OpenSees: the
+    first ``case.test_modes`` modes a test in z sees (:data:`MIN_BENDING`)."""
     from opensees_truth import solve_opensees
 
     from pcbdyn.board import build_model, load_board
-    from pcbdyn.fe.modal import Modes as ModelModes
     from pcbdyn.fe.probe import model_probe
-    from pcbdyn.testdata.csvio import write_points_csv
-    from pcbdyn.testdata.data import Dofs, Points
-    from pcbdyn.testdata.noise import Noise
-    from pcbdyn.testdata.simulate import simulate_test
-    from pcbdyn.testdata.uff import write_uff
 
-    tb = load_board(folder / "truth.toml")
+    tb = load_board(truth_toml)
     model = build_model(tb, None, tb.mesh_size, shared_mesh=True).model
     f, shapes = solve_opensees(model, case.test_modes + EXTRA_MODES, shell=case.shell)
     keep = np.flatnonzero(bending_share(shapes[:, :3]) >= MIN_BENDING)[:case.test_modes]
-    f, shapes = f[keep], shapes[..., keep]
+    points, dofs = measurement_points(case)
+    read = model_probe(model, points.xyz, dofs.directions, tol=0.02).P
+    return f[keep], np.asarray(read @ shapes[..., keep].reshape(-1, keep.size))
+
+
+def measurement_points(case: Case) -> tuple:
+    """(Points, Dofs) of the case's measurement points, each in +z."""
+    from pcbdyn.testdata.data import Dofs, Points
+
     xy = 1e-3 * np.asarray(case.points, float)
     ids = np.arange(1, len(xy) + 1)
-    points = Points(ids, np.column_stack([xy, np.zeros(len(xy))]))
-    dofs = Dofs(ids, np.tile([0.0, 0.0, 1.0], (len(ids), 1)))
-    write_points_csv(folder / "points.csv", points, dofs)
-    read = model_probe(model, points.xyz, dofs.directions, tol=0.02).P
-    z = np.asarray(read @ shapes.reshape(-1, shapes.shape[-1]))
-    modes = ModelModes(f, z, np.zeros((len(ids), 0)), None)
-    test = simulate_test(modes, points, dofs, np.eye(len(ids)), zeta=ZETA,
+    return Points(ids, np.column_stack([xy, np.zeros(len(xy))])), Dofs(ids, np.tile([0.0, 0.0, 1.0], (len(ids), 1)))
+
+
+def noisy_test(case: Case, f, z):
+    """The test of modes (``f``, ``z`` at the points) as measured: pcbdyn's noise model at the case's levels."""
+    from pcbdyn.fe.modal import Modes as ModelModes
+    from pcbdyn.testdata.noise import Noise
+    from pcbdyn.testdata.simulate import simulate_test
+
+    points, dofs = measurement_points(case)
+    modes = ModelModes(np.asarray(f, float), np.asarray(z, float), np.zeros((len(points.ids), 0)), None)
+    return simulate_test(modes, points, dofs, np.eye(len(points.ids)), zeta=ZETA,
                          noise=Noise(frequency_pct=case.noise[0], shape_pct=case.noise[1]), seed=case.seed)
-    write_uff(folder / "test.uff", test)
+
+
+def _solve_and_write(case: Case, folder: Path) -> list:
+    from pcbdyn.testdata.csvio import write_points_csv
+    from pcbdyn.testdata.uff import write_uff
+
+    f, z = truth_modes(case, folder / "truth.toml")
+    write_points_csv(folder / "points.csv", *measurement_points(case))
+    write_uff(folder / "test.uff", noisy_test(case, f, z))
+    np.save(folder / "shapes_z.npy", z)
     return [float(v) for v in f]
 
 

@@ -1,0 +1,53 @@
+"""The discovery benchmark's generator (benchmarks/discovery/cases.py): cases drawn from seeds as issue
+37 asks (sizes, thicknesses, 0-15 parts, 0-2 effects, 20-120 points, declared values a few % to 40 %
+off), the same case for the same seed, and boards that pcbdyn reads both as handed and as true."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import shapely
+from scipy.stats import kstest
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "benchmarks" / "discovery"))
+from cases import DEV, REPORT, draw  # noqa: E402
+from toml_text import board_text  # noqa: E402
+
+from pcbdyn.board import load_board  # noqa: E402
+
+
+def test_cases_are_drawn_as_the_issue_asks():
+    cases = [draw(s) for s in range(40)]
+    assert set(DEV).isdisjoint(REPORT) and len(DEV) == len(REPORT) == 200
+    for c in cases:
+        outline = shapely.Polygon(c.outline)
+        W, H = outline.bounds[2], outline.bounds[3]
+        assert 60 <= W <= 250 and 60 <= H <= 250 and 0.8 <= c.thickness_mm <= 3.2
+        assert 0 <= len(c.parts) <= 15 and len(c.effects) <= 2
+        assert 20 <= len(c.points) * 1.25 and len(c.points) <= 130
+        assert all(outline.contains(shapely.Point(p)) for p in c.points)
+        for p in c.parameters:
+            off = abs(np.log(p["true"] / p["nominal"]))
+            assert np.log(1.03) * 0.99 <= off <= np.log(1 / 0.6) * 1.01
+    kinds = {e["kind"] for c in cases for e in c.effects}
+    holds = {c.hold for c in cases}
+    assert len(kinds) >= 7 and holds == {"free", "standoffs", "guides", "edges", "mixed"}
+    # places are not on a grid: the effects' coordinates' fractions of a millimetre are uniform
+    at = np.array([e["at"] for c in cases for e in c.effects if "at" in e]).ravel()
+    assert kstest(at % 1.0, "uniform").pvalue > 0.01
+    assert draw(7).to_json() == draw(7).to_json()
+
+
+def test_handed_and_true_boards_load(tmp_path):
+    for seed in (0, 5, 13, 22):
+        c = draw(seed)
+        for truth in (False, True):
+            path = tmp_path / f"{seed}_{truth}.toml"
+            path.write_text(board_text(c, truth, c.mesh_mm / 2 if truth else None))
+            board = load_board(path)
+            assert len(board.components) == len(c.parts) + sum(e["kind"] == "heat_sink" for e in c.effects) * truth
+            if not truth:
+                assert [p.name for p in board.parameters] == [p["name"] for p in c.parameters]
