@@ -189,7 +189,8 @@ def paired_state(ob: Observation, model, K, M, modes, U, points=None) -> ConfigS
             if pr.used:  # a pair beyond the frequency limit is left to the nearest free frequency below
                 pairs[pr.test] = pr.model
         matched = pairs >= 0
-        free = [k for k in range(f_all.size) if k not in set(pairs.tolist())]
+        seen = np.linalg.norm(U, axis=0) > 1e-6 * np.linalg.norm(U, axis=0).max()  # not a mode the points miss
+        free = [k for k in range(f_all.size) if k not in set(pairs.tolist()) and seen[k]]
         for i in np.flatnonzero(pairs < 0):  # unpaired: nearest unused frequency keeps the rows defined
             k = min(free, key=lambda k: abs(f_all[k] / ob.f[i] - 1))
             pairs[i] = k
