@@ -52,7 +52,7 @@ from .model_form import MESH_LEVELS, fit_plate_share
 from .residual import ModalResidual
 from .fitting import estimate
 from .scan import Runner
-from .select import ALPHA, adopt, penalty, refine, search, without_vanished
+from .select import ALPHA, adopt, noticed, penalty, refine, search, without_vanished
 from .support import supports
 from .uncertainty import jackknife_cov
 
@@ -295,6 +295,11 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
     sel, theta, theta_sigma = fit_plate_share(res, cands, sel, [f.shift for f in forms], [f.plain for f in forms],
                                               models.bounds, alpha=alpha)
     stats.update(plate_theory_share=theta, plate_theory_share_sigma=theta_sigma)
+    if sel.chosen:
+        say("checking that the data notice each effect's removal")
+        found = len(sel.chosen)
+        sel = noticed(res, cands, sel, models.bounds, alpha=alpha)
+        stats["effects_not_noticed"] = found - len(sel.chosen)
     stats.update(chi2_after=sel.chi2[-1], candidates=len(cands))
     for n, v in zip(names, sel.p):
         out["parameters"][n]["final"] = float(v)

@@ -165,6 +165,30 @@ def without_vanished(res, candidates, sel: Selection, bounds=None, newton_steps:
     return adopt(sel, idx, fit, penalty(res.n_rows, len(candidates), alpha))
 
 
+#: Gauss-Newton steps of each fit that leaves an effect out (:func:`noticed`)
+NOTICE_STEPS = 4
+
+
+def noticed(res, candidates, sel: Selection, bounds=None, newton_steps: int = NOTICE_STEPS,
+            alpha: float = ALPHA) -> Selection:
+    """``sel`` without the effects whose removal the data do not notice (issue 37: nothing is reported
+    that the data do not need): each effect is left out in turn, the others and the declared parameters
+    refitted; while the least missed one raises chi^2 by less than one effect's penalty
+    (:func:`worth`), it is dropped. Run last, after the steps that move the model under the effects
+    (the mesh correction measured with them, the plate theory's share)."""
+    pen = penalty(res.n_rows, len(candidates), alpha)
+    idx = list(sel.chosen)
+    while idx:
+        trials = [([i for i in idx if i != j], estimate(res, sel.p, [candidates[i] for i in idx if i != j],
+                                                         np.delete(sel.values, k), newton_steps, bounds))
+                  for k, j in enumerate(idx)]
+        keep, fit = min(trials, key=lambda t: t[1].chi2)
+        if fit.state is None or worth(fit.chi2, sel.chi2[-1], res.n_rows, np.size(sel.p) + len(idx), pen):
+            break
+        sel, idx = adopt(sel, keep, fit, pen), keep
+    return sel
+
+
 def refine(res, candidates, sel: Selection, neighbours, bounds=None, newton_steps: int = 8,
            alpha: float = ALPHA, runner: Runner | None = None) -> Selection:
     """Local search on the geometry of the effects found: each chosen candidate is swapped in turn
