@@ -42,9 +42,7 @@ MOVES = {"across": 0.25, "turn": 0.25, "end0": 0.5, "end1": 0.5, "height": 0.25}
 STEP_RANGE = (0.25, 8.0)
 #: rounds over all moves (a round that improves nothing ends the search)
 ROUNDS = 2
-#: [element sizes] the forward-difference step of an end coordinate (and, in ln h, of the height): on
-#: the plate of tests/diagnosis/test_geometry_fit.py 0.125 took the bar from chi^2 950000 to 38000,
-#: 0.25 to 200000 (the rows are far from linear in the ends over a quarter element there)
+#: [element sizes] the forward-difference step of an end coordinate (and, in ln h, of the height)
 STEP = 0.125
 #: Gauss-Newton steps (each 1 + 5 re-meshed solves per rib, and halvings)
 GN_STEPS = 12
