@@ -20,7 +20,6 @@ import numpy as np
 
 from ..problems.models import StructureModels
 from .catalogue import place
-from .fitting import estimate
 from .layout import from_structure
 from .residual import ModalResidual
 
@@ -45,9 +44,3 @@ def remeshed(structure, configs, names, h: float, observations, chosen: list) ->
     obs = [ob.read_on(pm.model) for ob, pm in zip(observations, models.models)]
     layout = from_structure(models.models[0])
     return models, ModalResidual.of_models(models, obs), [place(layout, c) for c in chosen]
-
-
-def fit_at(structure, configs, names, h, observations, chosen, p, values, bounds) -> tuple:
-    """(models, residual, placed effects, :class:`.fitting.Fit`) on the mesh along ``chosen``'s lines."""
-    models, res, placed = remeshed(structure, configs, names, h, observations, chosen)
-    return models, res, placed, estimate(res, p, placed, values, STEPS, bounds)
