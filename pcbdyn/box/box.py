@@ -14,14 +14,16 @@ from .. import targets
 from ..atomic import write_checked
 from ..inputs import MAX_ENTRIES, MAX_NAME, Reader, read_toml
 from ..domain import Analysis, Configured
+from .cards import MAX_CARDS, holds, read_card
 from .entries import MAX_PLATES, RIB_MODELS, BoxError
 from .enrich import enriched_text
 from .model import BoxModel, build_model
 from .spec import (check_plates, read_configuration, read_joint, read_mass, read_materials, read_plate, read_rib,
                    read_support)
 
-#: the collections of box.toml that parameter targets address
-COLLECTIONS = ("plates", "ribs", "joints", "masses")
+#: the collections of box.toml that parameter targets address (``cards``: a card's own targets under
+#: ``cards.<card>.``, e.g. ``cards.card1.components.U1.thickness``)
+COLLECTIONS = ("plates", "ribs", "joints", "masses", "cards")
 #: [m] how far a measurement point may lie from the nearest plate's mid-surface (points on a face, on
 #: a rib's flank); farther ones are an error that names them
 POINT_TOL = 0.005
@@ -42,6 +44,11 @@ class Box(Configured):
     configurations: list = field(default_factory=list)
     parameters: list = field(default_factory=list)
     analysis: Analysis = field(default_factory=Analysis)
+    cards: list = field(default_factory=list)  # .cards.Card
+    holds: dict = field(default_factory=dict)  # {card name: [.cards.Hold]}
+
+    def card(self, name):
+        return next((c for c in self.cards if c.name == name), None)
 
     def plate(self, name):
         return next((p for p in self.plates if p.name == name), None)
@@ -56,6 +63,9 @@ class Box(Configured):
             t = targets.parse(target, COLLECTIONS)
         except targets.TargetError:
             return None
+        if t.prefix is not None:
+            card = self.card(t.prefix.split(".", 1)[1])
+            return None if card is None else card.board.quantity(str(t).split(".", 2)[2])
         if t.collection == "plates" and (p := self.plate(t.name)) is not None:
             if t.attribute == "E":
                 return None if p.material.orthotropic else p.material.E
@@ -70,7 +80,12 @@ class Box(Configured):
 
     # -------------------------------------------------------------------- domain-model interface
     def build(self, config: str | None = None, mesh_size: float | None = None, shared_mesh: bool = False) -> BoxModel:
-        """The FE model of configuration ``config`` (None: the base one); see :func:`.model.build_model`."""
+        """The FE model of configuration ``config`` (None: the base one); see :func:`.model.build_model`,
+        and with cards :func:`.system.build_system`."""
+        if self.cards:
+            from .system import build_system
+
+            return build_system(self, config, mesh_size, shared_mesh)
         return build_model(self, config, mesh_size, shared_mesh)
 
     def nearest_plates(self, xyz) -> tuple:
@@ -144,7 +159,7 @@ def parse_box(data: dict, path: Path) -> Box:
     """The Box of parsed box.toml ``data`` read from ``path``; a BoxError names the first bad field."""
     r = Reader(path, BoxError)
     r.table(data, "top level", ["box", "materials", "plates", "ribs", "supports", "joints", "masses",
-                                "configurations", "parameters", "analysis"], required=["box", "plates"])
+                                "configurations", "parameters", "analysis", "cards"], required=["box", "plates"])
     b = r.table(data["box"], "box", ["name", "mesh_size", "rib_model"])
     rib_model = r.choice(b.get("rib_model", "beam"), "box.rib_model", RIB_MODELS, "rib model",
                          {"beam": "eccentric beams", "shell": "shell strips"})
@@ -163,5 +178,7 @@ def parse_box(data: dict, path: Path) -> Box:
                           for i, e in enumerate(r.list(data, "configurations"))]
     r.unique([c.name for c in box.configurations], "configurations", "name")
     box.analysis = r.analysis(data)
+    box.cards = _named(r, data, "cards", read_card, path, limit=MAX_CARDS)
+    box.holds = {c.name: holds(r, box, c, f"cards[{i}]") for i, c in enumerate(box.cards)}
     box.parameters = targets.read_parameters(r, data, box.quantity, COLLECTIONS)
     return box
