@@ -89,8 +89,8 @@ class Box(Configured):
         return build_model(self, config, mesh_size, shared_mesh)
 
     def nearest_plates(self, xyz) -> tuple:
-        """(index of the nearest plate, distance [m]) of each point (k, 3)."""
-        d = np.array([p.distance(xyz) for p in self.plates])
+        """(index of the nearest plate or card (cards after the plates), distance [m]) of each point (k, 3)."""
+        d = np.array([p.distance(xyz) for p in self.plates] + [c.distance(xyz) for c in self.cards])
         return d.argmin(axis=0), d.min(axis=0)
 
     def check_points(self, points, source) -> None:
@@ -99,11 +99,11 @@ class Box(Configured):
         near, dist = self.nearest_plates(points.xyz)
         off = dist > POINT_TOL
         if off.any():
-            listed = "; ".join(f"{int(i)} at {np.round(x * 1e3, 3).tolist()} mm is {d * 1e3:.3g} mm from plate "
-                               f"'{self.plates[k].name}'"
+            names = [f"plate '{p.name}'" for p in self.plates] + [f"card '{c.name}'" for c in self.cards]
+            listed = "; ".join(f"{int(i)} at {np.round(x * 1e3, 3).tolist()} mm is {d * 1e3:.3g} mm from {names[k]}"
                                for i, x, d, k in zip(points.ids[off][:10], points.xyz[off][:10], dist[off][:10],
                                                      near[off][:10]))
-            raise BoxError(f"{Path(source).name}: {int(off.sum())} point(s) lie off every plate of {self.path.name} "
+            raise BoxError(f"{Path(source).name}: {int(off.sum())} point(s) lie off every plate{' and card' if self.cards else ''} of {self.path.name} "
                            f"(more than {POINT_TOL * 1e3:g} mm away): {listed}{' ...' if off.sum() > 10 else ''}. "
                            "Give the points in the box frame of the file and state their unit in the header (e.g. "
                            "'x [mm]')")
@@ -121,6 +121,7 @@ class Box(Configured):
                   for r in self.ribs]
         items += [item("fixture", f"{s.type} {s.plate}.{s.edge}", self.plate(s.plate).edge(s.edge))
                   for s in self.supports]
+        items += [item("plate", c.name, c.point(c.board.outline.vertices), True) for c in self.cards]
         added = self.configuration(config).masses if config else []
         items += [item("mass", m.name + (f" ({config})" if m in added else ""), [self.plate(m.plate).point(*m.at)])
                   for m in self.masses + added]

@@ -46,6 +46,21 @@ class Card:
     def normal(self) -> np.ndarray:
         return self.R[:, 2]
 
+    def local(self, xyz) -> np.ndarray:
+        """Box-frame points (k, 3) [m] in the board frame."""
+        return (np.atleast_2d(np.asarray(xyz, float)) - self.origin) @ self.R
+
+    def distance(self, xyz) -> np.ndarray:
+        """Distance [m] of box-frame points (k, 3) from the card's mid-surface (the outline's area, holes
+        included in it: a point over a hole is as far as it is off the plane)."""
+        from shapely.geometry import Point, Polygon
+
+        p = self.local(xyz)
+        poly = Polygon(self.board.outline.vertices)
+        off = np.array([0.0 if self.board.outline.contains(q[:2])[0] else poly.exterior.distance(Point(q[:2]))
+                        for q in p])
+        return np.hypot(p[:, 2], off)
+
     def point(self, xyz) -> np.ndarray:
         """Board-frame points (k, 2 or 3) [m] in the box frame."""
         p = np.atleast_2d(np.asarray(xyz, float))

@@ -84,6 +84,25 @@ class SystemModel(BoxModel):
         groups.update({name: [n for n in self.model.sets if n.startswith(f"cards.{name}.")] for name in self.cards})
         return groups
 
+    def reduced_parts(self, modes: int | None = None) -> list:
+        """[(global DOFs of a card, fixed-interface modes)] of the cards to reduce (Craig-Bampton):
+        those whose entry asks for it, or every card with ``modes``."""
+        return [(dof_index(pc.nodes).ravel(), modes or pc.card.reduce) for pc in self.cards.values()
+                if modes or pc.card.reduce]
+
+    def solve(self, n_modes: int | None = None, f_max: float | None = None, K=None, M=None, reduce: int | None = None):
+        """The modes of the system (:func:`pcbdyn.fe.modal.solve_modes`), with the cards that ask for it
+        (or all with ``reduce`` modes each) reduced to their interface (:mod:`pcbdyn.fe.craig_bampton`)."""
+        from ..fe.craig_bampton import craig_bampton, solve_reduced
+        from ..fe.modal import solve_modes
+
+        parts = self.reduced_parts(reduce)
+        if K is None or M is None:
+            K, M = assemble(self.model)
+        if not parts:
+            return solve_modes(self.model, n_modes, f_max, K=K, M=M)
+        return solve_reduced(craig_bampton(self.model, K, M, parts), n_modes, f_max, self.model.free)
+
     def layout_hints(self) -> tuple:
         suspects, footprints, t = super().layout_hints()
         return suspects, footprints, min([t] + [pc.card.board.thickness for pc in self.cards.values()])

@@ -157,13 +157,22 @@ def assess(board, bm, modes, K, M, psd: Psd, damping: Damping, *, axis: str = "z
     damage over ``duration`` [s] and of ``sine``, and the octave rule against ``chassis_hz``.
     ``parts``: the :func:`~.parts.judged_parts` to judge (default: all of the board's);
     ``probe_tol`` [m]: how far off the board a test point of a UFF damping file may lie."""
-    parts = judged_parts(board) if parts is None else parts
-    model = bm.model
-    zeta, source = modal_damping(damping, model, modes, probe_tol)
+    zeta, source = modal_damping(damping, bm.model, modes, probe_tol)
     try:
-        be = base_excitation(model, modes, K, M, zeta, axis)
+        be = base_excitation(bm.model, modes, K, M, zeta, axis)
     except VibrationError as exc:
         raise VibrationError(f"{board.path.name}: {exc}") from None
+    octave = None if chassis_hz is None else steinberg.octave_rule(float(be.frequencies[0]), chassis_hz)
+    return judge(board, bm.model, be, source, psd, damping, duration=duration, sine=sine, octave=octave, parts=parts)
+
+
+def judge(board, model, be: BaseExcitation, source, psd: Psd, damping: Damping, *, duration: float | None = None,
+          sine: SineSweep | None = None, octave: dict | None = None, parts=None, direction=None) -> Assessment:
+    """The :class:`Assessment` of a board whose response to the base excitation is ``be`` on its own
+    ``model`` (board frame: z normal to the board); ``direction``: the shaken axis in the board frame
+    (default the excitation's own axis); ``source``: where each mode's damping came from."""
+    parts = judged_parts(board) if parts is None else parts
+    axis = be.axis
     grid = frequency_grid(psd.f[0], psd.f[-1], be.frequencies, be.zeta)
     C0, C2 = be.covariance(psd, grid), be.covariance(psd, grid, moment=2)
     nodes = _shell_nodes(model)
@@ -179,7 +188,7 @@ def assess(board, bm, modes, K, M, psd: Psd, damping: Damping, *, axis: str = "z
     if parts:
         centres = np.column_stack([np.array([p.at for p in parts]), np.zeros(len(parts))])
         Bz = be.columns(model_probe(model, centres).P)
-        direction = np.eye(3)[AXES.index(axis)]
+        direction = np.eye(3)[AXES.index(axis)] if direction is None else direction
         Ba = be.columns(model_probe(model, centres, direction).P, "acceleration")
         Ca = be.covariance(psd, grid, "acceleration")
         k_long, k_across = (np.sqrt(be.variance(be.columns(k), C0)) for k in _curvature_rows(model, parts))
@@ -201,6 +210,5 @@ def assess(board, bm, modes, K, M, psd: Psd, damping: Damping, *, axis: str = "z
         if sine is not None:
             _sine(be, sine, Bz, parts, results)
     order = np.argsort([r.margin for r in results], kind="stable")
-    octave = None if chassis_hz is None else steinberg.octave_rule(float(be.frequencies[0]), chassis_hz)
     return Assessment(psd, damping, axis, duration, be, source, [results[i] for i in order],
                       node_z, grid, accel_psd[:, order], z_psd[:, order], octave, sine, notes)
