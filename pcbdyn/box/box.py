@@ -5,13 +5,16 @@ configuration, measurement points on the plates, the updated box.toml."""
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+import tomlkit
 
 from .. import targets
 from ..atomic import write_checked
+from ..board import load_board
 from ..inputs import MAX_ENTRIES, MAX_NAME, Reader, read_toml
 from ..domain import Analysis, Configured
 from .cards import MAX_CARDS, holds, read_card
@@ -135,9 +138,25 @@ class Box(Configured):
 
     def write_updated(self, values: dict, dst, source: str = "pcbdyn update") -> Path:
         """``dst``: this box.toml with the parameters' ``values`` {name: SI} written into their targets
-        (comments and layout kept), checked by loading it before it replaces ``dst``."""
+        (comments and layout kept), checked by loading it before it replaces ``dst``. A card's targets go
+        to an updated copy of its board.toml, written beside it and named as ``dst`` is after the box
+        (box.updated.2.toml: card1.updated.2.toml), which the updated box then names."""
         assignments = {t: float(values[p.name]) for p in self.parameters if p.name in values for t in p.targets}
-        text = targets.updated_text(self.path.read_text(encoding="utf-8"), assignments)
+        dst = Path(dst)
+        tail = dst.name[len(self.path.stem):] if dst.name.startswith(self.path.stem) else f".{dst.name}"
+        doc = tomlkit.parse(self.path.read_text(encoding="utf-8"))
+        for i, card in enumerate(self.cards):
+            own = {t.split(".", 2)[2]: v for t, v in assignments.items() if t.startswith(f"cards.{card.name}.")}
+            if not own:
+                continue
+            board = card.board
+            path = board.path.with_name(board.path.stem + tail)
+            text = targets.updated_text(board.path.read_text(encoding="utf-8"), own)
+            write_checked(path, f"# {board.path.name} in {dst.name}, with {', '.join(own)} updated by {source}\n"
+                          + text, load_board, BoxError)
+            doc["cards"][i]["board"] = os.path.relpath(path, dst.parent).replace(os.sep, "/")
+        text = targets.updated_text(tomlkit.dumps(doc), {t: v for t, v in assignments.items()
+                                                        if not t.startswith("cards.")})
         return write_checked(dst, f"# {self.path.name} with {', '.join(values)} updated by {source}\n" + text,
                              load_box, BoxError)
 
