@@ -103,6 +103,20 @@ class SystemModel(BoxModel):
             return solve_modes(self.model, n_modes, f_max, K=K, M=M)
         return solve_reduced(craig_bampton(self.model, K, M, parts), n_modes, f_max, self.model.free)
 
+    def reduction_error(self, modes, K, M) -> dict | None:
+        """None when no card is reduced; else the error of the reduced ``modes`` against the full model's
+        (solved here for as many modes): {"cards": {name: fixed-interface modes}, "errors_pct": per mode,
+        "max_error_pct"}, the contract of ``build --json``'s "reduction"."""
+        from ..fe.modal import solve_modes
+
+        parts = {name: pc.card.reduce for name, pc in self.cards.items() if pc.card.reduce}
+        if not parts:
+            return None
+        full = solve_modes(self.model, modes.frequencies.size, K=K, M=M).frequencies
+        n = min(full.size, modes.frequencies.size)
+        err = 100.0 * (modes.frequencies[:n] / full[:n] - 1.0)
+        return {"cards": parts, "errors_pct": err.tolist(), "max_error_pct": float(np.abs(err).max())}
+
     def layout_hints(self) -> tuple:
         suspects, footprints, t = super().layout_hints()
         return suspects, footprints, min([t] + [pc.card.board.thickness for pc in self.cards.values()])

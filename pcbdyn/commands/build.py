@@ -22,6 +22,10 @@ def analyse(board, config, stds: dict | None = None) -> dict:
     bm, modes, K, M = solve_structure(board, config)
     mass = static_mass(M)
     table = mode_table(bm, modes, M)
+    reduction = getattr(bm, "reduction_error", lambda *a: None)(modes, K, M)
+    if reduction is not None:
+        click.echo(f"cards reduced to their interface (Craig-Bampton: {', '.join(f'{c} {k} modes' for c, k in reduction['cards'].items())}): "
+                   f"largest frequency error against the full model {reduction['max_error_pct']:.3g} %")
     if stds is not None:
         from ..problems.uncertainty import frequency_std
 
@@ -38,6 +42,7 @@ def analyse(board, config, stds: dict | None = None) -> dict:
         "mass_kg": mass,
         "dofs": int(bm.model.n_dof),
         "rigid_body_modes": int(modes.n_rigid),
+        **({"reduction": reduction} if reduction is not None else {}),
     }
     return {"config": config, "model": bm, "modes": modes, "table": table, "summary": summary}
 

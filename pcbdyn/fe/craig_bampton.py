@@ -12,8 +12,10 @@ frequency is an upper bound of the full model's):
     K^ = [[K_BB + K_CI Psi (on C x C), 0], [0, Lambda]],
     M^ = [[M_BB + M_CI Psi + Psi^T M_IC + Psi^T M_II Psi (on C x C), (M_CI + Psi^T M_II) Phi], [sym, I]].
 
-The modes of (K^, M^) expand to full-length shapes through x_I. Psi is dense (n_I x n_C): the interface
-of a card held along two edges is a few hundred DOFs.
+The modes of (K^, M^) expand to full-length shapes through x_I. Psi is dense (n_I x n_C: the interface
+of a card held along two edges is a few hundred DOFs, so Psi of a 80k-DOF card takes hundreds of MB): it
+lives only while its part's blocks are formed; a part keeps the factor of K_II and K_IC, and the
+expansion solves for Psi x_C.
 """
 
 from __future__ import annotations
@@ -32,13 +34,19 @@ from .model import ModelError
 @dataclass
 class Part:
     """One reduced part: positions ``I`` of its unknowns and ``C`` of the outside ones it couples to
-    (in the constrained system), Psi (n_I, n_C), Phi (n_I, k) and its fixed-interface eigenvalues."""
+    (in the constrained system), the factor of K_II, K_IC (sparse), Phi (n_I, k) and its fixed-interface
+    eigenvalues."""
 
     I: np.ndarray
     C: np.ndarray
-    psi: np.ndarray
+    factor: object
+    KIC: sp.csr_matrix
     phi: np.ndarray
     lam: np.ndarray
+
+    def interior(self, xC: np.ndarray, q: np.ndarray) -> np.ndarray:
+        """x_I = Psi x_C + Phi q."""
+        return -self.factor.solve(np.asarray(self.KIC @ xC)) + self.phi @ q
 
 
 @dataclass
@@ -62,7 +70,7 @@ class CraigBampton:
         start = self.B.size
         for p in self.parts:
             k = p.phi.shape[1]
-            x[p.I] = p.psi @ z[pos_in_B[p.C]] + p.phi @ z[start:start + k]
+            x[p.I] = p.interior(z[pos_in_B[p.C]], z[start:start + k])
             start += k
         return self.red.expand(x)
 
@@ -90,8 +98,10 @@ def craig_bampton(model, K, M, parts) -> CraigBampton:
         KIB, MIB = KI[:, B], MI[:, B]
         cpos = np.unique(np.concatenate([KIB.tocoo().col, MIB.tocoo().col]))
         C = B[cpos]
-        KIC, MIC = KIB[:, cpos].toarray(), MIB[:, cpos].toarray()
-        psi = -factorize(KII, spd=True).solve(KIC)
+        KIC_s = KIB[:, cpos].tocsr()
+        KIC, MIC = KIC_s.toarray(), MIB[:, cpos].toarray()
+        factor = factorize(KII, spd=True)
+        psi = -factor.solve(KIC)
         lam, phi, rigid = eigenpairs(KII, MII, n_modes=min(int(k), I.size - 1))
         if rigid.any():
             raise ModelError("a reduced part floats with its interface held: it must couple to the rest by stiffness")
@@ -110,7 +120,8 @@ def craig_bampton(model, K, M, parts) -> CraigBampton:
         M_ent.append((q, q, np.ones(kk)))
         qr, qc = np.meshgrid(q, cpos, indexing="ij")
         M_ent += [(qr.ravel(), qc.ravel(), Mq.ravel()), (qc.ravel(), qr.ravel(), Mq.ravel())]
-        done.append(Part(I, C, psi, phi, lam))
+        done.append(Part(I, C, factor, KIC_s, phi, lam))
+        del psi, MIIpsi, KIC, MIC
         start += kk
 
     def matrix(entries):
