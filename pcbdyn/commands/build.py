@@ -34,11 +34,15 @@ def analyse(board, config, stds: dict | None = None) -> dict:
                f"{sum(len(es.conn) for es in bm.model.sets.values() if es.etype in ('quad4', 'tri3'))} shells"
                + (f", {modes.n_rigid} rigid-body modes" if modes.n_rigid else ""))
     click.echo(format_table(table) + "\n")
+    shares = None
+    if hasattr(bm, "share_groups"):  # a structure in 3-D: each part's share of each mode's kinetic energy
+        shares = [dict(zip(bm.share_groups(), map(float, col))) for col in bm.mode_shares(modes.shapes).T]
     summary = {
         "configuration": label,
         "modes": [{"n": int(row.mode), "frequency_hz": float(row.frequency_hz), "eff_mass_z": float(row.eff_mass_z),
-                   "shape": row.shape, **({"frequency_std_hz": float(row.frequency_std_hz)} if stds is not None else {})}
-                  for row in table.itertuples()],
+                   "shape": row.shape, **({"frequency_std_hz": float(row.frequency_std_hz)} if stds is not None else {}),
+                   **({"shares": shares[i]} if shares is not None else {})}
+                  for i, row in enumerate(table.itertuples())],
         "mass_kg": mass,
         "dofs": int(bm.model.n_dof),
         "rigid_body_modes": int(modes.n_rigid),

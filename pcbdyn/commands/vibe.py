@@ -39,6 +39,7 @@ def command(board_toml, psd_text, sine_csv, sweep_rate, sweeps, damping_text, du
             exclude, out, json_path, html):
     """Judge a board under a random (and sine) vibration specification: RMS responses at every part,
     Steinberg's allowable displacement, fatigue life (three-band, Miner) and the octave rule."""
+    from ..board import load_board
     from ..domain import StructureError
     from ..fe import ModelError
     from ..problems import load_structure
@@ -59,9 +60,8 @@ def command(board_toml, psd_text, sine_csv, sweep_rate, sweeps, damping_text, du
         if getattr(board, "cards", None):
             return _system(board, board_toml, psd, sine, damping, seconds, axis, chassis, config, exclude, out,
                            json_path, html)
-        if not hasattr(board, "components"):
-            raise VibrationError(f"{board_toml.name}: a box without [[cards]] has no parts to judge; vibe takes a "
-                                 "board.toml, or a box.toml with its cards")
+        if not hasattr(board, "components"):  # a box without cards: the board reader says what vibe takes
+            board = load_board(board_toml)
         parts = judged_parts(board, exclude)
         bm, modes, K, M = solve_structure(board, config, n_modes=MAX_MODES, f_max=analysis_band(psd, sine))
         t0 = step(f"random response of {len(parts)} part(s) to {psd.name} along {axis}")

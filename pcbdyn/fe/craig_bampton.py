@@ -75,6 +75,28 @@ class CraigBampton:
         return self.red.expand(x)
 
 
+#: columns of the constraint modes formed at a time (bounds the temporaries beside Psi)
+CHUNK = 64
+
+
+def _coupling(factor, MII, KIC, MIC, phi) -> tuple:
+    """(K_CI Psi, M_CI Psi + Psi^T M_IC + Psi^T M_II Psi, Phi^T (M_IC + M_II Psi)) of one part, with
+    Psi = -K_II^-1 K_IC solved and G = M_IC + M_II Psi formed :data:`CHUNK` columns at a time: only Psi
+    is held whole."""
+    nc = KIC.shape[1]
+    psi = np.empty((KIC.shape[0], nc))
+    for a in range(0, nc, CHUNK):
+        psi[:, a:a + CHUNK] = -factor.solve(KIC[:, a:a + CHUNK].toarray())
+    dK, dM, Mq = np.empty((nc, nc)), np.empty((nc, nc)), np.empty((phi.shape[1], nc))
+    for a in range(0, nc, CHUNK):
+        cols = slice(a, min(a + CHUNK, nc))
+        G = MIC[:, cols].toarray() + MII @ psi[:, cols]
+        dK[:, cols] = KIC.T @ psi[:, cols]
+        dM[:, cols] = MIC.T @ psi[:, cols] + psi.T @ G
+        Mq[:, cols] = phi.T @ G
+    return dK, dM, Mq
+
+
 def craig_bampton(model, K, M, parts) -> CraigBampton:
     """The reduction of ``model`` (assembled ``K``, ``M``) whose ``parts`` [(global DOFs, k modes)] are
     each replaced by their constraint modes and first k fixed-interface modes."""
@@ -98,20 +120,15 @@ def craig_bampton(model, K, M, parts) -> CraigBampton:
         KIB, MIB = KI[:, B], MI[:, B]
         cpos = np.unique(np.concatenate([KIB.tocoo().col, MIB.tocoo().col]))
         C = B[cpos]
-        KIC_s = KIB[:, cpos].tocsr()
-        KIC, MIC = KIC_s.toarray(), MIB[:, cpos].toarray()
+        KIC, MIC = KIB[:, cpos].tocsc(), MIB[:, cpos].tocsc()
         factor = factorize(KII, spd=True)
-        psi = -factor.solve(KIC)
         lam, phi, rigid = eigenpairs(KII, MII, n_modes=min(int(k), I.size - 1))
         if rigid.any():
             raise ModelError("a reduced part floats with its interface held: it must couple to the rest by stiffness")
         order = np.argsort(lam)
         lam, phi = lam[order], phi[:, order]
         kk = lam.size
-        dK = KIC.T @ psi
-        MIIpsi = MII @ psi
-        dM = MIC.T @ psi + psi.T @ MIC + psi.T @ MIIpsi
-        Mq = phi.T @ (MIC + MIIpsi)  # (k, n_C)
+        dK, dM, Mq = _coupling(factor, MII, KIC, MIC, phi)
         cc_r, cc_c = np.meshgrid(cpos, cpos, indexing="ij")
         K_ent.append((cc_r.ravel(), cc_c.ravel(), dK.ravel()))
         M_ent.append((cc_r.ravel(), cc_c.ravel(), dM.ravel()))
@@ -120,8 +137,7 @@ def craig_bampton(model, K, M, parts) -> CraigBampton:
         M_ent.append((q, q, np.ones(kk)))
         qr, qc = np.meshgrid(q, cpos, indexing="ij")
         M_ent += [(qr.ravel(), qc.ravel(), Mq.ravel()), (qc.ravel(), qr.ravel(), Mq.ravel())]
-        done.append(Part(I, C, factor, KIC_s, phi, lam))
-        del psi, MIIpsi, KIC, MIC
+        done.append(Part(I, C, factor, KIC.tocsr(), phi, lam))
         start += kk
 
     def matrix(entries):

@@ -33,6 +33,9 @@ def test_build_names_the_cards_modes_and_reports_the_reduction(example, tmp_path
     data = json.loads((tmp_path / "b.json").read_text())
     shapes = [m["shape"] for m in data["modes"]]
     assert shapes[0] == "shelf 100 %" and "ribs_card 100 %" in shapes and any("upper" in s for s in shapes)
+    shares = data["modes"][0]["shares"]
+    assert set(shares) == {"left", "right", "back", "upper", "ribs_card", "shelf"} and shares["shelf"] > 0.99
+    assert sum(shares.values()) == pytest.approx(1.0)
     assert data["reduction"]["cards"] == {"shelf": 30} and 0 <= data["reduction"]["max_error_pct"] < 0.5
     assert "Craig-Bampton: shelf 30 modes" in res.output
 
