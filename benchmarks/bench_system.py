@@ -3,6 +3,13 @@ building, 20 modes of the full system, and the same with every card reduced to i
 40 fixed-interface modes each): time, peak memory and the reduction's error against the full model. Each
 variant runs in a fresh process, so that its peak memory is its own.
 Run: python benchmarks/bench_system.py [--mesh 3.1] [--modes 20]
+
+Measured (2 cores shared with other jobs, 2026-11-27): 323,988 DOFs; full: build 114 s, 20 modes in 103 s,
+peak 1.8 GB. Reduced (interfaces of 24, 948 and 948 DOFs): the reduction 319 s (once: each card's K_II
+factor, 40 modes and constraint modes), then 130,278 DOFs solved in 38 s, peak 2.0 GB; largest frequency
+error 1.1e-5 %. The reduction pays when the housing is solved again and again with the cards as they
+are (updating the housing's parameters), not for one solve: its constraint modes, a dense n_I x n_C
+block per card, cost more than the whole system's shift-invert Lanczos here.
 """
 
 from __future__ import annotations

@@ -71,3 +71,17 @@ def test_a_card_whose_board_is_bad_names_both_files(example):
     _edit(example.with_name("card_guides.toml"), 'thickness = "1.6 mm"', 'thickness = "-1 mm"')
     with pytest.raises(BoxError, match=r"box.toml: cards\[1\].board: card 'shelf': card_guides.toml: board.thickness"):
         load_box(example)
+
+
+def test_a_simulated_test_on_cards_and_plates_correlates(example, tmp_path):
+    """simulate-test at the example's points (on the plates in x, y, z and on the cards normal to them),
+    excited on the shelf, then correlate: every test mode pairs with its model mode."""
+    uff, js = tmp_path / "test.uff", tmp_path / "c.json"
+    res = CliRunner().invoke(main, ["simulate-test", str(example), "--points", str(example.with_name("points.csv")),
+                                    "--excite", "100,40,60", "--excite-dir", "-z", "--modes", "8", "--out", str(uff)])
+    assert res.exit_code == 0, res.output
+    res = CliRunner().invoke(main, ["correlate", str(example), str(uff), "--json", str(js)])
+    assert res.exit_code == 0, res.output
+    pairs = json.loads(js.read_text())["pairs"]
+    assert [p["test_mode"] for p in pairs] == [p["model_mode"] for p in pairs] == list(range(1, 9))
+    assert min(p["mac"] for p in pairs) > 0.99
