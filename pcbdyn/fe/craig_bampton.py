@@ -27,7 +27,7 @@ import scipy.sparse as sp
 
 from .constraints import build_reduction
 from .linsolve import factorize
-from .modal import Modes, eigenpairs
+from .modal import Modes, eigenpairs, select_modes
 from .model import ModelError
 
 
@@ -151,11 +151,4 @@ def solve_reduced(cb: CraigBampton, n_modes: int | None = None, f_max: float | N
                   free: bool = False) -> Modes:
     """The first modes of the reduced system, as :class:`.modal.Modes` with full-length shapes."""
     lam, vec, rigid = eigenpairs(cb.K, cb.M, n_modes, f_max, free)
-    lam_e, vec_e = lam[~rigid], vec[:, ~rigid]
-    order = np.argsort(lam_e)
-    f = np.sqrt(np.maximum(lam_e[order], 0.0)) / (2.0 * np.pi)
-    keep = order[f <= f_max] if f_max is not None else order
-    if n_modes is not None:
-        keep = keep[:n_modes]
-    return Modes(np.sqrt(np.maximum(lam_e[keep], 0.0)) / (2.0 * np.pi), cb.expand(vec_e[:, keep]),
-                 cb.expand(vec[:, rigid]), cb.red)
+    return select_modes(lam, vec, rigid, cb.red, cb.expand, n_modes, f_max, free)

@@ -13,6 +13,8 @@ global components stay free and enter as masters.
 
 from __future__ import annotations
 
+from itertools import combinations
+
 import numpy as np
 
 from .mesh import NDOF
@@ -39,8 +41,6 @@ def _local_terms(dof: int, R) -> list:
 
 def _slaves(A: np.ndarray) -> list:
     """The global components (as many as A's rows) whose columns of A are best conditioned."""
-    from itertools import combinations
-
     r = A.shape[0]
     return list(max(combinations(range(3), r), key=lambda J: abs(np.linalg.det(A[:, list(J)]))))
 
