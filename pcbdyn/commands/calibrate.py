@@ -24,7 +24,7 @@ from pathlib import Path
 
 import click
 
-from .common import checked_outputs, done, fail, input_errors, library_option, parse_extra, parse_noise, step, test_arguments
+from .common import checked_outputs, done, fail, input_errors, library_option, parse_extra, parse_noise, step, test_arguments, units_option
 
 
 def names(text) -> list | None:
@@ -55,6 +55,7 @@ def names(text) -> list | None:
               help="write the families, before/after and the library written as JSON ('-': standard output)")
 @checked_outputs(folders=())
 @library_option(required=True, keep=True)
+@units_option
 def command(board_toml, test_uff, configs, freq_csv, joint_toml, families, with_, method, solver, noise, max_iter,
             tol_pct, mesh_size, mesh_error, json_path, library):
     """Calibrate part families' equivalent thicknesses from modal tests into a component library."""
@@ -95,6 +96,8 @@ def command(board_toml, test_uff, configs, freq_csv, joint_toml, families, with_
     click.echo(f"\n{rep.headline(cal, what['status'])}")
     for line in what["details"]:
         click.echo(f"  note: {line}")
+    for line in what["warnings"]:
+        click.echo(f"warning: {line}", err=True)
     click.echo(rep.format_families(fams))
     if cal.problem.names[len(cal.families):]:
         click.echo("\n" + rep.format_with(cal))
@@ -111,7 +114,8 @@ def command(board_toml, test_uff, configs, freq_csv, joint_toml, families, with_
         write_json(json_path, {
             "families": fams, "before": summary(cal.before), "after": summary(cal.after), "library": str(library),
             "with": rep.with_rows(cal), "method": method, "solver": solver, "noise": cal.noise,
-            "status": what["status"], "details": what["details"], "iterations": cal.result.iterations,
+            "status": what["status"], "details": what["details"], "warnings": what["warnings"],
+            "iterations": cal.result.iterations,
             "converged": bool(cal.result.converged), "reason": cal.result.reason,
             "boards": [str(it.structure.path) for it in cal.items],
             "tests": [{"board": it.structure.path.name, "configuration": c or "base", "file": str(p)}

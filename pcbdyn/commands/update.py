@@ -27,7 +27,7 @@ from __future__ import annotations
 import click
 
 from .common import (done, fail, folder_outputs, input_errors, library_option, measured_configurations, parse_extra, result_path,
-                     step, test_arguments)
+                     step, test_arguments, units_option)
 
 def parse_frf_freqs(text) -> list:
     """'150,230 Hz' or '150,230' -> frequencies [Hz]."""
@@ -54,13 +54,14 @@ def parse_frf_freqs(text) -> list:
 @click.option("--solver", type=click.Choice(["ls", "tls", "bayes", "bounded"]), default="bounded", show_default=True)
 @click.option("--params", default=None, help="comma-separated parameter names (default: all [[parameters]])")
 @click.option("--max-iter", type=click.IntRange(min=1), default=20, show_default=True)
-@click.option("--tol", "tol_pct", type=float, default=0.1, show_default=True,
+@click.option("--tol", "tol_pct", type=float, default=0.1, show_default=True,  # problems.run.TOL_FREQ_PCT
               help="stop when the max frequency error is below this percentage (eq. 7.2)")
 @click.option("--mesh-size", default=None, help="override board.mesh_size, e.g. '10 mm'")
 @folder_outputs("folder for board.updated.toml, the iteration plot and tables (default: board.updated.toml beside "
                 "the board)", "write parameters, status, before/after and history as JSON",
                 force="replace an earlier board.updated.toml beside the board (default: a numbered name)")
 @library_option()
+@units_option
 def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping, solver, params, max_iter, tol_pct,
             mesh_size, out, force, json_path):
     """Update a structure's [[parameters]] against modal tests: TEST_UFF for the base configuration and
@@ -105,24 +106,28 @@ def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping,
                                  progress=lambda h: click.echo(rep.progress_line(h), err=True))
         done(t0)
         what = outcome(problem, res, before, after)
-        dst = problem.write_updated(res.p, result_path(out, board_toml, "updated", force), source=(
-            f"pcbdyn update ({what['status']})"))
-    rows = rep.parameter_rows(problem, res.p)
+        rows = rep.parameter_rows(problem, res.p)
+        source = f"pcbdyn update ({what['status']})"
+        if out is None:
+            dst = problem.write_updated(res.p, result_path(None, board_toml, "updated", force), source=source)
+        else:
+            from ..report.manifest import replacing
+
+            with replacing(out, "pcbdyn update") as staged:  # the earlier --out stays whole until all is written
+                dst = staged.final(problem.write_updated(res.p, result_path(staged.path, board_toml, "updated"),
+                                                         source=source))
+                rep.plot_iterations(staged.path / "iterations.png", problem, res)
+                write_text(staged.path / "parameters.txt", rep.format_parameters(rows) + "\n")
+                write_text(staged.path / "correlation.txt", rep.format_correlation(before, after) + "\n")
     click.echo(f"\n{board.name}: {what['status']} after {res.iterations} iteration(s) ({res.reason}; best iterate "
                f"{res.best_iteration})")
     for line in what["details"]:
         click.echo(f"  note: {line}")
+    for line in what["warnings"]:
+        click.echo(f"warning: {line}", err=True)
     click.echo(rep.format_parameters(rows))
     click.echo("")
     click.echo(rep.format_correlation(before, after))
     click.echo(f"\nupdated board written to {dst}", err=True)
-    if out is not None:
-        from ..report.manifest import settle
-
-        written = [dst, out / "iterations.png", out / "parameters.txt", out / "correlation.txt"]
-        rep.plot_iterations(written[1], problem, res)
-        write_text(written[2], rep.format_parameters(rows) + "\n")
-        write_text(written[3], rep.format_correlation(before, after) + "\n")
-        settle(out, written, "pcbdyn update")
     if json_path is not None:
         write_json(json_path, rep.update_json(problem, res, rows, before, after, what, method, solver, dst))
