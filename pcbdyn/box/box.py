@@ -147,14 +147,13 @@ class Box(Configured):
         doc = tomlkit.parse(self.path.read_text(encoding="utf-8"))
         for i, card in enumerate(self.cards):
             own = {t.split(".", 2)[2]: v for t, v in assignments.items() if t.startswith(f"cards.{card.name}.")}
-            if not own:
-                continue
-            board = card.board
-            path = board.path.with_name(board.path.stem + tail)
-            text = targets.updated_text(board.path.read_text(encoding="utf-8"), own)
-            write_checked(path, f"# {board.path.name} in {dst.name}, with {', '.join(own)} updated by {source}\n"
-                          + text, load_board, BoxError)
-            doc["cards"][i]["board"] = os.path.relpath(path, dst.parent).replace(os.sep, "/")
+            path = board = card.board.path
+            if own:
+                path = board.with_name(board.stem + tail)
+                text = targets.updated_text(board.read_text(encoding="utf-8"), own)
+                write_checked(path, f"# {board.name} in {dst.name}, with {', '.join(own)} updated by {source}\n"
+                              + text, load_board, BoxError)
+            doc["cards"][i]["board"] = os.path.relpath(path.resolve(), dst.resolve().parent).replace(os.sep, "/")
         text = targets.updated_text(tomlkit.dumps(doc), {t: v for t, v in assignments.items()
                                                         if not t.startswith("cards.")})
         return write_checked(dst, f"# {self.path.name} with {', '.join(values)} updated by {source}\n" + text,

@@ -5,17 +5,20 @@ cards normal to them) with 2 % shape and 0.2 % frequency noise. The update of th
 shelf guides' k_rot (a card's target, cards.shelf.fixtures.*.k_rot) recovers both within 5 %, and writes
 the updated box.toml with the shelf's board.toml updated beside it, comments kept."""
 
+import json
 import shutil
 
 import numpy as np
 import pytest
 import tomlkit
+from click.testing import CliRunner
 from system_helpers import EXAMPLES
 
 from pcbdyn.box import load_box
+from pcbdyn.cli import main
 from pcbdyn.fe.modal import solve_modes
 from pcbdyn.problems import UpdateProblem, run
-from pcbdyn.testdata import Noise, read_points_csv
+from pcbdyn.testdata import Noise, read_points_csv, write_uff
 from pcbdyn.testdata.simulate import simulate_on_model
 
 NOISE = Noise(0.2, 2.0, 0.0)
@@ -40,8 +43,9 @@ def test_update_recovers_a_plate_modulus_and_a_card_guide_stiffness(tmp_path):
     system = truth.build(mesh_size=0.008)
     points, dofs = read_points_csv(tmp_path / "points.csv")
     truth.check_points(points, "points.csv")
-    test = simulate_on_model(system.model, solve_modes(system.model, n_modes=20), points, dofs, noise=NOISE, seed=3,
-                             tol=0.02).modes
+    data = simulate_on_model(system.model, solve_modes(system.model, n_modes=20), points, dofs, noise=NOISE, seed=3,
+                             tol=0.02)
+    test = data.modes
     box = load_box(tmp_path / "box.toml")
     problem = UpdateProblem(box, ["E_back", "k_shelf_guides"])
     sigma = NOISE.frequency_pct / 100 / np.sqrt(3) * test.frequencies
@@ -56,3 +60,13 @@ def test_update_recovers_a_plate_modulus_and_a_card_guide_stiffness(tmp_path):
     updated = load_box(dst)
     assert updated.card("shelf").board.fixture("left_guide").k_rot == pytest.approx(600.0 * k / 2.0, rel=1e-9)
     assert updated.plate("back").material.E == pytest.approx(70e9 * E, rel=1e-9)
+    # the command, whose frequency rows on a system are in units of their frequency (no noise stated)
+    write_uff(tmp_path / "test.uff", data)
+    out = tmp_path / "out"
+    res = CliRunner().invoke(main, ["update", str(tmp_path / "box.toml"), str(tmp_path / "test.uff"), "--params",
+                                    "E_back,k_shelf_guides", "--out", str(out), "--json", str(tmp_path / "u.json")])
+    assert res.exit_code == 0, res.output
+    got = json.loads((tmp_path / "u.json").read_text())["parameters"]
+    assert got["E_back"]["updated"] / 70e9 == pytest.approx(0.8, rel=0.05)
+    assert got["k_shelf_guides"]["updated"] / 300.0 == pytest.approx(2.0, rel=0.05)
+    assert load_box(out / "box.updated.toml").card("shelf").board.path.resolve().parent == tmp_path.resolve()  # beside the card
