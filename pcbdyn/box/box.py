@@ -92,6 +92,11 @@ class Box(Configured):
         return build_model(self, config, mesh_size, shared_mesh)
 
     def nearest_plates(self, xyz) -> tuple:
+        """(index of the nearest plate, distance [m]) of each point (k, 3)."""
+        d = np.array([p.distance(xyz) for p in self.plates])
+        return d.argmin(axis=0), d.min(axis=0)
+
+    def nearest_part(self, xyz) -> tuple:
         """(index of the nearest plate or card (cards after the plates), distance [m]) of each point (k, 3)."""
         d = np.array([p.distance(xyz) for p in self.plates] + [c.distance(xyz) for c in self.cards])
         return d.argmin(axis=0), d.min(axis=0)
@@ -99,7 +104,7 @@ class Box(Configured):
     def check_points(self, points, source) -> None:
         """A BoxError naming the points (``points.ids``, ``points.xyz`` [m]) of ``source`` farther than
         :data:`POINT_TOL` from every plate, with the nearest plate and how far it is."""
-        near, dist = self.nearest_plates(points.xyz)
+        near, dist = self.nearest_part(points.xyz)
         off = dist > POINT_TOL
         if off.any():
             names = [f"plate '{p.name}'" for p in self.plates] + [f"card '{c.name}'" for c in self.cards]
