@@ -33,6 +33,7 @@ from ..fe import EdgeSpringProperty, SpringProperty, dof_index
 from ..fe.assembly import assemble
 from ..fe.frames import idle_dofs, placed
 from ..fe.parametric import SetMaker
+from ..fe.probe import segment_parameter
 from ..fixtures.supports import edge_nodes, edge_rotation
 from .model import BoxModel, _tie_across, build_model
 
@@ -115,7 +116,7 @@ class SystemModel(BoxModel):
         full = solve_modes(self.model, modes.frequencies.size, K=K, M=M).frequencies
         n = min(full.size, modes.frequencies.size)
         err = 100.0 * (modes.frequencies[:n] / full[:n] - 1.0)
-        return {"cards": parts, "errors_pct": err.tolist(), "max_error_pct": float(np.abs(err).max())}
+        return {"cards": parts, "errors_pct": err.tolist(), "max_error_pct": float(np.abs(err).max(initial=0.0))}
 
     def layout_hints(self) -> tuple:
         suspects, footprints, t = super().layout_hints()
@@ -126,12 +127,6 @@ def _project(plate, x) -> np.ndarray:
     """Points ``x`` (k, 3) projected on ``plate``'s mid-surface."""
     n = plate.normal
     return x - np.outer((x - plate.origin) @ n, n)
-
-
-def _on_segment(a, b, x) -> np.ndarray:
-    """The point of segment a-b nearest to ``x`` (3,)."""
-    t = np.clip((x - a) @ (b - a) / ((b - a) @ (b - a)), 0.0, 1.0)
-    return a + t * (b - a)
 
 
 def _interfaces(box, card, local) -> list:
@@ -145,7 +140,8 @@ def _interfaces(box, card, local) -> list:
             x = card.point(local.model.nodes[c])
             if hold.rib is not None:
                 rib = box.rib(hold.rib)
-                h = _on_segment(plate.point(*rib.start), plate.point(*rib.end), x[0])[None]
+                a, b = plate.point(*rib.start)[None], plate.point(*rib.end)[None]
+                h = a + segment_parameter(x, a, b)[:, None] * (b - a)
             else:
                 h = _project(plate, x)
             out.append((hold, c, np.zeros(0, dtype=np.int64), h))
