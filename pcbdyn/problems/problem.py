@@ -94,7 +94,15 @@ class UpdateProblem:
 
         Shapes give P and MAC pairing; frequencies only pair by the test's mode numbers. ``n_modes``
         analytical modes are solved per iteration (default: rigid-body modes + the highest measured
-        mode number + 4). ``options`` go to Configuration (matching, sigma, ...)."""
+        mode number + 4). ``options`` go to Configuration (matching, sigma, ...).
+
+        On a system (a box with cards), frequency rows default to units of their own frequency (eq. 4.28
+        with the same percentage of noise on every mode, as library calibration weights them): most of a
+        system's modes do not depend on a given card's or plate's parameters, and rows of unit length
+        (eq. 4.42) would blow up the residuals of the modes a parameter cannot reach (a test of the
+        example with the back plate's E and a shelf's guides off drove both to their bounds)."""
+        if method == "freq" and "sigma" not in options and getattr(self.structures[structure], "cards", None):
+            options["sigma"] = measured.frequencies
         sysm = self.system(config, structure)
         P = None if measured.shapes is None else sysm.measurement_matrix(measured.xyz, measured.directions)
         n = n_modes or sysm.n_rigid + int(max(measured.numbers.max(), measured.frequencies.size)) + 4
