@@ -30,7 +30,8 @@ from .common import (PROBE_TOL, done, fail, folder_outputs, input_errors, librar
                    "test noise and the model's mesh error explain)")
 @click.option("--noise", default=None,
               help="the test's noise in percent, e.g. f=0.2,shape=2 (uniform bounds; the frequency noise sets the "
-                   "tolerance and the weights; default f=0.2)")
+                   "tolerance and the weights, the shape noise weighs the shapes when they join the fit; default "
+                   "f=0.2,shape=2)")
 @click.option("--min-mac", type=click.FloatRange(0.0, 1.0), default=0.5, show_default=True,
               help="pairs with a lower MAC are dropped")
 @click.option("--mesh-size", default=None, help="override board.mesh_size, e.g. '10 mm'")
@@ -54,7 +55,7 @@ def command(board_toml, test_uff, configs, freq_csv, per_guide, tol_pct, noise, 
 
     if (test_uff is None) == (freq_csv is None):
         fail("give either TEST_UFF (and NAME=FILE for other configurations) or --frequencies FILE.csv")
-    freq_noise, _ = parse_noise(noise)
+    freq_noise, shape_noise = parse_noise(noise)
     with input_errors():
         board = load_structure(board_toml)
         ms = to_si(mesh_size, "mm", "--mesh-size") if mesh_size else None
@@ -67,7 +68,7 @@ def command(board_toml, test_uff, configs, freq_csv, per_guide, tol_pct, noise, 
                 board.check_points(t.measured_points(), path)
         t0 = step("fitting the wedge-lock guides")
         result = fit_wedge_locks(board, tests, per_guide=per_guide, tol_pct=tol_pct, noise_pct=freq_noise,
-                                 mesh_size=ms, min_mac=min_mac, probe_tol=PROBE_TOL, max_iter=max_iter,
+                                 shape_noise_pct=shape_noise, mesh_size=ms, min_mac=min_mac, probe_tol=PROBE_TOL, max_iter=max_iter,
                                  progress=lambda msg: click.echo(f"    {msg}", err=True))
         done(t0)
     d = result.to_dict()

@@ -62,7 +62,7 @@ class BoardTests:
 class Calibration:
     """A calibration's problem, fit and result: ``families`` (the family parameter names, first in
     ``problem.names``), ``start`` {family: (value [m], library file it came from)}, ``result``
-    (:class:`~pcbdyn.updating.iteration.UpdateResult`), ``before``/``after`` correlation states,
+    (:class:`~pcbdyn.updating.driver.UpdateResult`), ``before``/``after`` correlation states,
     ``std`` [SI] of every parameter and ``std_mesh``, the part of it the mesh makes (a systematic error,
     common to every run on meshes alike), ``at_bound`` and ``undetermined`` parameter names, ``mesh_steps``
     (per test configuration, the relative change h -> h/2 of each measured mode's model frequency),
