@@ -37,7 +37,7 @@ import numpy as np
 from scipy.stats import chi2 as chi2_dist
 
 from ..updating.driver import update
-from ..updating.iteration import build_equations, objective_rows
+from ..updating.iteration import build_equations, objective_rows, unpaired
 from ..updating.scan import scan, scanned
 from ..updating.solvers import RankDeficiencyWarning, choose_rank
 from ..units import from_si
@@ -48,6 +48,8 @@ from .run import correlation_state, undetermined_directions, worse_configuration
 DEFAULT_NOISE = (0.2, 2.0)
 #: chi^2 with a smaller probability than this under the noise: the model cannot fit the test
 ALPHA_FIT = 1e-3
+#: a fit that pairs fewer of the measured modes than this share cannot fit the test, whatever its chi^2
+MIN_PAIRED = 0.5
 #: a parameter direction x = dp/p (d ln p on a log scale) known to worse than this at one sigma is not
 #: determined by the data
 UNDETERMINED_SD = 0.5
@@ -209,7 +211,9 @@ def fit(problem, measured, *, method: str = "freq", noise=(None, None), shapes: 
         model = model_errors(problem, tests, res.p, correlation_state(check, res.p))
         cfgs = build(model)
         check = configurations(problem, tests, "freq", f_pct, shape_pct, model, min_mac)
-        res = _run(problem, cfgs, res.p, 0, 1, solver, max_iter, tol_freq_pct, say)
+        more = _run(problem, cfgs, res.p, 0, 1, solver, max_iter, tol_freq_pct, say)
+        history = res.history + [{**h, "iteration": len(res.history) + k} for k, h in enumerate(more.history[1:])]
+        res = replace(more, history=history, iterations=len(history) - 1, best_iteration=len(history) - 1)
         runs[best], keys[best] = res, (res.history[-1]["unpaired"], res.history[-1]["objective"])
     before, after = correlation_state(check, problem.p0), correlation_state(check, res.p)
     out = Fit(problem, cfgs, res.p, res, before, after, "", [], _verdict(cfgs, res.p, problem),
@@ -235,7 +239,8 @@ def _run(problem, cfgs, p0, k, n, solver, max_iter, tol_freq_pct, say):
 def _progress_line(h) -> str:
     err = "" if h["max_freq_error_pct"] is None else f"max |df| {h['max_freq_error_pct']:.3f} %, "
     aside = f"; set aside: {', '.join(h['set_aside'])}" if h.get("set_aside") else ""
-    return f"iteration {h['iteration']}: {err}chi^2 {h['objective']:.4g}{aside}"
+    lost = f"{h['unpaired']} measured mode(s) unpaired, " if h["unpaired"] else ""
+    return f"iteration {h['iteration']}: {err}{lost}chi^2 {h['objective']:.4g}{aside}"
 
 
 def _verdict(cfgs, p, problem) -> dict:
@@ -249,7 +254,13 @@ def _verdict(cfgs, p, problem) -> dict:
     scales = sum(np.size(st["used"]) for c, st in zip(cfgs, states) if c.method == "modal")
     dof = int(sum(r.size for r in rows) - len(problem.names) - scales)
     pv = float(chi2_dist.sf(chi2, dof)) if dof > 0 else None
-    return {"chi2": chi2, "dof": dof, "p_value": pv, "fits": None if pv is None else bool(pv >= ALPHA_FIT)}
+    measured = sum(np.size(c.f_x) for c in cfgs)
+    paired = measured - sum(unpaired(c, st) for c, st in zip(cfgs, states))
+    fits = None if pv is None else bool(pv >= ALPHA_FIT)
+    if paired < MIN_PAIRED * measured:
+        fits = False  # the test's modes are not the model's
+    return {"chi2": chi2, "dof": dof, "p_value": pv, "fits": fits, "paired_modes": int(paired),
+            "measured_modes": int(measured)}
 
 
 def _judge(out: Fit, cfgs) -> None:
@@ -266,12 +277,18 @@ def _judge(out: Fit, cfgs) -> None:
         f", shape noise {out.noise['shape_pct']:g} %" if out.noise["shape_pct"] is not None else "")
     noise += "" if all(out.noise["stated"][:1 + (out.noise["shape_pct"] is not None)]) else " (assumed; state it with --noise)"
     d = []
-    if v["fits"] is False:
-        d.append(f"the model cannot fit the test: chi^2 {v['chi2']:.4g} over {v['dof']} degrees of freedom "
-                 f"(probability {v['p_value']:.2g} under the {noise}{', and the model error' if out.noise['model_error'] else ''})")
-    elif v["chi2"] is not None:
-        d.append(f"chi^2 {v['chi2']:.4g} over {v['dof']} degrees of freedom: within the {noise}"
-                 if v["fits"] else f"chi^2 {v['chi2']:.4g}: no degree of freedom left to judge the fit")
+    if v["chi2"] is not None:
+        model = ", and the model error" if out.noise["model_error"] else ""
+        chi2 = (f"chi^2 {v['chi2']:.4g} over {v['dof']} degrees of freedom (probability {v['p_value']:.2g} under the "
+                f"{noise}{model})" if v["p_value"] is not None else
+                f"chi^2 {v['chi2']:.4g} with no degree of freedom left to judge it (fewer rows than parameters)")
+        if v["paired_modes"] < MIN_PAIRED * v["measured_modes"]:
+            d.append(f"the model cannot fit the test: only {v['paired_modes']} of its {v['measured_modes']} measured "
+                     f"modes pair with a model mode (a test of another structure or configuration?); {chi2}")
+        elif v["fits"] is False:
+            d.append(f"the model cannot fit the test: {chi2}")
+        else:
+            d.append(f"{chi2}: within the noise" if v["fits"] else chi2)
     d += [f"configuration {c}: max |df| grew from {b:.2f} % to {a:.2f} %" for c, b, a in out.worse]
     d += [f"{n} stopped at its {side} bound" for n, side in out.at_bounds.items()]
     d += [f"the data do not determine {c}" for c in out.undetermined]
