@@ -6,7 +6,6 @@ verdict printed."""
 
 import json
 
-import numpy as np
 import pytest
 from click.testing import CliRunner
 
