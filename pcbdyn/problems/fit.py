@@ -166,7 +166,8 @@ def weak_directions(configs, p, names, free=None) -> list:
 
 def fit(problem, measured, *, method: str = "freq", noise=(None, None), shapes: str = "auto",
         scan_start: bool = True, model_pct=None, mesh_check: bool = False, solver: str = "bounded",
-        max_iter: int = 20, tol_freq_pct: float = 0.1, min_mac: float = 0.5, progress=None) -> Fit:
+        max_iter: int = 20, tol_freq_pct: float = 0.1, tol_param_pct: float = 0.5, min_mac: float = 0.5,
+        progress=None) -> Fit:
     """Fit ``problem`` (:class:`~.problem.UpdateProblem`, its ``p0`` the start) to ``measured``
     [(configuration or None, :class:`pcbdyn.testdata.Modes`)] or [(structure index, configuration, Modes)].
 
@@ -202,7 +203,8 @@ def fit(problem, measured, *, method: str = "freq", noise=(None, None), shapes: 
     ranges = scanned(problem.p0, problem.bounds, problem.log_scale) if scan_start else []
     sc = scan(cfgs, problem.p0, ranges, progress=say) if ranges else None
     starts = sc.starts if sc is not None else [problem.p0]
-    runs = [_run(problem, cfgs, p0, k, len(starts), solver, max_iter, tol_freq_pct, say) for k, p0 in enumerate(starts)]
+    tol = (max_iter, tol_freq_pct, tol_param_pct)
+    runs = [_run(problem, cfgs, p0, k, len(starts), solver, tol, say) for k, p0 in enumerate(starts)]
     keys = [(r.history[-1]["unpaired"], r.history[-1]["objective"]) for r in runs]
     best = min(range(len(runs)), key=lambda k: keys[k])
     res = runs[best]
@@ -211,7 +213,7 @@ def fit(problem, measured, *, method: str = "freq", noise=(None, None), shapes: 
         model = model_errors(problem, tests, res.p, correlation_state(check, res.p))
         cfgs = build(model)
         check = configurations(problem, tests, "freq", f_pct, shape_pct, model, min_mac)
-        more = _run(problem, cfgs, res.p, 0, 1, solver, max_iter, tol_freq_pct, say)
+        more = _run(problem, cfgs, res.p, 0, 1, solver, tol, say)
         history = res.history + [{**h, "iteration": len(res.history) + k} for k, h in enumerate(more.history[1:])]
         res = replace(more, history=history, iterations=len(history) - 1, best_iteration=len(history) - 1)
         runs[best], keys[best] = res, (res.history[-1]["unpaired"], res.history[-1]["objective"])
@@ -226,14 +228,14 @@ def fit(problem, measured, *, method: str = "freq", noise=(None, None), shapes: 
     return out
 
 
-def _run(problem, cfgs, p0, k, n, solver, max_iter, tol_freq_pct, say):
-    """The driver's fit from ``p0`` (start ``k`` of ``n``)."""
+def _run(problem, cfgs, p0, k, n, solver, tol, say):
+    """The driver's fit from ``p0`` (start ``k`` of ``n``); ``tol``: (max_iter, tol_freq_pct, tol_param_pct)."""
     if n > 1:
         say(f"start {k + 1} of {n}: {_values(problem, p0)}")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RankDeficiencyWarning)
-        return update(cfgs, p0, solver=solver, bounds=problem.bounds, log_scale=problem.log_scale, max_iter=max_iter,
-                      tol_freq_pct=tol_freq_pct, progress=lambda h: say(_progress_line(h)))
+        return update(cfgs, p0, solver=solver, bounds=problem.bounds, log_scale=problem.log_scale, max_iter=tol[0],
+                      tol_freq_pct=tol[1], tol_param_pct=tol[2], progress=lambda h: say(_progress_line(h)))
 
 
 def _progress_line(h) -> str:

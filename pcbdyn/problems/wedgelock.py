@@ -23,6 +23,7 @@ from scipy.stats import chi2 as chi2_dist
 
 from ..testdata import TestDataError
 from . import guides
+from ..updating.driver import evaluate
 from ..updating.scan import grid
 from .extremes import Extreme, correlate_extreme, mesh_errors
 from .fit import DEFAULT_NOISE
@@ -219,7 +220,7 @@ def _step2(result: WedgeLockResult, board, tests, per_guide, noise, h, min_mac, 
     shared = result.shared
     if shared.n < 2:
         raise _too_few(shared.n, 2, "a stiffness", result.clamped)
-    misfit = float(chi2_dist.sf(shared.chi2, shared.n - 1)) < ALPHA
+    misfit = float(chi2_dist.sf(shared.chi2, shared.n - 1)) < ALPHA or shared.fit.verdict["fits"] is False
     if len(names) > 1 and (per_guide or (per_guide is None and misfit and shared.n >= len(names) + 1)):
         say(f"fitting one stiffness per guide from {shared.values['k_rot']:.4g} N*m/rad/m")
         pg_model = SpringModel(board, tests, guides.spring_groups(board, True), bounds, sigma, noise,
@@ -228,10 +229,7 @@ def _step2(result: WedgeLockResult, board, tests, per_guide, noise, h, min_mac, 
         pg = result.per_guide
         if pg.n < len(names) + 1:
             raise _too_few(pg.n, len(names) + 1, "one stiffness per guide", result.clamped)
-        common = _common(shared.after, pg.after)
-        result.tests["per_guide_vs_shared"] = significance(
-            model.chi2(shared.after, common)[0], model.chi2(pg.after, common)[0], sum(map(len, common)),
-            len(names) - 1, len(names))
+        result.tests["per_guide_vs_shared"] = _per_guide_vs_shared(model, shared, pg, len(names))
         if per_guide or result.tests["per_guide_vs_shared"]["significant"]:
             result.chosen = pg
     fit = result.chosen
@@ -254,6 +252,20 @@ def _step2(result: WedgeLockResult, board, tests, per_guide, noise, h, min_mac, 
                          f"{result.clamped.max_abs_freq_error_pct:.2f} %), but springs do not explain the test "
                          f"significantly better ({what}): the rest of the error is not the guides' (as the thesis "
                          "concludes for its card, section 7.4.2); look elsewhere in the model (pcbdyn diagnose)")
+
+
+def _per_guide_vs_shared(model, shared, pg, n_guides: int) -> dict:
+    """The F test of one stiffness per guide against one shared (:func:`.spring_fit.significance`): on the
+    per-guide fit's own objective when the shapes joined it (the shared stiffness on every guide is that
+    model too; the frequencies of a nearly symmetric card barely tell the two apart), else on the frequencies
+    of the modes paired in both."""
+    if pg.fit.shapes:
+        chi2_shared = evaluate(pg.fit.configs, np.full(n_guides, shared.values["k_rot"]))[1]
+        v = pg.fit.verdict
+        return significance(chi2_shared, v["chi2"], v["dof"] + n_guides, n_guides - 1, n_guides)
+    common = _common(shared.after, pg.after)
+    return significance(model.chi2(shared.after, common)[0], model.chi2(pg.after, common)[0],
+                        sum(map(len, common)), n_guides - 1, n_guides)
 
 
 def _common(a, b) -> list:

@@ -17,7 +17,7 @@ def test_the_python_api_example_runs_and_recovers_the_parameter(tmp_path, capsys
         exec(compile(code, "README.md", "exec"), scope)
     finally:
         os.chdir(here)
-    values = scope["problem"].values(scope["result"].p)
-    assert abs(values["t_PGA"] / 4.2e-3 - 1) < 0.05
-    assert scope["after"][0]["max_freq_error_pct"] < scope["before"][0]["max_freq_error_pct"]
+    result = scope["result"]
+    assert abs(result.values["t_PGA"] / 4.2e-3 - 1) < 0.05 and result.status == "converged"
+    assert result.after[0]["max_freq_error_pct"] < result.before[0]["max_freq_error_pct"]
     assert "# The thesis' six-part test card" in (tmp_path / "board.updated.toml").read_text()
