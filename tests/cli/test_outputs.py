@@ -53,12 +53,12 @@ def test_a_study_whose_out_is_a_file_fails_before_the_shots(tmp_path):
 
 
 def test_update_on_the_thesis_data_says_the_model_cannot_fit(card, tmp_path):
-    """Table 7.2 data, four parameters (issue 40): the card's model cannot fit its test within the noise and
-    its mesh error (chi^2 far above its degrees of freedom), E_board ends on its bound and configuration c3
+    """Table 7.2 data, four parameters (issue 40): the card's model cannot fit its test within the noise
+    (chi^2 far above its degrees of freedom; with the mesh error in the noise it is still 3184 over 19), E_board ends on its bound and configuration c3
     ends worse than it started: the status says so instead of "converged", and no updated board is
     written without --force."""
     js = tmp_path / "u.json"
-    r = run(["update", card, "--frequencies", TABLE, "--out", tmp_path / "out", "--json", js])
+    r = run(["update", card, "--frequencies", TABLE, "--out", tmp_path / "out", "--json", js, "--no-mesh-check"])
     assert r.exit_code == 0, r.output
     data = json.loads(js.read_text())
     assert data["status"] == "cannot fit" and not data["verdict"]["fits"]
