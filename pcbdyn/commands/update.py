@@ -112,7 +112,8 @@ def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping,
             data = measured_configurations(board, test_uff, configs)
         done(t0)
         n_tests = len(check) if method.startswith("frf") else len(data)
-        t0 = step(f"updating {len(problem.names)} parameter(s) with {method}/{solver} on {n_tests} test configuration(s)")
+        t0 = step(f"updating {len(problem.names)} parameter(s) with {method}/{solver} on {n_tests} test "
+                  "configuration(s)")
         if method.startswith("frf"):
             blocks = f" ({len(cfgs)} equation blocks)" if len(cfgs) != len(check) else ""
             click.echo(f"    {len(cfgs)} FRF configuration(s){blocks}", err=True)
@@ -121,7 +122,8 @@ def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping,
             what, fitted = outcome(problem, res, before, after), None
         else:
             fitted = fit(problem, data, method=method, noise=noise, mesh_check=mesh_check, solver=solver,
-                         max_iter=max_iter, tol_freq_pct=tol_pct, progress=lambda msg: click.echo(f"    {msg}", err=True))
+                         max_iter=max_iter, tol_freq_pct=tol_pct,
+                         progress=lambda msg: click.echo(f"    {msg}", err=True))
             res, before, after = fitted.result, fitted.before, fitted.after
             what = {"status": fitted.status, "details": fitted.details}
         done(t0)

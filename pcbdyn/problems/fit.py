@@ -190,7 +190,8 @@ def fit(problem, measured, *, method: str = "freq", noise=(None, None), shapes: 
     if method == "freq" and all(m.shapes is not None for _, _, m in tests) and shapes != "never":
         weak = weak_directions(base, problem.p0, problem.names) if shapes == "auto" else ["asked for"]
         if weak:
-            why = "asked for" if shapes == "always" else f"the frequencies at the start do not determine {'; '.join(weak)}"
+            why = ("asked for" if shapes == "always" else
+                   f"the frequencies at the start do not determine {'; '.join(weak)}")
             method = "modal"
             say(f"mode shapes join the objective: {why}")
 
@@ -218,13 +219,15 @@ def fit(problem, measured, *, method: str = "freq", noise=(None, None), shapes: 
         res = replace(more, history=history, iterations=len(history) - 1, best_iteration=len(history) - 1)
         runs[best], keys[best] = res, (res.history[-1]["unpaired"], res.history[-1]["objective"])
     before, after = correlation_state(check, problem.p0), correlation_state(check, res.p)
-    out = Fit(problem, cfgs, res.p, res, before, after, "", [], _verdict(cfgs, res.p, problem),
+    judged = cfgs if method in ("freq", "modal") else configurations(problem, tests, "freq", f_pct, shape_pct, model,
+                                                                     min_mac, model is not None)
+    out = Fit(problem, cfgs, res.p, res, before, after, "", [], _verdict(judged, res.p, problem),
               {"frequency_pct": f_pct, "shape_pct": shape_pct if method == "modal" else None,
                "stated": list(stated), "model_error": model is not None},
               [{"start": s, "end": r.p, "objective": key[1], "unpaired": key[0], "kept": k == best}
                for k, (s, r, key) in enumerate(zip(starts, runs, keys))],
               None if sc is None else sc.to_dict(problem.names), why)
-    _judge(out, cfgs)
+    _judge(out, cfgs if method in ("freq", "modal") else None)
     return out
 
 
@@ -234,8 +237,9 @@ def _run(problem, cfgs, p0, k, n, solver, tol, say):
         say(f"start {k + 1} of {n}: {_values(problem, p0)}")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RankDeficiencyWarning)
-        return update(cfgs, p0, solver=solver, bounds=problem.bounds, log_scale=problem.log_scale, max_iter=tol[0],
-                      tol_freq_pct=tol[1], tol_param_pct=tol[2], progress=lambda h: say(_progress_line(h)))
+        return update(cfgs, p0, solver=solver, bounds=problem.bounds, log_scale=problem.log_scale,
+                      max_iter=tol[0], tol_freq_pct=tol[1], tol_param_pct=tol[2],
+                      progress=lambda h: say(_progress_line(h)))
 
 
 def _progress_line(h) -> str:
@@ -266,18 +270,25 @@ def _verdict(cfgs, p, problem) -> dict:
 
 
 def _judge(out: Fit, cfgs) -> None:
-    """``status`` and ``details`` of a finished fit (module docstring)."""
+    """``status`` and ``details`` of a finished fit (module docstring); the directions the data leave open
+    from ``cfgs``, rows in noise units (None: from the rank of the last solve, for QMS and FBM)."""
     prob, res = out.problem, out.result
     lo, hi = prob.bounds
     out.at_bounds = {n: "lower" if np.isclose(v, a, rtol=1e-6) else "upper" for n, v, a, b in
                      zip(prob.names, out.p, lo, hi) if np.isclose(v, a, rtol=1e-6) or np.isclose(v, b, rtol=1e-6)}
     out.worse = worse_configurations(out.before, out.after)
     free = [j for j, n in enumerate(prob.names) if n not in out.at_bounds]
-    out.undetermined = weak_directions(cfgs, out.p, prob.names, free) if free else []
+    if cfgs is None:
+        sol = res.solution
+        out.undetermined = [] if sol is None or not sol.rank_deficient else undetermined_directions(
+            sol.null_space.T[:3], prob.names)
+    else:
+        out.undetermined = weak_directions(cfgs, out.p, prob.names, free) if free else []
     v = out.verdict
     noise = f"frequency noise {out.noise['frequency_pct']:g} %" + (
         f", shape noise {out.noise['shape_pct']:g} %" if out.noise["shape_pct"] is not None else "")
-    noise += "" if all(out.noise["stated"][:1 + (out.noise["shape_pct"] is not None)]) else " (assumed; state it with --noise)"
+    if not all(out.noise["stated"][:1 + (out.noise["shape_pct"] is not None)]):
+        noise += " (assumed; state it with --noise)"
     d = []
     if v["chi2"] is not None:
         model = ", and the model error" if out.noise["model_error"] else ""

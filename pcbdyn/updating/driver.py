@@ -4,14 +4,15 @@ region.
 Every iteration solves the stacked equations of :func:`.iteration.build_equations` for relative changes
 x = dp/p (or d ln p on a log scale) and tries p <- p (1 + x). A trial is kept only when it lowers the
 objective (:func:`.iteration.objective_rows`: the paired frequency errors in units of their noise, with
-the shapes' for "modal"; ||b|| for the FRF methods), a trial that pairs fewer measured modes never being
-better (the FRF methods' equation errors are no such objective: their steps are all kept, the iterate
-of least ||b|| returned). A rejected trial shrinks the region (the largest |x| allowed) to a quarter of its step; a kept one
-that reached the region's edge doubles it. The first step is the thesis' full step, so a fit whose
-linearisation holds runs as the thesis runs it; one that starts far off (tens of percent, decades) moves
-as far as the linearisation is trusted instead of overshooting into a worse model. The objective never
-rises, so there is no divergence: a fit stops converged (eqs. 7.2-7.4), at the iteration limit, or
-stalled where no step however short lowers the objective.
+the shapes' for "modal"), a trial that pairs fewer measured modes never being better. A rejected trial
+shrinks the region (the largest |x| allowed) to a quarter of its step; a kept one that reached the
+region's edge doubles it. The first step is the thesis' full step, so a fit whose linearisation holds
+runs as the thesis runs it; one that starts far off (tens of percent, decades) moves as far as the
+linearisation is trusted instead of overshooting into a worse model. The objective never rises, so there
+is no divergence: a fit stops converged (eqs. 7.2-7.4, or at a minimum: the full step would gain less
+than :data:`MIN_GAIN`), at the iteration limit, or stalled where no step however short lowers the
+objective. The FRF methods' equation errors are no objective of that kind: their steps are all kept and
+the iterate of least ||b|| returned.
 """
 
 from __future__ import annotations
@@ -167,7 +168,8 @@ def update(
     while True:
         it = len(history) - 1
         if have_f and entry["max_freq_error_pct"] < tol_freq_pct:
-            converged, reason = True, f"max frequency error {entry['max_freq_error_pct']:.3g} % < {tol_freq_pct} % (eq. 7.2)"
+            converged = True
+            reason = f"max frequency error {entry['max_freq_error_pct']:.3g} % < {tol_freq_pct} % (eq. 7.2)"
             break
         if it >= 1 and full_steps[-1] and np.max(np.abs(history[-2]["proposed"])) * 100 < tol_param_pct:
             converged, reason = True, f"max parameter change < {tol_param_pct} % (eq. 7.3)"
@@ -175,7 +177,8 @@ def update(
         if have_f and it >= 3 and all(full_steps[-3:]):
             s = [h["sigma"] for h in history[-4:]]
             if np.mean(np.abs(np.diff(s))) * 100 < tol_sigma_pct:
-                converged, reason = True, f"frequency residue changed < {tol_sigma_pct} % over three iterations (eq. 7.4)"
+                converged = True
+                reason = f"frequency residue changed < {tol_sigma_pct} % over three iterations (eq. 7.4)"
                 break
         if it == max_iter:
             break
@@ -216,7 +219,8 @@ def update(
                 reason = f"at a minimum: the full step would lower the objective by only {first[2]:.2g}"
             elif searched:
                 stalled = True
-                reason = f"stalled: the line search (eq. 7.6) found no decrease of the frequency residue at iteration {it}"
+                reason = ("stalled: the line search (eq. 7.6) found no decrease of the frequency residue at "
+                          f"iteration {it}")
             else:
                 stalled = True
                 reason = (f"stalled at iteration {it}: no step along the equations' solution lowers the objective "

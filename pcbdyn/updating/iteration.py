@@ -37,8 +37,8 @@ class Configuration:
     frf_omegas, H_x, excitation: updating frequencies [rad/s], measured receptances
         (n_meas, n_freq) and the excited model DOF for the FRF methods.
     method: one of METHODS ("modal": frequencies and MAC-paired shapes in units of their noise,
-        :mod:`.shapes`; needs ``sigma`` and ``shape_noise``). matching: "expand" (dynamic expansion of the data) or "reduce"
-        (Guyan reduction of the model) when P is not None. damping: treatment of unknown damping
+        :mod:`.shapes`; needs ``sigma`` and ``shape_noise``). matching: "expand" (dynamic expansion of
+        the data) or "reduce" (Guyan reduction of the model) when P is not None. damping: treatment of unknown damping
         in the data (appendix A): any of equations.DAMPING_TREATMENTS for "frf-in",
         "undamped"/"proportional" for "frf-out".
     sigma: standard deviations of the equations' rows (chi-squares weights, eq. 4.28; for the

@@ -57,6 +57,16 @@ def test_mirror_basins_are_scanned_and_the_shapes_choose():
     assert mirror[1] > 1e3 * max(evaluate([configuration("modal")], res.p)[1], 1e-12)
 
 
+def test_at_most_three_parameters_are_scanned_the_widest_first():
+    """Log-scale parameters and those whose bounds span a decade are scanned, three at most, the widest
+    first; a bound at zero spans three decades either side of the start."""
+    p0 = np.array([1.0, 1.0, 1.0, 1.0, 1.0])
+    lo, hi = np.array([0.5, 1e-2, 0.0, 1e-1, 0.9]), np.array([2.0, 1e2, 100.0, 1e1, 1.1])
+    got = scanned(p0, (lo, hi), log_scale=[4])
+    assert [j for j, _, _ in got] == [2, 1, 3]  # 5 decades (0 -> 1e-3), 4, 2; the log one (0.09 decades) is left
+    assert got[0][1:] == (1e-3, 100.0)
+
+
 def test_shape_derivatives_match_nelson():
     """The modal sum over every mode is Nelson's exact derivative; over the lowest four modes of a
     ten-mass chain it misses the rest, which the quasi-static correction brings back to within 3 % (from 48 %)."""
