@@ -7,8 +7,9 @@ springs only if they explain the test significantly better than clamped guides. 
 FILE.csv`` (configuration, mode, frequency_hz) test mode n pairs with model mode n.
 
 Writes the tables (extremes, stiffness, before/after), the iteration history and the frequencies
-against the stiffness (``--out``), ``<board>.updated.toml`` with the fitted stiffness (springs only: into
-``--out``, else beside the board, never over an earlier one unless ``--force``), and ``--json``."""
+against the stiffness (``--out``), ``<board>.updated.toml`` with the fitted stiffness (springs whose fit
+converged only, unless ``--force``: into ``--out``, else beside the board, never over an earlier one
+unless ``--force``), and ``--json``."""
 
 from __future__ import annotations
 
@@ -38,7 +39,8 @@ from .common import (PROBE_TOL, done, fail, folder_outputs, input_errors, librar
 @click.option("--max-iter", type=click.IntRange(min=1), default=20, show_default=True)
 @folder_outputs("folder for board.updated.toml (springs only), the tables and pictures (default: board.updated.toml "
                 "beside the board)", "write the extremes, the decision, the stiffness, before/after and the history as "
-                "JSON", force="replace an earlier board.updated.toml beside the board (default: a numbered name)")
+                "JSON", force="replace an earlier board.updated.toml beside the board (default: a numbered name), "
+                              "and write it even when the spring fit did not converge")
 @library_option()
 def command(board_toml, test_uff, configs, freq_csv, per_guide, tol_pct, noise, min_mac, mesh_size, max_iter, out,
             force, json_path):
@@ -81,7 +83,11 @@ def command(board_toml, test_uff, configs, freq_csv, per_guide, tol_pct, noise, 
     for text in tables.values():
         click.echo("\n" + text)
     d["updated_board"] = None
-    if d["decision"] == "springs":
+    status = next((f["status"] for f in d["fits"].values() if f["chosen"]), None)
+    if d["decision"] == "springs" and status != "converged" and not force:
+        click.echo(f"\nno updated board written: the spring fit did not converge ({status}); --force writes it anyway",
+                   err=True)
+    elif d["decision"] == "springs":
         try:
             dst = result.chosen.problem.write_updated(result.chosen.result.p,
                                                       result_path(out, board_toml, "updated", force),
