@@ -11,7 +11,8 @@ the answer, and what it means.
 2. Shapes: when the frequency equations at the start do not determine every parameter (numerically
    rank-deficient, or a direction whose standard deviation exceeds :data:`UNDETERMINED_SD`) and the test
    has shapes, the shapes join the objective (:mod:`pcbdyn.updating.shapes`, method "modal"), in units of
-   their stated noise (2 % assumed when none is stated).
+   their stated noise (when none is stated: 2 % to start with, then what the fit's shape residual shows,
+   :func:`shape_noise_estimate`, and the fit finished with that).
 3. Starts: parameters on a log scale or with wide bounds are scanned (:mod:`pcbdyn.updating.scan`); each
    basin found is fitted, the best kept and the others reported.
 4. The fit: the trust-region iteration of :func:`pcbdyn.updating.driver.update`.
@@ -209,26 +210,52 @@ def fit(problem, measured, *, method: str = "freq", noise=(None, None), shapes: 
     keys = [(r.history[-1]["unpaired"], r.history[-1]["objective"]) for r in runs]
     best = min(range(len(runs)), key=lambda k: keys[k])
     res = runs[best]
+    if method == "modal" and not stated[1]:
+        shape_pct = shape_noise_estimate(cfgs, res.p)
+        say(f"the shapes' residual says their noise is {shape_pct:.3g} % (uniform bound): refitted with it")
+        cfgs = build(model)
+        res = _more(res, _run(problem, cfgs, res.p, 0, 1, solver, tol, say))
     if mesh_check:
         say("the model on a mesh twice as fine at the fitted parameters (its mesh error)")
         model = model_errors(problem, tests, res.p, correlation_state(check, res.p))
         cfgs = build(model)
         check = configurations(problem, tests, "freq", f_pct, shape_pct, model, min_mac)
-        more = _run(problem, cfgs, res.p, 0, 1, solver, tol, say)
-        history = res.history + [{**h, "iteration": len(res.history) + k} for k, h in enumerate(more.history[1:])]
-        res = replace(more, history=history, iterations=len(history) - 1, best_iteration=len(history) - 1)
-        runs[best], keys[best] = res, (res.history[-1]["unpaired"], res.history[-1]["objective"])
+        res = _more(res, _run(problem, cfgs, res.p, 0, 1, solver, tol, say))
+    runs[best], keys[best] = res, (res.history[-1]["unpaired"], res.history[-1]["objective"])
     before, after = correlation_state(check, problem.p0), correlation_state(check, res.p)
     judged = cfgs if method in ("freq", "modal") else configurations(problem, tests, "freq", f_pct, shape_pct, model,
                                                                      min_mac, model is not None)
     out = Fit(problem, cfgs, res.p, res, before, after, "", [], _verdict(judged, res.p, problem),
               {"frequency_pct": f_pct, "shape_pct": shape_pct if method == "modal" else None,
+               "shape_estimated": method == "modal" and not stated[1],
                "stated": list(stated), "model_error": model is not None},
               [{"start": s, "end": r.p, "objective": key[1], "unpaired": key[0], "kept": k == best}
                for k, (s, r, key) in enumerate(zip(starts, runs, keys))],
               None if sc is None else sc.to_dict(problem.names), why)
     _judge(out, cfgs if method in ("freq", "modal") else None)
     return out
+
+
+def _more(res, more):
+    """The run ``more`` that went on from ``res``'s end, its history joined to ``res``'s."""
+    history = res.history + [{**h, "iteration": len(res.history) + k} for k, h in enumerate(more.history[1:])]
+    return replace(more, history=history, iterations=len(history) - 1, best_iteration=len(history) - 1)
+
+
+def shape_noise_estimate(cfgs, p) -> float:
+    """The shape noise [%, uniform bound] the residual of the paired shapes of the "modal" ``cfgs`` at ``p``
+    shows: sqrt 3 times the rms of each mode's residual relative to its rms, over the modes (the model's
+    error in the shapes counts in it, as it should in their weight)."""
+    (_, _), _, states = build_equations(cfgs, p)
+    ratios = []
+    for c, st in zip(cfgs, states):
+        if c.method != "modal" or st.get("set_aside"):
+            continue
+        for a, k in enumerate(st["used"]):
+            d, u = np.asarray(c.phi_x, float)[:, k], st["phi_am"][:, a]
+            r = d - (u @ d) / (u @ u) * u
+            ratios.append(np.mean(r**2) / np.mean(d**2))
+    return float(100.0 * math.sqrt(3.0 * np.mean(ratios)))
 
 
 def _run(problem, cfgs, p0, k, n, solver, tol, say):
@@ -287,8 +314,10 @@ def _judge(out: Fit, cfgs) -> None:
     v = out.verdict
     noise = f"frequency noise {out.noise['frequency_pct']:g} %" + (
         f", shape noise {out.noise['shape_pct']:g} %" if out.noise["shape_pct"] is not None else "")
-    if not all(out.noise["stated"][:1 + (out.noise["shape_pct"] is not None)]):
-        noise += " (assumed; state it with --noise)"
+    if out.noise["shape_estimated"]:
+        noise += " (the shapes' estimated from their residual)"
+    if not out.noise["stated"][0]:
+        noise += " (the frequencies' assumed; state it with --noise)"
     d = []
     if v["chi2"] is not None:
         model = ", and the model error" if out.noise["model_error"] else ""

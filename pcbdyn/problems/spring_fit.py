@@ -18,7 +18,7 @@ from scipy.stats import f as f_dist
 from ..updating.iteration import build_equations
 from ..updating.solvers import covariance
 from . import guides
-from .fit import configurations, fit
+from .fit import DEFAULT_NOISE, configurations, fit
 from .problem import UpdateProblem
 from .run import correlation_state
 
@@ -126,8 +126,6 @@ class SpringModel:
         self.configs = configurations(self.problem, self.tests, "freq", *self._noise(), model, min_mac)
 
     def _noise(self) -> tuple:
-        from .fit import DEFAULT_NOISE
-
         return tuple(v if v is not None else d for v, d in zip(self.noise, DEFAULT_NOISE))
 
     def state(self, p) -> list | None:
