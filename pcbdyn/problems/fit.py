@@ -4,10 +4,12 @@ the answer, and what it means.
 
 1. Weights: every measured frequency in units of its noise (a uniform bound f %, eq. 5.72: standard
    deviation f / sqrt 3 %, 0.2 % when none is stated) and of the model's own error where known (mesh
-   error, in quadrature), so that chi^2 judges the fit (eq. 4.28). A known mesh error is also taken out:
-   the model is fitted to the frequencies its own mesh would show for the test structure, f_x (1 + e),
-   so that the parameters do not absorb it (a coarse card is too stiff, and a fitted guide stiffness
-   comes out soft to make up for it; the correlation tables keep the measured frequencies).
+   error, in quadrature), so that chi^2 judges the fit (eq. 4.28). A known mesh error (given, or found by
+   the mesh check: the model on a mesh twice as fine at the fitted parameters, after which the fit is
+   finished) is also taken out: the model is fitted to the frequencies and shapes its own mesh would show
+   for the test structure, so that the parameters do not absorb it (a coarse card is too stiff, and a
+   fitted guide stiffness comes out soft to make up for it; the correlation tables keep the measured
+   frequencies).
 2. Shapes: when the frequency equations at the start do not determine every parameter (numerically
    rank-deficient, or a direction whose standard deviation exceeds :data:`UNDETERMINED_SD`) and the test
    has shapes, the shapes join the objective (:mod:`pcbdyn.updating.shapes`, method "modal"), in units of
@@ -17,7 +19,7 @@ the answer, and what it means.
    basin found is fitted, the best kept and the others reported.
 4. The fit: the trust-region iteration of :func:`pcbdyn.updating.driver.update`.
 5. The verdict, the first that applies: "cannot fit" (chi^2 above what its degrees of freedom allow at
-   :data:`ALPHA_FIT`), "error grew" (a configuration ends worse than it started), "on a bound", "not
+   :data:`ALPHA_FIT`, or fewer than :data:`MIN_PAIRED` of the measured modes paired), "error grew" (a configuration ends worse than it started), "on a bound", "not
    determined" (with the direction the data leave open), "not converged", "converged". Only a
    "converged" fit succeeded.
 
