@@ -149,9 +149,8 @@ class _Ritz:
         self.cfg = cfg
         self.n = cfg.n_modes or 2 * np.size(cfg.f_x) + 4
         Phi = np.hstack([solve_modes(*cfg.model(p)[:2], self.n)[1] for p in anchors])
-        Q, R = np.linalg.qr(Phi)
-        d = np.abs(np.diag(R))
-        B = Q[:, d > 1e-8 * d.max()]
+        U, sv, _ = np.linalg.svd(Phi, full_matrices=False)
+        B = U[:, sv > 1e-10 * sv[0]]
         self.indices = [j for j, _, _ in ranges]
         self.nodes = [0.5 * (a + b) + 0.5 * (b - a) * CHEBYSHEV for _, a, b in ranges]
         self.Kr = np.empty((NODES,) * len(ranges) + (B.shape[1],) * 2)

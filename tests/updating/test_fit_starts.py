@@ -1,9 +1,11 @@
 """Fits that find the answer from far off (issue 40), on plain matrices: a mirror-symmetric chain whose two
-end springs the frequencies cannot tell apart (two basins of the scan; the shapes decide, and their
-Jacobian is the exact one), and a string updated from 60 % off inside the trust region."""
+end springs the frequencies cannot tell apart (two basins of the scan; the shapes decide), the shape
+derivatives against Nelson's, which parameters are scanned, and three springs scanned jointly on the
+Rayleigh-Ritz reanalysis of a long chain."""
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 
 from pcbdyn.updating import Configuration, solve_modes, update
 from pcbdyn.updating.driver import evaluate
@@ -91,3 +93,39 @@ def test_shape_derivatives_match_nelson():
         modal = eigenvector_derivatives_modal(lam[:4], Phi[:, :4], 0, dKs, dMs)[:, j]
         err, err_modal = (np.linalg.norm(v - exact) / np.linalg.norm(exact) for v in (D[j, :, 0], modal))
         assert err < 0.03 and err < 0.1 * err_modal, (err, err_modal)
+
+
+def long_chain(n: int = 1200):
+    """``n`` unit masses in a row on springs of 1e6 N/m, held at both ends, three of whose springs (at
+    1/12, 5/12 and 9/12 of the length) are the parameters: big enough to be scanned on the reanalysis."""
+    where = [n // 12, 5 * n // 12, 9 * n // 12]
+
+    def springs(k):
+        return sp.diags([k[:-1] + k[1:], -k[1:-1], -k[1:-1]], [0, 1, -1], format="csc")
+
+    K0 = springs(np.where(np.isin(np.arange(n + 1), where), 0.0, 1e6))
+    dKs = [springs(np.eye(n + 1)[i]) for i in where]
+    M = sp.identity(n, format="csc")
+    return lambda p: (K0 + sum(pj * d for pj, d in zip(p, dKs)), M, dKs, [sp.csc_matrix((n, n))] * 3)
+
+
+@pytest.mark.filterwarnings("ignore::pcbdyn.updating.solvers.RankDeficiencyWarning")
+def test_three_parameters_scanned_jointly_on_the_reanalysis():
+    """Three springs each searched over six decades (a 6 x 6 x 6 grid) from a start 30-3000 times off: the
+    grid is solved on the Rayleigh-Ritz reanalysis, whose objective at every grid point checked equals a
+    full solve's to 1e-6, and the fit from the best start recovers all three springs."""
+    model = long_chain()
+    truth = np.array([3e4, 2e6, 3e5])
+    lam, Phi = solve_modes(*model(truth)[:2], 8)
+    f = np.sqrt(lam) / (2 * np.pi)
+    P = sp.csr_matrix((np.ones(40), (np.arange(40), np.linspace(0, 1199, 40).astype(int))), shape=(40, 1200))
+    cfg = Configuration(model, f_x=f, phi_x=P @ Phi, P=P, method="freq", sigma=1e-3 * f, n_modes=12)
+    bounds, p0 = (np.full(3, 1e3), np.full(3, 1e9)), np.full(3, 1e8)
+    sc = scan([cfg], p0, scanned(p0, bounds, [0, 1, 2]))
+    assert sc.solved == "reanalysis" and sc.keys.shape == (6, 6, 6, 2)
+    for at in [(0, 0, 0), (2, 4, 3), (5, 1, 2)]:
+        p = np.array([v[i] for v, i in zip(sc.values, at)])
+        assert sc.keys[at][1] == pytest.approx(evaluate([cfg], p)[1], rel=1e-6)
+    res = update(cfg, sc.starts[0], solver="bounded", bounds=bounds, log_scale=[0, 1, 2], tol_freq_pct=0.0,
+                 tol_param_pct=1e-4)
+    assert res.converged and np.allclose(res.p, truth, rtol=1e-4), res.p / truth
