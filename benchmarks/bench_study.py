@@ -52,7 +52,8 @@ def bundled() -> None:
         shutil.copy(root / "examples/studies/study.toml", d)
         load, t0 = os.getloadavg()[0], time.perf_counter()
         before = os.times()
-        subprocess.run([sys.executable, "-m", "pcbdyn.cli", "study", str(Path(d) / "study.toml"), "--quiet"],
+        subprocess.run([sys.executable, "-m", "pcbdyn.cli", "study", str(Path(d) / "study.toml"), "--quiet",
+                        "--out", str(Path(d) / "study_out")],
                        check=True, capture_output=True)
         after = os.times()
         cpu = (after.children_user + after.children_system) - (before.children_user + before.children_system)

@@ -7,11 +7,14 @@ it) loses its locks with the process, and a small cleaner process started with t
 (:func:`_watch`) notices the end of the run, however it ended, and removes every temporary in the
 folders the run wrote to whose lock it can take (:func:`clear_stale`); those of live writers, locked,
 stay. The next atomic write into a folder does the same, for runs the cleaner could not serve (a
-machine reset). Temporary folders (:func:`temporary_folder`) work alike.
+machine reset). Temporary folders (:func:`temporary_folder`) work alike, and a folder replaced whole
+(:func:`replaced_folder`) is filled as one beside it, then takes its place.
 """
 
 from __future__ import annotations
 
+import ctypes
+import errno
 import fcntl
 import os
 import select
@@ -24,7 +27,8 @@ from pathlib import Path
 
 #: marks pcbdyn's temporary files and folders (never a name a user would give)
 MARK = ".pcbdyn~"
-_LOCK_FILE = ".lock"
+#: the file of a temporary folder whose lock says that its run is alive
+LOCK_FILE = ".lock"
 #: this process's pipe to its cleaner: (pid of the process that opened it, write end, folders told)
 _cleaner: list = []
 
@@ -54,7 +58,7 @@ def clear_stale(folder) -> list:
     a killed run); returns their paths."""
     removed = []
     for p in Path(folder).glob(f".*{MARK}*"):
-        lock = p / _LOCK_FILE if p.is_dir() else p
+        lock = p / LOCK_FILE if p.is_dir() else p
         try:
             fd = os.open(lock, os.O_RDWR)
         except OSError:
@@ -135,21 +139,58 @@ def atomic_path(path):
 
 
 @contextmanager
-def temporary_folder(prefix: str = "pcbdyn"):
-    """A new folder in the system's temporary folder, removed after the block; one left by a killed
-    run is removed by the next use (:func:`clear_stale`)."""
-    base = Path(tempfile.gettempdir())
+def temporary_folder(prefix: str = "pcbdyn", base=None):
+    """A new folder in ``base`` (default: the system's temporary folder), removed after the block; one
+    left by a killed run is removed by the next use (:func:`clear_stale`)."""
+    base = Path(tempfile.gettempdir() if base is None else base)
     clear_stale(base)
     _watch(base)
     folder = Path(tempfile.mkdtemp(prefix=f".{prefix}{MARK}", dir=base))
-    fd = os.open(folder / f"{_LOCK_FILE}.new", os.O_RDWR | os.O_CREAT, 0o600)
+    fd = os.open(folder / f"{LOCK_FILE}.new", os.O_RDWR | os.O_CREAT, 0o600)
     fcntl.flock(fd, fcntl.LOCK_EX)
-    os.rename(folder / f"{_LOCK_FILE}.new", folder / _LOCK_FILE)  # a cleaner sees the lock file only locked
+    os.rename(folder / f"{LOCK_FILE}.new", folder / LOCK_FILE)  # a cleaner sees the lock file only locked
     try:
         yield folder
     finally:
         os.close(fd)
         shutil.rmtree(folder, ignore_errors=True)
+
+
+@contextmanager
+def replaced_folder(target):
+    """Yield a new folder beside the folder ``target`` to fill (its :data:`LOCK_FILE` aside); when the block
+    ends without an error the new folder takes ``target``'s place whole, in one step where the system can
+    (Linux: a rename exchange; elsewhere ``target`` moves aside just before), and ``target``'s former
+    content is removed. On an error, or a killed run (:func:`clear_stale`), ``target`` stays as it was and
+    the new folder goes."""
+    target = Path(target)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    with temporary_folder(target.name, base=target.parent) as new:
+        yield new
+        (new / LOCK_FILE).unlink()
+        if not target.exists():
+            os.rename(new, target)
+        elif not _exchange(new, target):
+            aside = Path(tempfile.mkdtemp(prefix=f".{target.name}{MARK}", dir=target.parent))
+            os.rename(target, aside)
+            os.rename(new, target)
+            os.rename(aside, new)  # removed with the temporary folder
+
+
+def _exchange(a: Path, b: Path) -> bool:
+    """Swap two paths in one step (Linux' renameat2 with RENAME_EXCHANGE); False where the system or the
+    file system cannot."""
+    try:
+        renameat2 = ctypes.CDLL(None, use_errno=True).renameat2
+    except (OSError, AttributeError):
+        return False
+    at_cwd, exchange = -100, 2
+    if renameat2(at_cwd, os.fsencode(a), at_cwd, os.fsencode(b), exchange) == 0:
+        return True
+    err = ctypes.get_errno()
+    if err in (errno.EINVAL, errno.ENOSYS, errno.EOPNOTSUPP):
+        return False
+    raise OSError(err, os.strerror(err), str(b))
 
 
 def unwritable(path, folder: bool) -> str | None:

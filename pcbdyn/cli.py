@@ -14,7 +14,7 @@ from pathlib import Path
 import click
 
 from .commands import (build, calibrate, correlate, diagnose, export, identify, import_kicad, library, localize,
-                       simulate_test, study, update, vibe, wedgelock)
+                       pretest, shock, simulate_test, study, update, vibe, wedgelock)
 from .process import process_settings
 
 
@@ -45,8 +45,8 @@ def main():
     process_settings()
 
 
-for _module in (build, simulate_test, correlate, update, wedgelock, localize, study, diagnose, vibe, identify,
-                import_kicad, export, calibrate, library):
+for _module in (build, pretest, simulate_test, correlate, update, wedgelock, localize, study, diagnose, vibe, shock,
+                identify, import_kicad, export, calibrate, library):
     main.add_command(_module.command)
 
 

@@ -276,6 +276,19 @@ def _unit_of(raw) -> str | None:
     return m.group(1)
 
 
+def append_entry(doc, collection: str, fields: dict, note: str) -> None:
+    """Append a table of ``fields`` to the array of tables ``collection`` of the tomlkit document ``doc``
+    (made when absent), headed by the comment ``note`` (where the entry came from); the rest of the
+    document is kept as written."""
+    table = tomlkit.table()
+    table.add(tomlkit.comment(note))
+    for key, value in fields.items():
+        table.add(key, value)
+    if collection not in doc:
+        doc.add(collection, tomlkit.aot())
+    doc[collection].append(table)
+
+
 def updated_text(text: str, assignments: dict) -> str:
     """The TOML ``text`` with each target of ``assignments`` {target: value [SI]} set (:func:`write`),
     everything else as the user wrote it."""

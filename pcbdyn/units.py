@@ -24,6 +24,10 @@ _UNIT_TOKEN = re.compile(r"\s*(?:(?P<name>[^\W\d]\w*|%)|(?P<op>\*\*|[*/·^()])|(
 _NOT_FINITE = re.compile(r"\s*[-+]?(?:nan|inf)", re.IGNORECASE)
 
 
+#: length units of measured-data files (the points CSV's columns, a UFF file without dataset 164): metres per unit
+LENGTHS = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "um": 1e-6, "in": 0.0254, "ft": 0.3048}
+
+
 class UnitError(ValueError):
     """A quantity that is missing its unit, cannot be parsed, or has the wrong dimension."""
 
@@ -68,6 +72,16 @@ def to_si(value, unit: str, where: str = "value") -> float:
             f"({dim or 'dimensionless'})"
         )
     return _finite(factor(number), value, unit, where)
+
+
+#: the unit a quantity read in the key's unit is printed in, where that reads badly in a table (a modulus in
+#: Pa: 2.6e+10)
+PRINTED = {"Pa": "GPa"}
+
+
+def printed_unit(unit: str) -> str:
+    """The unit tables print a quantity read in ``unit`` in (``PRINTED``, else ``unit`` itself)."""
+    return PRINTED.get(unit, unit)
 
 
 def from_si(value: float, unit: str) -> float:

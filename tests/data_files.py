@@ -1,6 +1,7 @@
 """Input files shared by the tests (tests/data): boards that several tests build, read as they are or
 with a few fields changed, so that no test retypes a board."""
 
+import os
 from pathlib import Path
 
 DATA = Path(__file__).resolve().parent / "data"
@@ -26,3 +27,17 @@ def write_board(tmp_path, text: str, name: str = "board.toml") -> Path:
     p = tmp_path / name
     p.write_text(text)
     return p
+
+
+#: third-party files from outside the project (../shared/realdata beside the clone; PCBDYN_REALDATA names
+#: another place, e.g. for a worktree): never committed, tests that read them skip where it is absent
+REALDATA = Path(os.environ.get("PCBDYN_REALDATA", Path(__file__).resolve().parents[1] / ".." / "shared" / "realdata"))
+
+
+def realdata(folder: str):
+    """(path of ``folder`` of the third-party files, a pytest skip mark for where it is absent)."""
+    import pytest
+
+    path = REALDATA / folder
+    return path, pytest.mark.skipif(not path.is_dir(), reason=f"the third-party test files ({path}: {folder}'s data, "
+                                                               "not part of the project) are not beside this clone")

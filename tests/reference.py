@@ -1,11 +1,10 @@
-"""The shared reference data (analytical and published values with their sources): the
-``shared/reference`` folder beside the repository, as on CI, or ``$PCBDYN_REFERENCE``."""
+"""The reference data (analytical and published values with their sources) the tests check
+against: ``tests/data/reference`` (its README.md gives each file's sources)."""
 
 import json
-import os
 from pathlib import Path
 
-REFERENCE_DIR = Path(os.environ.get("PCBDYN_REFERENCE", Path(__file__).resolve().parents[2] / "shared" / "reference"))
+REFERENCE_DIR = Path(__file__).resolve().parent / "data" / "reference"
 
 
 def load(name: str) -> dict:

@@ -128,11 +128,5 @@ def enriched_text(text: str, effects, date: str | None = None, source: str = "pc
     doc = tomlkit.parse(text)
     date = date or _dt.date.today().isoformat()
     for collection, note, fields in _entries(effects, _Names(doc)):
-        table = tomlkit.table()
-        table.add(tomlkit.comment(f"found by {source} on {date}: {note}"))
-        for key, value in fields.items():
-            table.add(key, value)
-        if collection not in doc:
-            doc.add(collection, tomlkit.aot())
-        doc[collection].append(table)
+        targets.append_entry(doc, collection, fields, f"found by {source} on {date}: {note}")
     return tomlkit.dumps(doc)

@@ -29,7 +29,8 @@ def analyse(board, config, stds: dict | None = None) -> dict:
     click.echo(f"\n{board.name} [{label}]: {mass * 1e3:.2f} g, {bm.model.n_dof} DOFs, "
                f"{sum(len(es.conn) for es in bm.model.sets.values() if es.etype in ('quad4', 'tri3'))} shells"
                + (f", {modes.n_rigid} rigid-body modes" if modes.n_rigid else ""))
-    click.echo(format_table(table) + "\n")
+    warning = empty_band(board, bm, modes, K, M)
+    click.echo(f"warning: {warning}\n" if warning else format_table(table) + "\n")
     summary = {
         "configuration": label,
         "modes": [{"n": int(row.mode), "frequency_hz": float(row.frequency_hz), "eff_mass_z": float(row.eff_mass_z),
@@ -38,13 +39,26 @@ def analyse(board, config, stds: dict | None = None) -> dict:
         "mass_kg": mass,
         "dofs": int(bm.model.n_dof),
         "rigid_body_modes": int(modes.n_rigid),
+        **({"warning": warning} if warning else {}),
     }
     return {"config": config, "model": bm, "modes": modes, "table": table, "summary": summary}
 
 
-def write_results(board, solved: dict, out: Path, pictures: bool = True) -> list:
-    """Write one solved configuration (:func:`analyse`) as CSV, VTU and PNG under ``out``; returns the
-    paths written."""
+def empty_band(board, bm, modes, K, M) -> str | None:
+    """What to say when no elastic mode lies below [analysis] f_max (an empty band is an answer, not an
+    error): the first mode above it, solved alone."""
+    f_max = board.analysis.f_max
+    if modes.frequencies.size or f_max is None:
+        return None
+    from ..fe.modal import solve_modes
+
+    first = solve_modes(bm.model, n_modes=1, K=K, M=M).frequencies
+    above = f"the first is at {first[0]:.4g} Hz" if first.size else "the model has none"
+    return f"no mode below [analysis] f_max = {f_max:g} Hz ({above}); raise f_max in {board.path.name} to see modes"
+
+
+def write_results(board, solved: dict, out: Path, pictures: bool = True) -> None:
+    """Write one solved configuration (:func:`analyse`) as CSV, VTU and PNG under ``out``."""
     from ..report.files import write_text
     from ..report.vtu import write_modes_vtu
 
@@ -54,18 +68,15 @@ def write_results(board, solved: dict, out: Path, pictures: bool = True) -> list
     write_text(out / f"{stem}.csv", solved["table"].to_csv(index=False))
     vtu = out / f"{stem}.vtu"
     write_modes_vtu(vtu, bm.model, modes.frequencies, modes.shapes)
-    files = [out / f"{stem}.csv", vtu]
     if pictures:
-        from ..report.pictures import mode_pictures, picture_names
+        from ..report.pictures import mode_pictures
 
         t0 = step(f"[{label}] rendering {modes.frequencies.size} mode-shape pictures")
         renderer = mode_pictures(vtu, bm.model, modes.frequencies, modes.shapes, out / "png", prefix=stem,
                                  title=f"{board.name} [{label}]", outlines=board.outlines(config))
-        files += [out / "png" / n for n in picture_names(stem, modes.frequencies.size)]
         done(t0)
         if renderer != "pyvista":
             click.echo("  note: 3-D rendering (pyvista) failed; the 3-D views are drawn by matplotlib", err=True)
-    return files
 
 
 def uncertainty_note(stds: dict) -> str:
@@ -95,7 +106,7 @@ def command(board_toml, config, all_configs, out, json_path, no_pictures, html, 
         if config is not None and all_configs:
             raise click.UsageError("give --config NAME or --all-configs, not both")
         configs = [None] + board.configuration_names() if all_configs else [config]
-        written, stds = [], None
+        stds = None
         if uncertainty:
             from ..problems.uncertainty import library_uncertainty
 
@@ -104,7 +115,15 @@ def command(board_toml, config, all_configs, out, json_path, no_pictures, html, 
         solved = [analyse(board, c, stds=stds) for c in configs]  # every configuration solves before any file
         results = [r["summary"] for r in solved]
         if out is not None:
-            written = [f for r in solved for f in write_results(board, r, out, pictures=not no_pictures)]
+            from ..report.manifest import replacing
+
+            with replacing(out, "pcbdyn build") as run:  # the earlier --out stays whole until all is written
+                for r in solved:
+                    write_results(board, r, run.path, pictures=not no_pictures)
+                if html:
+                    from ..report.pages import build_page
+
+                    page = run.final(build_page(run.path, board_toml, board, results))
     if json_path is not None:
         data = dict(results[0]) if len(results) == 1 else {**results[0], "configurations": results}
         data["board"] = board.name
@@ -112,14 +131,10 @@ def command(board_toml, config, all_configs, out, json_path, no_pictures, html, 
             data["uncertainty"] = {f: {"equivalent_thickness_m": v, "std_m": sd, "parts": refs}
                                    for f, (v, sd, refs) in stds.items()}
         write_json(json_path, data)
-    if html:
-        from ..report.pages import build_page
-
-        click.echo(f"page written to {build_page(out, board_toml, board, results)}", err=True)
     if out is not None:
-        from ..report.manifest import settle
-
-        removed = settle(out, written, "pcbdyn build")
-        if removed:
-            click.echo(f"removed {len(removed)} file(s) an earlier run wrote to {out}/ and this one did not", err=True)
+        if html:
+            click.echo(f"page written to {page}", err=True)
+        if run.removed:
+            click.echo(f"removed {len(run.removed)} file(s) an earlier run wrote to {out}/ and this one did not",
+                       err=True)
         click.echo(f"results written to {out}/", err=True)

@@ -24,7 +24,7 @@ from pathlib import Path
 
 import click
 
-from .common import checked_outputs, done, fail, input_errors, library_option, parse_extra, parse_noise, step, test_arguments
+from .common import checked_outputs, done, fail, input_errors, library_option, parse_extra, parse_noise, step, test_arguments, units_option
 
 
 def names(text) -> list | None:
@@ -55,6 +55,7 @@ def names(text) -> list | None:
               help="write the families, before/after and the library written as JSON ('-': standard output)")
 @checked_outputs(folders=())
 @library_option(required=True, keep=True)
+@units_option
 def command(board_toml, test_uff, configs, freq_csv, joint_toml, families, with_, method, solver, noise, max_iter,
             tol_pct, mesh_size, mesh_error, json_path, library):
     """Calibrate part families' equivalent thicknesses from modal tests into a component library."""
@@ -86,13 +87,15 @@ def command(board_toml, test_uff, configs, freq_csv, joint_toml, families, with_
         cal = calibrate(cal, method, solver, (f_pct, shape_pct), mesh_error, max_iter=max_iter, tol_freq_pct=tol_pct,
                         tol_param_pct=0.01, progress=lambda msg: click.echo(f"    {msg}", err=True))
         done(t0)
-        what = {"status": cal.fit.status, "details": cal.fit.details}
+        what = {"status": cal.fit.status, "details": cal.fit.details, "warnings": cal.fit.warnings}
         t0 = step(f"writing the library {library}")
         fams = write_library(cal, library)
         done(t0)
     click.echo(f"\n{rep.headline(cal, what['status'])}")
     for line in what["details"]:
         click.echo(f"  note: {line}")
+    for line in what["warnings"]:
+        click.echo(f"warning: {line}", err=True)
     click.echo(rep.format_families(fams))
     if cal.problem.names[len(cal.families):]:
         click.echo("\n" + rep.format_with(cal))
@@ -109,7 +112,8 @@ def command(board_toml, test_uff, configs, freq_csv, joint_toml, families, with_
         write_json(json_path, {
             "families": fams, "before": summary(cal.before), "after": summary(cal.after), "library": str(library),
             "with": rep.with_rows(cal), "method": method, "solver": solver, "noise": cal.noise,
-            "status": what["status"], "details": what["details"], "verdict": cal.fit.verdict,
+            "status": what["status"], "details": what["details"], "warnings": what["warnings"],
+            "verdict": cal.fit.verdict,
             "iterations": cal.result.iterations,
             "converged": bool(cal.result.converged), "reason": cal.result.reason,
             "boards": [str(it.structure.path) for it in cal.items],

@@ -51,10 +51,13 @@ def input_errors(*more):
         fail(" ".join(str(exc).strip("'\"").split()))  # one line, whatever a library put in the text
 
 
-def solve_structure(structure, config: str | None, n_modes: int | None = None, f_max: float | None = None):
+def solve_structure(structure, config: str | None, n_modes: int | None = None, f_max: float | None = None,
+                    min_modes: int = 0):
     """Build the FE model of one configuration of ``structure`` and solve its modes, with progress.
 
-    Returns (built model, modes, K, M). ``n_modes``/``f_max`` default to the structure's [analysis].
+    Returns (built model, modes, K, M). ``n_modes``/``f_max`` default to the structure's [analysis];
+    at least the first ``min_modes`` are returned even when they lie above ``f_max`` (a response to an
+    input below the fundamental still needs its modes and static residual).
     """
     from ..fe.assembly import assemble
     from ..fe.modal import solve_modes
@@ -68,6 +71,8 @@ def solve_structure(structure, config: str | None, n_modes: int | None = None, f
     t0 = step(f"[{label}] solving {pm.model.n_dof} DOFs for {n_modes} modes")
     K, M = assemble(pm.model)
     modes = solve_modes(pm.model, n_modes=n_modes, f_max=f_max, K=K, M=M)
+    if modes.frequencies.size < min_modes:
+        modes = solve_modes(pm.model, n_modes=min_modes, K=K, M=M)
     done(t0)
     return pm, modes, K, M
 
@@ -167,7 +172,8 @@ def check_writable(path: Path, option: str, folder: bool, shown=None) -> None:
 
 def checked_outputs(folders=("out",), files=("json_path",)):
     """A command decorator: its output options (keywords ``folders`` for folders, ``files`` for files)
-    are checked before any work (and ``--html`` needs ``--out``), so that a run never fails after its
+    are checked before any work (and ``--html`` needs ``--out``; a folder must be one a run may replace
+    whole, :func:`pcbdyn.report.manifest.unreplaceable`), so that a run never fails after its
     computation for want of a place to write; ``--json -`` writes the JSON to the standard output and the
     report to stderr."""
 
@@ -180,6 +186,12 @@ def checked_outputs(folders=("out",), files=("json_path",)):
                 for key in keys:
                     if kwargs.get(key) is not None and str(kwargs[key]) != "-":
                         check_writable(Path(kwargs[key]), OPTION_NAMES.get(key, f"--{key}"), folder)
+            for key in folders:
+                if kwargs.get(key) is not None:
+                    from ..report.manifest import unreplaceable
+
+                    if (why := unreplaceable(kwargs[key])) is not None:
+                        raise click.UsageError(f"{OPTION_NAMES.get(key, f'--{key}')} {kwargs[key]}: {why}")
             if str(kwargs.get("json_path")) == "-":
                 from ..report.files import json_to_stdout
 
@@ -248,3 +260,20 @@ def library_option(required: bool = False, keep: bool = False):
                             default=None, help=help_text)(wrapper)
 
     return decorate
+
+
+def units_option(command):
+    """The ``--units`` option of every command that reads test data: the length unit of UFF files that state
+    none (no dataset 164), for the whole command (:func:`pcbdyn.testdata.uff_geometry.stated_units`); a file
+    without one whose grid is too wide for metres is refused, naming this option."""
+    from ..units import LENGTHS
+
+    @functools.wraps(command)
+    def wrapper(*args, units=None, **kwargs):
+        from ..testdata.uff_geometry import stated_units
+
+        with stated_units(units):
+            return command(*args, **kwargs)
+
+    return click.option("--units", type=click.Choice(list(LENGTHS)), default=None,
+                        help="length unit of test files (UFF) that state none (no dataset 164); default m")(wrapper)

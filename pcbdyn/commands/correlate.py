@@ -10,7 +10,7 @@ from pathlib import Path
 import click
 
 from ..domain import MAX_MODES
-from .common import PROBE_TOL, done, fail, folder_outputs, input_errors, library_option, solve_structure, step
+from .common import PROBE_TOL, done, fail, folder_outputs, input_errors, library_option, solve_structure, step, units_option
 
 @click.command("correlate")
 @click.argument("board_toml", type=click.Path(exists=True, dir_okay=False, path_type=Path))
@@ -23,6 +23,7 @@ from .common import PROBE_TOL, done, fail, folder_outputs, input_errors, library
 @folder_outputs("folder for pairs.csv, comac.csv and the PNG pictures",
                 "write pairs, unpaired test modes and COMAC as JSON", html=True)
 @library_option()
+@units_option
 def command(board_toml, test_uff, config, min_mac, n_modes, out, json_path, html):
     """Correlate a structure's model (board.toml or box.toml, one configuration) with a modal test (UFF with
     mode shapes): pairs by MAC, frequency differences, COMAC, pictures."""
@@ -32,11 +33,12 @@ def command(board_toml, test_uff, config, min_mac, n_modes, out, json_path, html
     from ..report.correlation_report import comac_line, format_pairs, write_outputs
     from ..report.files import write_json
     from ..testdata import TestDataError
-    from ..testdata.measured import read_modes
+    from ..testdata.measured import read_test
 
     with input_errors():
         board = load_structure(board_toml)
-        test_modes = read_modes(test_uff)
+        test = read_test(test_uff)
+        test_modes = test.modes
         board.check_points(test_modes.measured_points(), test_uff)
         n_model = n_modes or min(MAX_MODES, max(board.analysis.modes, math.ceil(1.5 * test_modes.n_modes)))
         bm, modes, _, _ = solve_structure(board, config, n_modes=n_model)
@@ -60,18 +62,20 @@ def command(board_toml, test_uff, config, min_mac, n_modes, out, json_path, html
     if pairing.unpaired_test:
         click.echo(f"unpaired test modes: {', '.join(str(i + 1) for i in pairing.unpaired_test)}")
     click.echo(comac_line(corr))
+    for line in pairing.warnings(modes.frequencies):
+        click.echo(f"warning: {line}", err=True)
     written = []
     if out is not None:
-        from ..report.manifest import settle
+        from ..report.manifest import replacing
 
         t0 = step(f"writing tables and pictures to {out}")
-        written = write_outputs(out, board, bm, modes, test_modes, corr)
-        if html:
-            from ..report.pages import correlate_page
+        with replacing(out, "pcbdyn correlate") as run:  # the earlier --out stays whole until all is written
+            written = write_outputs(run.path, board, bm, modes, test_modes, corr, test.wireframe)
+            if html:
+                from ..report.pages import correlate_page
 
-            written.append(correlate_page(out, board_toml, test_uff, board, label, pairing,
-                                          dict(zip(corr.dof_labels, corr.comac.tolist())), written).name)
-        settle(out, [out / w for w in written], "pcbdyn correlate")
+                written.append(correlate_page(run.path, board_toml, test_uff, board, label, pairing,
+                                              dict(zip(corr.dof_labels, corr.comac.tolist())), written).name)
         done(t0)
         click.echo(f"results written to {out}/ ({len(written)} files)", err=True)
     if json_path is not None:
@@ -81,6 +85,7 @@ def command(board_toml, test_uff, config, min_mac, n_modes, out, json_path, html
             "test_frequencies_hz": [float(f) for f in test_modes.frequencies],
             "model_frequencies_hz": [float(f) for f in modes.frequencies],
             "mac_matrix": pairing.mac.round(6).tolist(),
+            "automac": pairing.automac.round(6).tolist(),
             "files": written,
         })
         write_json(json_path, data)

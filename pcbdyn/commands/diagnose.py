@@ -15,7 +15,7 @@ from pathlib import Path
 import click
 
 from ..diagnosis import KINDS
-from .common import done, folder_outputs, input_errors, library_option, measured_configurations, parse_noise, result_path, step
+from .common import done, folder_outputs, input_errors, library_option, measured_configurations, parse_noise, result_path, step, units_option
 
 
 @click.command("diagnose")
@@ -42,12 +42,12 @@ from .common import done, folder_outputs, input_errors, library_option, measured
                 "write effects, before/after and statistics as JSON",
                 force="replace an earlier <board>.diagnosed.toml beside the board (default: a numbered name)")
 @library_option()
+@units_option
 def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size, quick, workers, scheduler, out, force,
             json_path):
     """Find the effects a board model lacks from modal tests: TEST_UFF (with mode shapes) of the base
     configuration and NAME=FILE for each perturbed configuration of board.toml (e.g. c2=test2.uff)."""
     from ..diagnosis.pipeline import diagnose
-    from ..domain import StructureError
     from ..problems import load_structure
     from ..report import diagnosis_report as rep
     from ..report.files import write_json, write_text
@@ -73,24 +73,17 @@ def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size,
     click.echo(rep.format_effects(d.effects))
     click.echo("")
     click.echo(rep.format_states(d.before, d.parameters_only, d.after))
-    enriched, written = None, []
-    if d.effects:
-        try:
-            enriched = board.write_enriched(rep.enriched_effects(d), result_path(out, board_toml, "diagnosed", force))
-            written.append(enriched)
-            click.echo(f"\nboard with the effects declared written to {enriched}", err=True)
-        except StructureError as exc:
-            click.echo(f"\nnote: the enriched board.toml was not written: {exc}", err=True)
-    if out is not None:
-        from ..report.manifest import settle
+    if out is None:
+        enriched = _enriched(board, d, result_path(None, board_toml, "diagnosed", force))
+    else:
+        from ..report.manifest import replacing
 
-        written += [out / "effects.txt", out / "correlation.txt"]
-        write_text(written[-2], rep.format_effects(d.effects) + "\n")
-        write_text(written[-1], rep.format_states(d.before, d.parameters_only, d.after) + "\n")
-        if d.evidence:
-            written.append(out / "evidence.png")
-            rep.plot_evidence(written[-1], board, d.evidence, d.effects)
-        settle(out, written, "pcbdyn diagnose")
+        with replacing(out, "pcbdyn diagnose") as run:  # the earlier --out stays whole until all is written
+            enriched = _enriched(board, d, result_path(run.path, board_toml, "diagnosed"), run.final)
+            write_text(run.path / "effects.txt", rep.format_effects(d.effects) + "\n")
+            write_text(run.path / "correlation.txt", rep.format_states(d.before, d.parameters_only, d.after) + "\n")
+            if d.evidence:
+                rep.plot_evidence(run.path / "evidence.png", board, d.evidence, d.effects)
     if json_path is not None:
         write_json(json_path, {
             "effects": d.effects, "noise_only": d.noise_only, "message": d.message,
@@ -98,3 +91,20 @@ def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size,
             "after": rep.summary(d.after), "parameters": d.parameters, "statistics": d.statistics,
             "enriched_board": None if enriched is None else str(enriched),
         })
+
+
+def _enriched(board, d, path, final=lambda p: p):
+    """The board with the effects found declared, written to ``path`` (None when there are none, or when it
+    cannot be written: said why); returns where it ends up (``final`` of the path written)."""
+    from ..domain import StructureError
+    from ..report import diagnosis_report as rep
+
+    if not d.effects:
+        return None
+    try:
+        enriched = final(board.write_enriched(rep.enriched_effects(d), path))
+    except StructureError as exc:
+        click.echo(f"\nnote: the enriched board.toml was not written: {exc}", err=True)
+        return None
+    click.echo(f"\nboard with the effects declared written to {enriched}", err=True)
+    return enriched

@@ -35,7 +35,8 @@ def changed_quantities(base, updated, base_name: str, updated_name: str) -> dict
               help="board.updated.toml from 'pcbdyn update': export its values (same board, same mesh)")
 @click.option("--config", default=None, help="configuration name from [[configurations]]")
 @click.option("--modes", "n_modes", type=click.IntRange(1, MAX_MODES), default=None,
-              help="modes asked for on EIGRL (default: [analysis] modes of the board)")
+              help="elastic modes asked for on EIGRL, which adds a free board's rigid-body modes (default: [analysis] "
+                   "modes of the board)")
 @click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="write the card counts, mass, changed values and notes as JSON")
 @checked_outputs(folders=(), files=("json_path", "bdf"))
@@ -69,7 +70,8 @@ def command(board_toml, bdf, updated, config, n_modes, json_path):
     except (BoardError, ModelError) as exc:
         fail(str(exc))
     click.echo(f"\n{bm.board.name} [{config or 'base'}]: {mass * 1e3:.3f} g, {bm.model.n_nodes} nodes "
-               f"(+{deck.extra_grids} extra grids), EIGRL {n} modes")
+               f"(+{deck.extra_grids} extra grids), EIGRL {n + deck.rigid_modes} modes ({n} elastic"
+               + (f" and the {deck.rigid_modes} rigid-body modes Nastran counts)" if deck.rigid_modes else ")"))
     click.echo("  ".join(f"{k} {v}" for k, v in sorted(deck.counts.items())))
     for k, (a, b) in changed.items():
         click.echo(f"updated: {k} {a:.6g} -> {b:.6g} (SI)")
@@ -80,6 +82,7 @@ def command(board_toml, bdf, updated, config, n_modes, json_path):
         write_json(json_path, {
             "board": bm.board.name, "configuration": config or "base", "source": str(source), "nastran": str(bdf),
             "cards": dict(sorted(deck.counts.items())), "mass_kg": mass, "modes": n,
+            "eigrl_nd": n + deck.rigid_modes,
             "sets": deck.sets, "extra_grids": deck.extra_grids, "notes": deck.notes,
             "updated": {k: {"from": a, "to": b} for k, (a, b) in changed.items()},
         })

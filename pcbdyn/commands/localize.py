@@ -16,7 +16,7 @@ from pathlib import Path
 
 import click
 
-from .common import done, folder_outputs, input_errors, library_option, measured_configurations, parse_extra, parse_noise, step
+from .common import done, folder_outputs, input_errors, library_option, measured_configurations, parse_extra, parse_noise, step, units_option
 
 METHOD_CHOICES = ["tls-qrf", "svd-qr", "qr", "min-norm"]
 
@@ -40,6 +40,7 @@ METHOD_CHOICES = ["tls-qrf", "svd-qr", "qr", "min-norm"]
 @folder_outputs("folder for the evidence figure and the FBM map (PNG)",
                 "write the selection and its evidence as JSON")
 @library_option()
+@units_option
 def command(board_toml, test_uff, config_tests, method, eq_type, params, rank, alpha, noise, matching, out,
             json_path):
     """Localise model errors among a structure's [[parameters]] from modal tests: TEST_UFF of the base
@@ -80,19 +81,18 @@ def command(board_toml, test_uff, config_tests, method, eq_type, params, rank, a
     if out is not None:
         from ..problems.localize import fbm_map
         from ..report.localisation_plots import localisation_figure, save_map
-        from ..report.manifest import settle
+        from ..report.manifest import replacing
 
-        out.mkdir(parents=True, exist_ok=True)
-        written = [out / "localisation.png"]
-        localisation_figure(written[0], tls, problem.names)
-        measured = tests[0][1]
-        if eq_type in ("qms", "fbm") and measured.shapes is not None:
-            xy = measured.xyz[:, :2] if getattr(board, "outline", None) is not None else measured.xyz  # 3-D: a box
-            fbm, peak = fbm_map(configs[0], states[0])
-            written.append(out / "fbm_map.png")
-            save_map(written[-1], xy, None, fbm, "FBM residual forces at the test points (eq. 5.2)")
-            data["fbm_peak_mm"] = [1e3 * float(v) for v in xy[peak]]
-        settle(out, written, "pcbdyn localize")
-        click.echo(f"wrote {', '.join(str(w) for w in written)}", err=True)
+        written = ["localisation.png"]
+        with replacing(out, "pcbdyn localize") as run:  # the earlier --out stays whole until all is written
+            localisation_figure(run.path / written[0], tls, problem.names)
+            measured = tests[0][1]
+            if eq_type in ("qms", "fbm") and measured.shapes is not None:
+                xy = measured.xyz[:, :2] if getattr(board, "outline", None) is not None else measured.xyz  # a box: 3-D
+                fbm, peak = fbm_map(configs[0], states[0])
+                written.append("fbm_map.png")
+                save_map(run.path / written[-1], xy, None, fbm, "FBM residual forces at the test points (eq. 5.2)")
+                data["fbm_peak_mm"] = [1e3 * float(v) for v in xy[peak]]
+        click.echo(f"wrote {', '.join(str(out / w) for w in written)}", err=True)
     if json_path is not None:
         write_json(json_path, data)

@@ -36,13 +36,14 @@ def check_band(f_range, df: float) -> None:
 @click.option("--noise", default="0", show_default=True,
               help="noise in percent: one number for all, or 'f=0.2,shape=2,frf=1' (thesis eq. 5.72-5.74)")
 @click.option("--seed", type=int, default=None, help="random seed, for repeatable noise")
-@click.option("--f-range", "f_range", default=None, help="FRF lines f_lo,f_hi in Hz (default 0 to 1.2 x top mode)")
+@click.option("--f-range", "f_range", default=None, help="FRF lines f_lo,f_hi in Hz (default df to 1.2 x top mode)")
 @click.option("--df", type=float, default=1.0, show_default=True, help="FRF line spacing [Hz]")
 @click.option("--damping", type=float, default=0.01, show_default=True, help="viscous damping ratio of every mode")
 @click.option("--kind", type=click.Choice(["receptance", "mobility", "accelerance"]), default="accelerance",
               show_default=True, help="FRF kind")
 @click.option("--modes", "n_modes", type=click.IntRange(1, MAX_MODES), default=None,
-              help="number of modes written, and summed in the FRFs (default: [analysis] modes of the board)")
+              help="number of modes written (default: [analysis] modes of the board); the FRFs sum every mode up to "
+                   "twice the band's top")
 @click.option("--out", type=click.Path(dir_okay=False, path_type=Path), default=Path("test.uff"), show_default=True,
               help="UFF file to write (points 2411, modes 55, FRFs 58)")
 @click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
@@ -56,7 +57,7 @@ def command(board_toml, points_csv, config, excite, excite_dir, noise, seed, f_r
     from ..report.files import write_json
     from ..testdata import Noise, Points, TestDataError, read_points_csv, write_uff
     from ..testdata.data import check_damping
-    from ..testdata.simulate import frequency_axis, simulate_on_model
+    from ..testdata.simulate import frequency_axis, frf_modes, simulate_on_model
 
     xyz = (number_pair(excite, "--excite", "mm", counts=(2, 3)) + (0.0,))[:3]
     direction = (-1.0 if excite_dir[0] == "-" else 1.0) * np.eye(3)["xyz".index(excite_dir[1])]
@@ -75,12 +76,19 @@ def command(board_toml, points_csv, config, excite, excite_dir, noise, seed, f_r
         points, dofs = read_points_csv(points_csv)
         board.check_points(points, points_csv)
         board.check_points(Points([0], [xyz]), "--excite")
-        bm, modes, _, _ = solve_structure(board, config, n_modes=n_modes)
+        bm, modes, K, M = solve_structure(board, config, n_modes=n_modes)
         f_axis = frequency_axis(band, df, float(modes.frequencies.max()))
-        t0 = step(f"reading the model at {len(dofs)} DOFs and summing {modes.frequencies.size} modes "
-                  f"over {f_axis.size} lines")
+        if f_axis[0] == 0 and modes.n_rigid and kind != "accelerance":
+            raise click.BadParameter(f"a free structure's {kind} is infinite at 0 Hz: start the band above 0 "
+                                     f"(e.g. {df:g},{f_axis[-1]:g})", param_hint="--f-range")
+        t0 = step(f"solving the modes up to twice the band's top ({2 * f_axis[-1]:g} Hz) for the FRFs")
+        summed = frf_modes(bm.model, modes, f_axis, K, M)
+        done(t0)
+        t0 = step(f"reading the model at {len(dofs)} DOFs and summing {summed.frequencies.size} modes and the "
+                  f"static compliance of the others over {f_axis.size} lines")
         data = simulate_on_model(bm.model, modes, points, dofs, excite=xyz, excite_direction=direction, f_axis=f_axis,
-                                 zeta=damping, kind=kind, noise=noise_levels, seed=seed, tol=PROBE_TOL)
+                                 zeta=damping, kind=kind, noise=noise_levels, seed=seed, tol=PROBE_TOL,
+                                 frf_modes=summed, K=K, M=M)
         done(t0)
         write_uff(out, data)
     ref_id = int(data.frfs.reference.point_ids[0])
@@ -99,6 +107,7 @@ def command(board_toml, points_csv, config, excite, excite_dir, noise, seed, f_r
             "modes": [{"n": j + 1, "frequency_hz": float(f), "damping_ratio": float(z)}
                       for j, (f, z) in enumerate(zip(data.modes.frequencies, data.modes.damping))],
             "model_frequencies_hz": [float(f) for f in modes.frequencies],
+            "frf_modes_summed": int(summed.frequencies.size),
             "points": len(points), "response_dofs": len(dofs),
             "excitation": {"point": ref_id, "x_m": xyz[0], "y_m": xyz[1], "z_m": xyz[2], "direction": excite_dir},
             "noise_pct": {"frequency": noise_levels.frequency_pct, "shape": noise_levels.shape_pct,

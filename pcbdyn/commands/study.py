@@ -1,4 +1,4 @@
-"""``pcbdyn study study.toml [--json PATH]``: success-ratio study of error localisation methods
+"""``pcbdyn study study.toml [--out DIR] [--json PATH]``: success-ratio study of error localisation methods
 (thesis section 5.3) over noise levels x random shots x methods x equation types.
 
 study.toml::
@@ -13,7 +13,6 @@ study.toml::
     seed = 0
     workers = 2                        # default: all cores
     scheduler = "tcp://host:8786"      # optional: run the shots on a Dask cluster (or --scheduler)
-    out = "study_out"                  # optional: CSV + PNG (relative to the toml)
 
     [case]                             # optional case options
     nu = 0.35
@@ -44,14 +43,16 @@ from .common import checked_outputs, library_option
 
 @click.command("study")
 @click.argument("study_toml", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.option("--out", type=click.Path(file_okay=False, path_type=Path), default=None,
+              help="folder for the shots and the summary (CSV) and the success ratios (PNG)")
 @click.option("--json", "json_path", type=click.Path(dir_okay=False, path_type=Path),
               help="write the summary and every shot's result as JSON ('-': standard output)")
 @click.option("--scheduler", default=None, help="a Dask scheduler address (tcp://host:8786): the shots run on that "
                                                 "cluster instead of local processes (same results)")
 @click.option("--quiet", is_flag=True, help="no progress bar")
-@checked_outputs(folders=())
+@checked_outputs()
 @library_option()
-def command(study_toml: Path, json_path: Path | None, scheduler: str | None, quiet: bool):
+def command(study_toml: Path, out: Path | None, json_path: Path | None, scheduler: str | None, quiet: bool):
     """Judge localisation methods by their success ratio over noisy random shots (thesis eq. 5.65-5.66)."""
     from ..problems.study_spec import build_case, read_spec
     from ..report.files import write_json, write_text
@@ -71,17 +72,15 @@ def command(study_toml: Path, json_path: Path | None, scheduler: str | None, qui
     click.echo(f"\n{spec['case']}: true errors {', '.join(true)}; {spec['shots']} shots per level")
     table = summary.pivot_table(index=["equations", "level_pct"], columns="method", values="mean")
     click.echo("mean success ratio [%]:\n" + table.round(1).to_string() + "\n")
-    if spec["out"] is not None:
+    if out is not None:
         from ..report.localisation_plots import success_ratio_figure
+        from ..report.manifest import replacing
 
-        from ..report.manifest import settle
-
-        written = [spec["out"] / name for name in ("shots.csv", "summary.csv", "success_ratios.png")]
-        write_text(written[0], df.to_csv(index=False))
-        write_text(written[1], summary.to_csv(index=False))
-        success_ratio_figure(written[2], summary)
-        settle(spec["out"], written, "pcbdyn study")
-        click.echo(f"wrote {spec['out']}/shots.csv, summary.csv, success_ratios.png", err=True)
+        with replacing(out, "pcbdyn study") as run:  # the earlier --out stays whole until all is written
+            write_text(run.path / "shots.csv", df.to_csv(index=False))
+            write_text(run.path / "summary.csv", summary.to_csv(index=False))
+            success_ratio_figure(run.path / "success_ratios.png", summary)
+        click.echo(f"wrote {out}/shots.csv, summary.csv, success_ratios.png", err=True)
     if json_path is not None:
         write_json(json_path, {"case": spec["case"], "true_errors": true,
                                "summary": summary.to_dict(orient="records"), "shots": df.to_dict(orient="records")})

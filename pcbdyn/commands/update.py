@@ -34,7 +34,7 @@ from __future__ import annotations
 import click
 
 from .common import (done, fail, folder_outputs, input_errors, library_option, measured_configurations, parse_extra,
-                     parse_noise, result_path, step, test_arguments)
+                     parse_noise, result_path, step, test_arguments, units_option)
 
 def parse_frf_freqs(text) -> list:
     """'150,230 Hz' or '150,230' -> frequencies [Hz]."""
@@ -61,7 +61,7 @@ def parse_frf_freqs(text) -> list:
 @click.option("--solver", type=click.Choice(["ls", "tls", "bayes", "bounded"]), default="bounded", show_default=True)
 @click.option("--params", default=None, help="comma-separated parameter names (default: all [[parameters]])")
 @click.option("--max-iter", type=click.IntRange(min=1), default=20, show_default=True)
-@click.option("--tol", "tol_pct", type=float, default=0.1, show_default=True,
+@click.option("--tol", "tol_pct", type=float, default=0.1, show_default=True,  # problems.run.TOL_FREQ_PCT
               help="stop when the max frequency error is below this percentage (eq. 7.2)")
 @click.option("--mesh-size", default=None, help="override board.mesh_size, e.g. '10 mm'")
 @click.option("--noise", default=None,
@@ -75,6 +75,7 @@ def parse_frf_freqs(text) -> list:
                 force="replace an earlier board.updated.toml beside the board (default: a numbered name), and write "
                       "it even when the fit did not converge")
 @library_option()
+@units_option
 def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping, solver, params, max_iter, tol_pct,
             mesh_size, noise, mesh_check, out, force, json_path):
     """Update a structure's [[parameters]] against modal tests: TEST_UFF for the base configuration and
@@ -125,15 +126,28 @@ def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping,
                          max_iter=max_iter, tol_freq_pct=tol_pct,
                          progress=lambda msg: click.echo(f"    {msg}", err=True))
             res, before, after = fitted.result, fitted.before, fitted.after
-            what = {"status": fitted.status, "details": fitted.details}
+            what = {"status": fitted.status, "details": fitted.details, "warnings": fitted.warnings}
         done(t0)
+        rows = rep.parameter_rows(problem, res.p)
+        source = f"pcbdyn update ({what['status']})"
         written = what["status"] == "converged" or force
-        dst = problem.write_updated(res.p, result_path(out, board_toml, "updated", force), source=(
-            f"pcbdyn update ({what['status']})")) if written else None
-    rows = rep.parameter_rows(problem, res.p)
+        if out is None:
+            dst = problem.write_updated(res.p, result_path(None, board_toml, "updated", force),
+                                        source=source) if written else None
+        else:
+            from ..report.manifest import replacing
+
+            with replacing(out, "pcbdyn update") as staged:  # the earlier --out stays whole until all is written
+                dst = staged.final(problem.write_updated(res.p, result_path(staged.path, board_toml, "updated"),
+                                                         source=source)) if written else None
+                rep.plot_iterations(staged.path / "iterations.png", problem, res)
+                write_text(staged.path / "parameters.txt", rep.format_parameters(rows) + "\n")
+                write_text(staged.path / "correlation.txt", rep.format_correlation(before, after) + "\n")
     click.echo(f"\n{board.name}: {what['status']} after {res.iterations} iteration(s) ({res.reason})")
     for line in what["details"]:
         click.echo(f"  note: {line}")
+    for line in what["warnings"]:
+        click.echo(f"warning: {line}", err=True)
     click.echo(rep.format_parameters(rows))
     click.echo("")
     click.echo(rep.format_correlation(before, after))
@@ -142,13 +156,5 @@ def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping,
                    err=True)
     else:
         click.echo(f"\nupdated board written to {dst}", err=True)
-    if out is not None:
-        from ..report.manifest import settle
-
-        files = [out / "iterations.png", out / "parameters.txt", out / "correlation.txt"]
-        rep.plot_iterations(files[0], problem, res)
-        write_text(files[1], rep.format_parameters(rows) + "\n")
-        write_text(files[2], rep.format_correlation(before, after) + "\n")
-        settle(out, files + ([dst] if dst is not None else []), "pcbdyn update")
     if json_path is not None:
         write_json(json_path, rep.update_json(problem, res, rows, before, after, what, method, solver, dst, fitted))

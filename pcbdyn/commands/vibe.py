@@ -8,10 +8,12 @@ from pathlib import Path
 
 import click
 
-from .common import PROBE_TOL, done, fail, folder_outputs, library_option, solve_structure, step
+from .common import PROBE_TOL, done, fail, folder_outputs, library_option, solve_structure, step, units_option
 
 #: at most this many modes are computed (all of them up to twice the top input frequency otherwise)
 MAX_MODES = 150
+#: at least this many, whatever the band (a spectrum below the fundamental still needs them)
+MIN_MODES = 3
 
 
 @click.command("vibe")
@@ -35,6 +37,7 @@ MAX_MODES = 150
 @folder_outputs("folder for parts.csv, modes.csv, response_psd.csv, board_map.png, response_psd.png",
                 "write input_grms, modes[] and parts[] (ref, z_rms_m, z_allow_m, ratio, life_h, ...) as JSON", html=True)
 @library_option()
+@units_option
 def command(board_toml, psd_text, sine_csv, sweep_rate, sweeps, damping_text, duration, axis, chassis_freq, config,
             exclude, out, json_path, html):
     """Judge a board under a random (and sine) vibration specification: RMS responses at every part,
@@ -42,7 +45,6 @@ def command(board_toml, psd_text, sine_csv, sweep_rate, sweeps, damping_text, du
     from ..board import BoardError, load_board
     from ..fe import ModelError
     from ..report import vibration_report as report
-    from ..report.files import write_json
     from ..testdata import TestDataError
     from ..units import UnitError, to_si
     from ..vibration import (VibrationError, analysis_band, assess, judged_parts, load_psd, parse_damping,
@@ -56,32 +58,43 @@ def command(board_toml, psd_text, sine_csv, sweep_rate, sweeps, damping_text, du
         seconds = to_si(duration, "s", "--duration") if duration is not None else psd.duration
         chassis = to_si(chassis_freq, "Hz", "--chassis-freq") if chassis_freq is not None else None
         parts = judged_parts(board, exclude)
-        bm, modes, K, M = solve_structure(board, config, n_modes=MAX_MODES, f_max=analysis_band(psd, sine))
+        bm, modes, K, M = solve_structure(board, config, n_modes=MAX_MODES, f_max=analysis_band(psd, sine),
+                                          min_modes=MIN_MODES)
         t0 = step(f"random response of {len(parts)} part(s) to {psd.name} along {axis}")
         a = assess(board, bm, modes, K, M, psd, damping, axis=axis, duration=seconds, sine=sine, chassis_hz=chassis,
                    parts=parts, probe_tol=PROBE_TOL)
         done(t0)
     except (BoardError, ModelError, TestDataError, UnitError, VibrationError) as exc:
         fail(str(exc))
-    click.echo(f"\n{board.name} [{config or 'base'}] under {psd.name}:")
-    click.echo("\n".join(report.summary_lines(a)))
-    click.echo("\n" + report.format_table(report.parts_table(a)))
+    inputs = {"configuration": config or "base", "PSD": f"{psd_text} ({psd.source})",
+              "sine sweep": str(sine_csv) if sine_csv else None, "damping": damping.describe(),
+              "axis": axis, "duration": None if seconds is None else f"{seconds:g} s",
+              "chassis frequency": None if chassis is None else f"{chassis:g} Hz",
+              "excluded parts": ", ".join(exclude) or None}
+    report_verdict("vibe", report, a, board_toml, board, bm.model, psd.name, inputs, out, json_path, html)
+
+
+def report_verdict(name: str, report, result, board_toml, board, model, input_name: str, inputs: dict, out, json_path,
+                   html: bool) -> None:
+    """The end of ``vibe`` and ``shock``: print the summary and the parts table of ``result`` (through
+    its ``report`` module), write its files into ``out`` (the page with ``html``, the manifest) and
+    the JSON, with the files written."""
+    click.echo(f"\n{board.name} [{inputs['configuration']}] under {input_name}:")
+    click.echo("\n".join(report.summary_lines(result)))
+    click.echo("\n" + report.format_table(report.parts_table(result)))
     written = []
     if out is not None:
-        t0 = step(f"writing tables and pictures to {out}")
-        written = report.write_outputs(out, board, bm.model, a)
-        if html:
-            inputs = {"configuration": config or "base", "PSD": f"{psd_text} ({psd.source})",
-                      "sine sweep": str(sine_csv) if sine_csv else None, "damping": damping.describe(),
-                      "axis": axis, "duration": None if seconds is None else f"{seconds:g} s",
-                      "chassis frequency": None if chassis is None else f"{chassis:g} Hz",
-                      "excluded parts": ", ".join(exclude) or None}
-            written.append(report.html_page(out, board_toml, board, a, inputs).name)
-        from ..report.manifest import settle
+        from ..report.manifest import replacing
 
-        settle(out, [out / w for w in written], "pcbdyn vibe")
+        t0 = step(f"writing tables and pictures to {out}")
+        with replacing(out, f"pcbdyn {name}") as run:  # the earlier --out stays whole until all is written
+            written = report.write_outputs(run.path, board, model, result)
+            if html:
+                written.append(report.html_page(run.path, board_toml, board, result, inputs).name)
         done(t0)
         click.echo(f"results written to {out}/ ({len(written)} files)", err=True)
     if json_path is not None:
-        write_json(json_path, {"board": board.name, "configuration": config or "base", **a.to_dict(),
+        from ..report.files import write_json
+
+        write_json(json_path, {"board": board.name, "configuration": inputs["configuration"], **result.to_dict(),
                                "files": written})

@@ -13,12 +13,10 @@ unless ``--force``), and ``--json``."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import click
 
 from .common import (PROBE_TOL, done, fail, folder_outputs, input_errors, library_option, parse_extra, parse_noise, result_path, step,
-                     test_arguments)
+                     test_arguments, units_option)
 
 
 @click.command("wedgelock")
@@ -42,12 +40,12 @@ from .common import (PROBE_TOL, done, fail, folder_outputs, input_errors, librar
                 "JSON", force="replace an earlier board.updated.toml beside the board (default: a numbered name), "
                               "and write it even when the spring fit did not converge")
 @library_option()
+@units_option
 def command(board_toml, test_uff, configs, freq_csv, per_guide, tol_pct, noise, min_mac, mesh_size, max_iter, out,
             force, json_path):
     """Fit wedge-lock guides in two steps: hinged and clamped extremes, then rotational springs. TEST_UFF
     is the base configuration's test, NAME=FILE each perturbed configuration's of board.toml (e.g.
     c2=test2.uff); or measured frequencies (--frequencies CSV)."""
-    from ..domain import StructureError
     from ..problems import load_structure
     from ..problems.wedgelock import fit_wedge_locks
     from ..report import wedgelock_report as rep
@@ -82,36 +80,43 @@ def command(board_toml, test_uff, configs, freq_csv, per_guide, tol_pct, noise, 
     click.echo(f"\n{board.name}: guides {', '.join(result.guides)}")
     for text in tables.values():
         click.echo("\n" + text)
-    d["updated_board"] = None
-    status = next((f["status"] for f in d["fits"].values() if f["chosen"]), None)
-    if d["decision"] == "springs" and status != "converged" and not force:
+    for line in d["warnings"]:
+        click.echo(f"warning: {line}", err=True)
+    status = next((f["status"] for f in d.get("fits", {}).values() if f["chosen"]), None)
+    springs = d["decision"] == "springs" and (status == "converged" or force)
+    if d["decision"] == "springs" and not springs:
         click.echo(f"\nno updated board written: the spring fit did not converge ({status}); --force writes it anyway",
                    err=True)
-    elif d["decision"] == "springs":
-        try:
-            dst = result.chosen.problem.write_updated(result.chosen.result.p,
-                                                      result_path(out, board_toml, "updated", force),
-                                                      source="pcbdyn wedgelock")
-            d["updated_board"] = str(dst)
-            click.echo(f"\nupdated board written to {dst}", err=True)
-        except StructureError as exc:
-            click.echo(f"note: the updated board was not written ({exc}); the fitted stiffness is in the table "
-                       "above and in the JSON (k_rot): give each guide its own [[parameters]] entry, or set k_rot "
-                       "in board.toml by hand", err=True)
-    if out is not None:
-        from ..report.manifest import settle
+    if out is None:
+        d["updated_board"] = _updated(result, result_path(None, board_toml, "updated", force)) if springs else None
+    else:
+        from ..report.manifest import replacing
 
-        written = [] if d["updated_board"] is None else [Path(d["updated_board"])]
-        for name, text in tables.items():
-            written.append(out / name)
-            write_text(written[-1], text + "\n")
-        if d["history"]:
-            written.append(out / "history.png")
-            rep.plot_history(written[-1], d)
-        if "scan" in d:
-            written.append(out / "frequencies_vs_k.png")
-            rep.plot_frequencies(written[-1], d)
-        settle(out, written, "pcbdyn wedgelock")
+        with replacing(out, "pcbdyn wedgelock") as run:  # the earlier --out stays whole until all is written
+            d["updated_board"] = _updated(result, result_path(run.path, board_toml, "updated"), run.final) \
+                if springs else None
+            for name, text in tables.items():
+                write_text(run.path / name, text + "\n")
+            if d["history"]:
+                rep.plot_history(run.path / "history.png", d)
+            if "scan" in d:
+                rep.plot_frequencies(run.path / "frequencies_vs_k.png", d)
         click.echo(f"results written to {out}/", err=True)
     if json_path is not None:
         write_json(json_path, d)
+
+
+def _updated(result, path, final=lambda p: p) -> str | None:
+    """The board with the fitted springs written to ``path``; where it ends up (``final`` of the path
+    written), or None when its springs cannot be written back (said why)."""
+    from ..domain import StructureError
+
+    try:
+        dst = final(result.chosen.problem.write_updated(result.chosen.result.p, path, source="pcbdyn wedgelock"))
+    except StructureError as exc:
+        click.echo(f"note: the updated board was not written ({exc}); the fitted stiffness is in the table above and "
+                   "in the JSON (k_rot): give each guide its own [[parameters]] entry, or set k_rot in board.toml by "
+                   "hand", err=True)
+        return None
+    click.echo(f"\nupdated board written to {dst}", err=True)
+    return str(dst)

@@ -4,8 +4,8 @@ thickness with its standard deviation, the calibration runs behind it, and where
 The one search path (:func:`search_path`): a board looks for a family first in the folders a command
 names with ``--library DIR`` (:func:`chosen`), then in a ``library/`` folder next to its board.toml,
 then in the folders named in the PCBDYN_LIBRARY path variable (``os.pathsep``-separated), then in the
-library shipped inside the package (``pcbdyn/library/``, package data, so a plain ``pip install`` has
-it).
+library shipped with pcbdyn (:func:`shipped_library`: the repository's top-level ``library/``, installed
+as ``pcbdyn/library/`` package data, so a plain ``pip install`` has it).
 """
 
 from __future__ import annotations
@@ -14,7 +14,6 @@ import os
 import re
 from contextlib import contextmanager
 from dataclasses import dataclass
-from importlib import resources
 from pathlib import Path
 
 from ..inputs import MAX_NAME, MAX_TEXT, Reader, read_toml
@@ -77,8 +76,12 @@ def search_path(board_dir: Path | None = None) -> list[Path]:
 
 
 def shipped_library() -> Path:
-    """The folder of part families installed with pcbdyn (package data)."""
-    return Path(str(resources.files("pcbdyn") / "library"))
+    """The folder of part families shipped with pcbdyn: ``pcbdyn/library/`` of an installed package (setup.py
+    maps the repository's ``library/`` there), else, in a source tree or an editable install, the
+    repository's ``library/``."""
+    package = Path(__file__).resolve().parents[1]
+    installed = package / "library"
+    return installed if installed.is_dir() else package.parent / "library"
 
 
 def available(board_dir: Path | None = None) -> list[str]:

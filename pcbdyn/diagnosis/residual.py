@@ -186,7 +186,8 @@ def paired_state(ob: Observation, model, K, M, modes, U, points=None) -> ConfigS
     else:
         pairs = -np.ones(m, int)
         for pr in pair_modes(ob.shapes, U, ob.f, f_all, min_mac=0.3).pairs:
-            pairs[pr.test] = pr.model
+            if pr.used:  # a pair beyond the frequency limit is left to the nearest free frequency below
+                pairs[pr.test] = pr.model
         matched = pairs >= 0
         free = [k for k in range(f_all.size) if k not in set(pairs.tolist())]
         for i in np.flatnonzero(pairs < 0):  # unpaired: nearest unused frequency keeps the rows defined

@@ -20,7 +20,8 @@ solves it, in SI units (m, kg, s, N, Pa).
   between them (CELAS2 in global components, or CBUSH/PBUSH in a CORD2R edge frame when the edge
   is not along an axis).
 - fixed DOFs: SPC1; multi-point constraints: MPC (dependent DOF first), as pcbdyn eliminates
-  them; EIGRL with the number of modes (and f_max); PARAM,COUPMASS,1 (consistent mass).
+  them; EIGRL with the number of modes, the rigid-body ones of a free model included (and f_max);
+  PARAM,COUPMASS,1 (consistent mass).
 
 What a Nastran card cannot say (a beam's linear Timoshenko bending or rotary inertia, a
 laminate's rotary inertia) is written as the nearest card and named in :attr:`Deck.notes`.
@@ -54,6 +55,7 @@ class Deck:
     sets: list = field(default_factory=list)  # [{"set", "etype", "card", "pid", "elements"}]
     notes: list = field(default_factory=list)
     extra_grids: int = 0
+    rigid_modes: int = 0  # rigid-body modes counted in EIGRL's ND besides the elastic modes asked for
 
 
 class _Writer:
@@ -289,7 +291,8 @@ def _constraints(w: _Writer) -> None:
 
 def nastran_deck(model, n_modes: int, f_max: float | None = None, title: str = "pcbdyn model",
                  header: str = "") -> Deck:
-    """The SOL 103 deck of ``model`` asking for ``n_modes`` modes (below ``f_max`` [Hz] if given);
+    """The SOL 103 deck of ``model`` asking for ``n_modes`` elastic modes (below ``f_max`` [Hz] if given; EIGRL's
+    ND adds the rigid-body modes of a free model);
     ``header``: comment lines put first (where the model comes from)."""
     w = _Writer(model)
     for i, xyz in enumerate(model.nodes):
@@ -302,7 +305,8 @@ def nastran_deck(model, n_modes: int, f_max: float | None = None, title: str = "
         used, pid = WRITERS[es.etype](w, es)
         sets.append({"set": es.name, "etype": es.etype, "card": used, "pid": pid, "elements": int(len(es.conn))})
     _constraints(w)
-    w.add("EIGRL", [1, None, None if f_max is None else float(f_max), int(n_modes)])
+    rigid = _rigid_modes(model)
+    w.add("EIGRL", [1, None, None if f_max is None else float(f_max), int(n_modes) + rigid])
     control = ["SOL 103", "CEND", f"TITLE = {title}"[:72], "ECHO = NONE", "METHOD = 1"]
     control += ["SPC = 1"] if w.counts["SPC1"] else []
     control += ["MPC = 1"] if w.counts["MPC"] else []
@@ -311,7 +315,15 @@ def nastran_deck(model, n_modes: int, f_max: float | None = None, title: str = "
     head = comment("\n".join(filter(None, [header, "Units: SI (m, kg, s, N, Pa). Written by pcbdyn from its FE "
                                                  "model as it is solved."])))
     text = head + notes + "\n".join(control) + "\n" + "".join(w.lines) + "ENDDATA\n"
-    return Deck(text, w.counts, sets, w.notes, w.next_grid - 1 - model.n_nodes)
+    return Deck(text, w.counts, sets, w.notes, w.next_grid - 1 - model.n_nodes, rigid)
+
+
+def _rigid_modes(model) -> int:
+    """The rigid-body modes of a free model: Nastran's EIGRL counts them in ND, so that asking for n modes
+    of a free card gave n - 6 elastic ones."""
+    from ..fe.modal import solve_modes
+
+    return solve_modes(model, n_modes=1).n_rigid if model.free else 0
 
 
 def write_nastran(path, model, n_modes: int, f_max: float | None = None, title: str = "pcbdyn model",

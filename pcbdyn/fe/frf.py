@@ -79,7 +79,7 @@ def frf_modal(
     ``zeta``: modal viscous damping ratios (scalar or one per elastic mode); ``eta``: structural loss
     factors (scalar or per mode; D = eta K gives exactly eta_r = eta); ``alpha``, ``beta``: Rayleigh
     damping C = alpha M + beta K (exactly modal for mass-normalised modes). Rigid-body modes
-    contribute 1 / (-w^2 + i w alpha). ``residual``: an (n_response, n_excitation) real compliance
+    contribute 1 / (-w^2 + i w alpha) (at 0 Hz its limit, :func:`_rigid`). ``residual``: an (n_response, n_excitation) real compliance
     added at every frequency, typically :func:`residual_flexibility` for the truncated modes (divided
     by 1 + i eta when ``eta`` is a scalar, as the structural damping acts on those modes too).
     """
@@ -96,17 +96,29 @@ def frf_modal(
     ww = w[:, None]
     den = wr2 - ww**2 + 1j * ww * (2.0 * z * wr + alpha + beta * wr2) + 1j * e * wr2
     H = np.einsum("im,fm,jm->fij", modes.shapes[i], 1.0 / den, modes.shapes[j])
-    if modes.n_rigid:
-        with np.errstate(divide="ignore", invalid="ignore"):
-            den0 = 1.0 / (-(w**2) + 1j * w * alpha)
-        H = H + np.einsum("im,f,jm->fij", modes.rigid_shapes[i], den0, modes.rigid_shapes[j])
     if residual is not None:
         R = np.asarray(residual)
         if R.shape != (i.size, j.size):
             raise ValueError(f"residual must have shape (n_response, n_excitation) = {(i.size, j.size)}, got {R.shape}")
         eta_all = float(eta) if eta is not None and np.ndim(eta) == 0 else 0.0
         H = H + R[None] / (1.0 + 1j * eta_all)  # the missing modes' static response with D = eta K
-    return _convert(H, w, kind)
+    H = _convert(H, w, kind)
+    if modes.n_rigid:
+        H = H + np.einsum("im,f,jm->fij", modes.rigid_shapes[i], _rigid(w, alpha, kind), modes.rigid_shapes[j])
+    return H
+
+
+def _rigid(w: np.ndarray, alpha: float, kind: str) -> np.ndarray:
+    """A rigid-body mode's factor 1 / (-w^2 + i w alpha), as ``kind``, written so that 0 Hz gives its limit:
+    a free body's accelerance there is 1 undamped (0 with alpha > 0), not 0 * inf; its receptance (and its
+    undamped mobility) is infinite there."""
+    d = -w + 1j * alpha
+    with np.errstate(divide="ignore", invalid="ignore"):
+        if kind == "receptance":
+            return np.where(w > 0, 1.0 / (w * d), np.inf)
+        if kind == "mobility":
+            return np.where(d != 0, 1j / np.where(d != 0, d, 1.0), np.inf)
+        return np.where(w > 0, -w / np.where(w > 0, d, 1.0), 0.0 if alpha else 1.0)
 
 
 def residual_flexibility(model, modes: Modes, response_dofs, excitation_dofs, K=None, M=None) -> np.ndarray:

@@ -10,13 +10,14 @@ A_jj = phi_j^2 / (2 i omega_d) for the receptance residue. The complex shape is 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..correlation.mac import automac
 from ..testdata import Modes, TestDataError, real_modes
 from . import lscf, stability
+from .quality import indicators
 
 
 @dataclass
@@ -24,7 +25,9 @@ class Identification:
     """Identified modes (shapes at the response DOFs), the chart they were chosen from, how they were
     chosen ("auto" or "manual"), the shapes' scaling ("mass" or "unit"), the band [Hz] and the
     highest model order used; ``mac_neighbours`` (n, 2): MAC of each shape with the previous and the
-    next mode (NaN at the ends)."""
+    next mode (NaN at the ends); ``quality``: per mode the indicators of :func:`.quality.indicators`;
+    ``criteria``: the rules of the choice (:func:`.stability.criteria`); ``notes``: what the choice
+    says to the user (requests of ``select`` that shared a pole)."""
 
     modes: Modes
     chart: stability.Chart
@@ -34,6 +37,9 @@ class Identification:
     band: tuple
     max_order: int
     mac_neighbours: np.ndarray
+    quality: list = field(default_factory=list)
+    criteria: dict = field(default_factory=dict)
+    notes: list = field(default_factory=list)
 
 
 def _driving_rows(frfs) -> dict:
@@ -95,7 +101,8 @@ def identify(frfs, band=None, max_order: int = 40, select=None) -> Identificatio
     order = int(max(2, min(max_order, f.size // 4)))
     all_poles = lscf.poles_by_order(f, rows, frfs.kind, order)
     c = stability.chart(all_poles, f, rows, frfs.kind, band)
-    chosen = stability.auto_select(c) if select is None else stability.pick(c, select)
+    groups, notes = (stability.auto_select(c), []) if select is None else stability.pick(c, select)
+    chosen = [stability.representative(c, g) for g in groups]
     poles = c.pole[chosen]
     A = lscf.residues(poles, f, rows, frfs.kind)
     psi, scaling = shapes(A, pairs, frfs, poles)
@@ -103,5 +110,6 @@ def identify(frfs, band=None, max_order: int = 40, select=None) -> Identificatio
     big = np.argmax(np.abs(phi), axis=0)
     phi = phi * np.sign(phi[big, np.arange(phi.shape[1])])
     modes = Modes(frfs.points, frfs.response, c.frequency[chosen], phi, c.damping[chosen], mpc)
-    return Identification(modes, c, list(map(int, chosen)), "auto" if select is None else "manual", scaling,
-                          (float(lo), float(hi)), order, _neighbours(phi))
+    return Identification(modes, c, chosen, "auto" if select is None else "manual", scaling,
+                          (float(lo), float(hi)), order, _neighbours(phi), indicators(psi, mpc, c, groups),
+                          stability.criteria(len(rows)), notes)

@@ -1,16 +1,23 @@
 """The stabilisation chart and the choice of poles from it.
 
 A pole at model order n is compared with the nearest pole (in frequency) at the order below:
-stable in frequency when they differ by less than TOL_F, in damping by less than TOL_D
-(relative), in shape when the MAC of their residue vectors (all FRFs) exceeds TOL_MAC. A physical
-mode shows as a column of poles stable in all three over many orders; noise and the modes outside
-the band give poles that wander from order to order.
+stable in frequency when they differ by less than TOL_F, in damping by less than TOL_D (relative)
+or TOL_D_ABS (absolute: the damping of a lightly damped measured structure, 0.1 % of critical or
+less, scatters from order to order by more than 5 % of itself), in shape when the MAC of their
+residue vectors (all FRFs) exceeds TOL_MAC. With one FRF the shape test cannot fail (a residue
+vector of one value), so stability rests on frequency and damping. A physical mode shows as a
+column of poles stable over many orders; noise and the modes outside the band give poles that
+wander from order to order. Only physical poles enter the chart (:func:`.lscf.physical`: positive
+frequency inside the band, damping ratio in (0, MAX_DAMPING)).
 
-Automatic choice: the poles stable in all three are grouped by frequency (a gap of more than
-CLUSTER_GAP between neighbours starts a new group; a group holding two poles of one order is cut
-at its largest gaps into as many modes); a group seen at MIN_SUPPORT of the orders or more is a
-mode, represented by its pole of median frequency. Manual choice: the pole of median frequency
-among the most stable ones within TOL_PICK of each frequency given.
+Automatic choice: the stable poles are grouped by frequency (a gap of more than CLUSTER_GAP between
+neighbours starts a new group; a group holding two poles of one order is cut at its largest gaps
+into as many modes); a group is a mode when it is seen at MIN_SUPPORT of the orders from the one it
+first appears at (a mode of a wide band appears only once the order can hold it) and at
+MIN_ORDERS_FRACTION of all orders, at least 3; it is represented by its pole of median frequency.
+Manual choice: every pole stable in frequency is grouped likewise, and each frequency given takes the
+nearest group within TOL_PICK, distinct ones where the groups allow, the most stable pole of median
+frequency standing for it; requests that share one group are said so.
 """
 
 from __future__ import annotations
@@ -18,18 +25,29 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.optimize import linear_sum_assignment
 
 from ..correlation.mac import mac
 from ..testdata import TestDataError
-from .lscf import physical, residues
+from .lscf import MAX_DAMPING, physical, residues
 
-TOL_F, TOL_D, TOL_MAC = 0.01, 0.05, 0.98
+TOL_F, TOL_D, TOL_D_ABS, TOL_MAC = 0.01, 0.05, 0.001, 0.98
 CLUSTER_GAP = 0.005
-MIN_SUPPORT = 0.25
+MIN_SUPPORT = 0.5
+MIN_ORDERS_FRACTION = 0.15
 TOL_PICK = 0.02
 #: stability codes, least to most stable: new (o), frequency (f), frequency and damping (d),
 #: frequency and shape (v), all three (s)
 RANK = {"o": 0, "f": 1, "d": 2, "v": 2, "s": 3}
+
+
+def criteria(n_rows: int) -> dict:
+    """The rules of the choice, as the JSON states them (``n_rows``: the FRFs fitted)."""
+    return {"frequency_tolerance": TOL_F, "damping_tolerance_relative": TOL_D, "damping_tolerance_absolute": TOL_D_ABS,
+            "shape_mac_min": TOL_MAC if n_rows > 1 else None, "physical_damping": [0.0, MAX_DAMPING],
+            "cluster_gap": CLUSTER_GAP, "min_support_from_first_order": MIN_SUPPORT,
+            "min_orders_fraction": MIN_ORDERS_FRACTION, "pick_tolerance": TOL_PICK,
+            "shape_test": "MAC of the residues over all FRFs" if n_rows > 1 else "none: one FRF"}
 
 
 @dataclass
@@ -56,19 +74,20 @@ def _status(p, A, prev_p, prev_A) -> str:
     if abs(f1 - f0) > TOL_F * f0:
         return "o"
     z0, z1 = -prev_p[j].real / f0, -p.real / f1
-    damp = abs(z1 - z0) <= TOL_D * z0
+    damp = abs(z1 - z0) <= max(TOL_D * z0, TOL_D_ABS)
     shape = mac(A, prev_A[:, j])[0, 0] >= TOL_MAC
     return "s" if damp and shape else "d" if damp else "v" if shape else "f"
 
 
 def chart(all_poles, f, rows, kind, band) -> Chart:
     """The chart of the LSCF poles of every order (``all_poles[k]`` at order 2 (k + 1)), with the
-    residues of each order's physical poles for the shape test."""
+    residues of each order's physical poles for the shape test (none fitted for one FRF: its test cannot
+    fail)."""
     out = ([], [], [])
     prev_p = prev_A = None
     for k, raw in enumerate(all_poles):
         p = physical(raw, band)
-        A = residues(p, f, rows, kind)
+        A = residues(p, f, rows, kind) if len(rows) > 1 else np.ones((1, p.size))
         for i, pole in enumerate(p):
             out[0].append(2 * (k + 1))
             out[1].append(pole)
@@ -85,7 +104,7 @@ def _median_pole(c: Chart, idx) -> int:
 
 
 def _groups(c: Chart, idx) -> list:
-    """Stable poles ``idx`` grouped by frequency, groups with two poles of one order split."""
+    """Poles ``idx`` grouped by frequency, groups with two poles of one order split."""
     idx = idx[np.argsort(c.frequency[idx])]
     if idx.size == 0:
         return []
@@ -103,24 +122,42 @@ def _groups(c: Chart, idx) -> list:
 
 
 def auto_select(c: Chart) -> list:
-    """Indices (into the chart) of one pole per physical mode, by frequency."""
-    stable = np.flatnonzero(c.code == "s")
-    need = max(3, int(np.ceil(MIN_SUPPORT * c.n_orders)))
-    keep = [g for g in _groups(c, stable) if np.unique(c.order[g]).size >= need]
-    return sorted((_median_pole(c, g) for g in keep), key=lambda i: c.frequency[i])
+    """One group of chart indices (the mode's stable poles) per physical mode, by frequency."""
+    orders = np.unique(c.order)
+    least = max(3, int(np.ceil(MIN_ORDERS_FRACTION * orders.size)))
+    keep = []
+    for g in _groups(c, np.flatnonzero(c.code == "s")):
+        seen = np.unique(c.order[g]).size
+        span = int(np.sum(orders >= c.order[g].min()))
+        if seen >= max(least, np.ceil(MIN_SUPPORT * span)):
+            keep.append(g)
+    return sorted(keep, key=lambda g: c.frequency[_median_pole(c, g)])
 
 
-def pick(c: Chart, frequencies) -> list:
-    """Indices of the poles chosen near each of ``frequencies`` [Hz] (manual override)."""
-    chosen = []
-    rank = np.array([RANK[s] for s in c.code], dtype=int)
-    for f0 in frequencies:
-        near = np.flatnonzero(np.abs(c.frequency - f0) <= TOL_PICK * f0)
-        if near.size == 0:
-            raise TestDataError(f"--select: no pole within {TOL_PICK:.0%} of {f0:g} Hz in the stabilisation chart; "
-                                "pick frequencies where the chart shows a column of poles")
-        best = near[rank[near] == rank[near].max()]
-        chosen.append(_median_pole(c, best))
-    if len(set(chosen)) < len(chosen):
-        raise TestDataError("--select: two of the frequencies given pick the same pole; give each mode once")
-    return sorted(chosen, key=lambda i: c.frequency[i])
+def representative(c: Chart, g) -> int:
+    """The pole standing for a group: of median frequency among its most stable poles."""
+    rank = np.array([RANK[s] for s in c.code[g]], dtype=int)
+    return _median_pole(c, np.asarray(g)[rank == rank.max()])
+
+
+def pick(c: Chart, frequencies) -> tuple:
+    """(groups, notes): for each of ``frequencies`` [Hz] the nearest group of poles stable in frequency
+    within TOL_PICK, each group given once (manual override); the notes say which requests shared one."""
+    groups = _groups(c, np.flatnonzero(c.code != "o"))
+    f_req = np.asarray(frequencies, dtype=float)
+    f_grp = np.array([c.frequency[representative(c, g)] for g in groups])
+    d = np.abs(f_grp[None, :] - f_req[:, None]) / f_req[:, None] if groups else np.zeros((f_req.size, 0))
+    for k in np.flatnonzero(~np.any(d <= TOL_PICK, axis=1)):
+        raise TestDataError(f"--select: no pole within {TOL_PICK:.0%} of {f_req[k]:g} Hz in the stabilisation chart; "
+                            "pick frequencies where the chart shows a column of poles")
+    rows, cols = linear_sum_assignment(np.where(d <= TOL_PICK, d, 1e6))
+    taken = {int(r): int(g) for r, g in zip(rows, cols) if d[r, g] <= TOL_PICK}
+    notes = []
+    for k in range(f_req.size):
+        if k not in taken:
+            g = int(np.argmin(d[k]))
+            other = next(r for r, gg in taken.items() if gg == g)
+            notes.append(f"--select: {f_req[k]:g} Hz and {f_req[other]:g} Hz pick the same pole at {f_grp[g]:.2f} Hz "
+                         "(no other column within 2 %): kept once")
+    chosen = sorted(set(taken.values()), key=lambda g: f_grp[g])
+    return [groups[g] for g in chosen], notes

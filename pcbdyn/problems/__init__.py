@@ -7,7 +7,7 @@ from .load import load_structure
 from .models import StructureModels
 from .problem import UpdateProblem
 from .run import correlation_state, run
-from .system import ConfigSystem, DynamicReduced, shape_pairing
+from .system import ConfigSystem, DynamicReduced, ShapePairing
 
 __all__ = ["ConfigSystem", "DynamicReduced", "StructureModels", "UpdateProblem", "correlation_state",
-           "load_structure", "run", "shape_pairing"]
+           "load_structure", "run", "ShapePairing"]

@@ -59,21 +59,24 @@ def pairs_by_number(test, f_model) -> list:
 
 
 def correlate_configuration(pm, test, min_mac: float, probe_tol=None) -> dict:
-    """A built model ``pm`` of one configuration against its ``test``: pairs, unpaired test modes and
-    the model modes in the tested band left without a partner."""
+    """A built model ``pm`` of one configuration against its ``test``: pairs (beyond the frequency limit
+    too: an extreme brackets the test, it is not updated), unpaired test modes, the model modes in the
+    tested band left without a partner and the pairing's warnings (aliased model modes)."""
     modes = solve_modes(pm.model, n_modes=model_modes_needed(test))
     f = modes.frequencies
+    warnings = []
     if test.shapes is not None:
-        d = correlate(test, pm.model, modes, min_mac=min_mac, tol=probe_tol).pairing.to_dict()
+        pairing = correlate(test, pm.model, modes, min_mac=min_mac, tol=probe_tol).pairing
         pairs = [{k: q[k] for k in ("test_mode", "model_mode", "f_test_hz", "f_model_hz", "df_pct", "mac")}
-                 for q in d["pairs"]]
+                 for q in pairing.to_dict()["pairs"]]  # an extreme brackets the test: every pair counts
+        warnings = pairing.warnings(f, beyond=False)
     else:
         pairs = pairs_by_number(test, f)
     paired_t, paired_m = {q["test_mode"] for q in pairs}, {q["model_mode"] for q in pairs}
     band = max([float(test.frequencies.max())] + [q["f_model_hz"] for q in pairs])
     return {"pairs": pairs, "unpaired_test_modes": [i + 1 for i in range(test.n_modes) if i + 1 not in paired_t],
             "unpaired_model_modes": [{"model_mode": j + 1, "f_model_hz": float(fj)} for j, fj in enumerate(f)
-                                     if j + 1 not in paired_m and fj <= band]}
+                                     if j + 1 not in paired_m and fj <= band], "warnings": warnings}
 
 
 def correlate_extreme(board, kind: str, tests, mesh_size=None, min_mac: float = 0.5, probe_tol=None) -> Extreme:

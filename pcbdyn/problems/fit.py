@@ -45,7 +45,7 @@ from ..updating.scan import scan, scanned
 from ..updating.solvers import RankDeficiencyWarning, choose_rank
 from ..units import from_si
 from .discretisation import model_errors
-from .run import correlation_state, undetermined_directions, worse_configurations
+from .run import TOL_FREQ_PCT, correlation_state, pairing_warnings, undetermined_directions, worse_configurations
 
 #: frequency and shape noise [%] (uniform bounds, eqs. 5.72-5.73) assumed when a test states none
 DEFAULT_NOISE = (0.2, 2.0)
@@ -93,6 +93,11 @@ class Fit:
     @property
     def values(self) -> dict:
         return self.problem.values(self.p)
+
+    @property
+    def warnings(self) -> list:
+        """The pairing's warnings before and after (:func:`.run.pairing_warnings`)."""
+        return pairing_warnings(self.before + self.after)
 
     def summary(self) -> dict:
         """The JSON-ready account of the fit (status, verdict, noise, starts, shapes)."""
@@ -169,7 +174,7 @@ def weak_directions(configs, p, names, free=None) -> list:
 
 def fit(problem, measured, *, method: str = "freq", noise=(None, None), shapes: str = "auto",
         scan_start: bool = True, model_pct=None, mesh_check: bool = False, solver: str = "bounded",
-        max_iter: int = 20, tol_freq_pct: float = 0.1, tol_param_pct: float = 0.5, min_mac: float = 0.5,
+        max_iter: int = 20, tol_freq_pct: float = TOL_FREQ_PCT, tol_param_pct: float = 0.5, min_mac: float = 0.5,
         progress=None) -> Fit:
     """Fit ``problem`` (:class:`~.problem.UpdateProblem`, its ``p0`` the start) to ``measured``
     [(configuration or None, :class:`pcbdyn.testdata.Modes`)] or [(structure index, configuration, Modes)].

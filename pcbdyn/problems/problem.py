@@ -26,7 +26,7 @@ import numpy as np
 
 from ..updating.frf_lines import choose_frf_frequencies, model_receptance
 from ..updating.iteration import Configuration
-from .system import ConfigSystem, DynamicReduced, ProblemError, shape_pairing
+from .system import ConfigSystem, DynamicReduced, ProblemError, ShapePairing
 
 
 class UpdateProblem:
@@ -114,7 +114,7 @@ class UpdateProblem:
         P = sysm.measurement_matrix(measured.xyz, measured.directions)
         return [Configuration(model=DynamicReduced(sysm, P, 2 * np.pi * f), f_x=measured.frequencies[k:k + 1],
                               phi_x=measured.shapes[:, k:k + 1], method=method, n_modes=P.shape[0],
-                              name=f"{sysm.label}:{k + 1}", pairing=shape_pairing(min_mac), **options)
+                              name=f"{sysm.label}:{k + 1}", pairing=ShapePairing(min_mac), **options)
                 for k, f in enumerate(measured.frequencies)]
 
     def frf_configurations(self, config, measured: list, method: str = "frf-out", freqs=None,

@@ -12,11 +12,16 @@ from ..updating.driver import update
 from ..updating.iteration import build_equations
 from ..updating.solvers import RankDeficiencyWarning
 
+#: the frequency criterion (thesis eq. 7.2, max |df| in %) an update stops at unless told otherwise: the
+#: API's and ``pcbdyn update --tol``'s (tests/docs/test_readme_api.py keeps them one)
+TOL_FREQ_PCT = 0.1
+
 
 def correlation_state(configs, p) -> list:
     """Per configuration at ``p``: the pairs (as in ``pcbdyn correlate``: test_mode, model_mode
-    (1-based, elastic modes), f_test_hz, f_model_hz, df_pct, mac) and the max |df| in percent (None for
-    a configuration none of whose modes pairs)."""
+    (1-based, elastic modes), f_test_hz, f_model_hz, df_pct, mac), the max |df| in percent (None for
+    a configuration none of whose modes pairs) and the pairing's warnings (model modes the test grid
+    cannot tell apart, pairs beyond the frequency limit: reported, not used)."""
     _, _, states = build_equations(configs, p)
     out = []
     for cfg, st in zip(configs, states):
@@ -26,8 +31,10 @@ def correlation_state(configs, p) -> list:
             pairs.append({"test_mode": int(u) + 1, "model_mode": int(st["pairs"][u]) + 1 - cfg.n_rigid,
                           "f_test_hz": ft, "f_model_hz": float(fa), "df_pct": 100.0 * (float(fa) - ft) / ft,
                           "mac": None if st.get("mac") is None else float(st["mac"][k])})
+        said = getattr(cfg.pairing, "warnings", None)
         out.append({"configuration": cfg.name, "pairs": pairs,
-                    "max_freq_error_pct": max(abs(q["df_pct"]) for q in pairs) if pairs else None})
+                    "max_freq_error_pct": max(abs(q["df_pct"]) for q in pairs) if pairs else None,
+                    "warnings": said() if said else []})
     return out
 
 
@@ -36,9 +43,11 @@ def run(problem, configs, solver: str = "ls", check=None, **kwargs):
     (UpdateResult, before, after), before/after from :func:`correlation_state` on ``check`` (default
     ``configs``; give the full-model configurations of :meth:`~.problem.UpdateProblem.configuration`
     when updating on :meth:`~.problem.UpdateProblem.mode_configurations`). ``kwargs`` go to
-    :func:`pcbdyn.updating.driver.update` (``progress``, ``max_iter``, ...). The solvers' warnings
+    :func:`pcbdyn.updating.driver.update` (``progress``, ``max_iter``, ``tol_freq_pct``: default
+    :data:`TOL_FREQ_PCT`, as the command line's, ...). The solvers' warnings
     are not printed: :func:`outcome` says what they meant with the parameters named."""
     check = configs if check is None else check
+    kwargs.setdefault("tol_freq_pct", TOL_FREQ_PCT)
     before = correlation_state(check, problem.p0)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RankDeficiencyWarning)
@@ -71,8 +80,9 @@ def outcome(problem, res, before, after) -> dict:
     """What an update did, in the user's terms: ``status`` ("error grew", "on a bound", "not determined",
     "stalled", "not converged" or "converged": the first that applies), and ``details``: parameters at
     their bounds, configurations whose error grew (before -> after), parameter combinations the equations
-    did not determine at the last solve, configurations set aside because no mode paired. The fits of
-    :func:`.fit.fit` judge more (the chi^2 verdict, the directions in units of the noise)."""
+    did not determine at the last solve, configurations set aside because no mode paired; ``warnings``:
+    the pairing's before and after (:func:`pairing_warnings`). The fits of :func:`.fit.fit` judge more
+    (the chi^2 verdict, the directions in units of the noise)."""
     lo, hi = problem.bounds
     bounds = {n: "lower" if np.isclose(v, a, rtol=1e-6) else "upper" for n, v, a, b in
               zip(problem.names, res.p, lo, hi) if np.isclose(v, a, rtol=1e-6) or np.isclose(v, b, rtol=1e-6)}
@@ -96,4 +106,11 @@ def outcome(problem, res, before, after) -> dict:
     else:
         status = "converged" if res.converged else "not converged"
     return {"status": status, "details": details, "at_bounds": bounds, "worse": [c for c, _, _ in worse],
-            "undetermined": undetermined, "set_aside": set_aside}
+            "undetermined": undetermined, "set_aside": set_aside, "warnings": pairing_warnings(before + after)}
+
+
+def pairing_warnings(states) -> list:
+    """The pairing's warnings of correlation ``states`` (model modes the test grid cannot tell apart, pairs
+    beyond the frequency limit), each once, prefixed with its configuration."""
+    return list(dict.fromkeys(f"configuration {s['configuration']}: {w}" for s in states
+                              for w in s.get("warnings", [])))

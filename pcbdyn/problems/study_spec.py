@@ -5,13 +5,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..atomic import unwritable
 from ..domain import StructureError
 from ..inputs import MAX_NAME, Reader, read_toml
 from ..units import shown
 from .cases import CASES, CaseError, StructureCase
 
-KEYS = ["case", "levels_pct", "shots", "methods", "equations", "rank", "seed", "workers", "scheduler", "out", "board",
+KEYS = ["case", "levels_pct", "shots", "methods", "equations", "rank", "seed", "workers", "scheduler", "board",
         "points"]
 
 
@@ -27,6 +26,9 @@ def read_spec(path: Path) -> dict:
     doc = read_toml(path, StudyError)[1]
     r = Reader(path, StudyError)
     r.table(doc, "top level", ["study", "case", "truth"], required=["study"])
+    if isinstance(doc["study"], dict) and "out" in doc["study"]:
+        r.fail("study.out", "the output folder is given as every command's is: remove out from [study] and run "
+                            "'pcbdyn study FILE --out DIR'")
     s = r.table(doc["study"], "study", KEYS)
     case = s.get("case", "simulated_free_pcb")
     if not isinstance(case, str) or case not in CASES:
@@ -50,15 +52,9 @@ def read_spec(path: Path) -> dict:
     elif "truth" in doc or "board" in s or "points" in s:
         r.fail("study.board" if "board" in s else "study.points" if "points" in s else "truth",
                f"only case = \"board\" takes a board, points and a [truth] table (case is {case!r})")
-    out = s.get("out")
-    if out is not None:
-        r.text(out, "study.out", 400)
-        if (why := unwritable(path.parent / out, folder=True)) is not None:
-            r.fail("study.out", f"[study] out = {out}: {why}")
     return {
         "case": case, "case_options": opts, "levels": levels, "shots": shots, "methods": methods,
         "equations": equations, "rank": rank, "seed": seed, "workers": workers, "scheduler": scheduler,
-        "out": None if out is None else (path.parent / out),
     }
 
 

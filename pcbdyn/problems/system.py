@@ -93,29 +93,39 @@ class ConfigSystem:
         """The driver's pairing callable for the measured modes ``measured`` (:class:`pcbdyn.testdata.Modes`):
         by MAC (:func:`pcbdyn.correlation.pairing.pair_modes`) when shapes are measured, else by the
         test's mode numbers; rigid-body modes never pair."""
-        return shape_pairing(min_mac, self.n_rigid, None if measured.shapes is not None else measured.numbers)
+        return ShapePairing(min_mac, self.n_rigid, None if measured.shapes is not None else measured.numbers)
 
 
-def shape_pairing(min_mac: float, n_rigid: int = 0, numbers=None):
+class ShapePairing:
     """A pairing callable (f_a, phi_a, f_x, phi_x) -> analytical index per measured mode (-1: unpaired):
     by MAC, each model mode used once (:func:`pcbdyn.correlation.pairing.pair_modes`), past the first
-    ``n_rigid`` (rigid-body) analytical modes; with ``numbers`` (1-based elastic mode numbers, for
-    frequencies without shapes) by those numbers."""
+    ``n_rigid`` (rigid-body) analytical modes, a pair beyond the frequency limit left out; with ``numbers``
+    (1-based elastic mode numbers, for frequencies without shapes) by those numbers. ``last``: the
+    :class:`~pcbdyn.correlation.pairing.Pairing` of the last call, for its warnings."""
 
-    def pairing(f_a, phi_a, f_x, phi_x):
+    def __init__(self, min_mac: float, n_rigid: int = 0, numbers=None):
+        self.min_mac, self.n_rigid, self.numbers = min_mac, n_rigid, numbers
+        self.last = None
+
+    def __call__(self, f_a, phi_a, f_x, phi_x):
         out = -np.ones(np.size(f_x), int)
+        n_rigid, numbers = self.n_rigid, self.numbers
         if numbers is not None or phi_x is None:
             k = n_rigid + (np.arange(np.size(f_x)) + 1 if numbers is None else np.asarray(numbers)) - 1
             ok = k < np.size(f_a)
             out[ok] = k[ok]
             return out
-        res = pair_modes(np.asarray(phi_x), np.asarray(phi_a)[:, n_rigid:], f_x, np.asarray(f_a)[n_rigid:],
-                         min_mac=min_mac)
-        for pr in res.pairs:
-            out[pr.test] = pr.model + n_rigid
+        self.last = pair_modes(np.asarray(phi_x), np.asarray(phi_a)[:, n_rigid:], f_x, np.asarray(f_a)[n_rigid:],
+                               min_mac=self.min_mac)
+        for pr in self.last.pairs:
+            if pr.used:
+                out[pr.test] = pr.model + n_rigid
         return out
 
-    return pairing
+    def warnings(self) -> list:
+        """The last pairing's warnings (aliased model modes, pairs beyond the frequency limit), with elastic
+        mode numbers (no model frequencies: an update's before and after say the same)."""
+        return [] if self.last is None else self.last.warnings()
 
 
 class DynamicReduced:

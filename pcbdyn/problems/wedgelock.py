@@ -22,11 +22,12 @@ import numpy as np
 from scipy.stats import chi2 as chi2_dist
 
 from ..testdata import TestDataError
-from . import guides
 from ..updating.driver import evaluate
 from ..updating.scan import grid
+from . import guides
 from .extremes import Extreme, correlate_extreme, mesh_errors
 from .fit import DEFAULT_NOISE
+from .run import pairing_warnings
 from .spring_fit import ALPHA, SpringFit, SpringModel, chi2, significance
 
 #: frequency noise [%] (uniform bound, eq. 5.72) assumed when the test states none
@@ -63,6 +64,12 @@ class WedgeLockResult:
         return [{"configuration": c["configuration"], "pairs": c["pairs"],
                  "max_freq_error_pct": max((abs(q["df_pct"]) for q in c["pairs"]), default=None)}
                 for c in self.clamped.configs]
+
+    def warnings(self) -> list:
+        """The pairing's warnings of the extremes and of step 2's start and fit, each once."""
+        states = [{"configuration": c["configuration"], "warnings": c.get("warnings", [])}
+                  for e in (self.hinged, self.clamped) for c in e.configs]
+        return pairing_warnings(states + ([] if self.chosen is None else self.chosen.before + self.chosen.after))
 
     def before_after(self) -> tuple:
         """(before, after): step 2's start and fit, or the clamped model twice when step 2 did not run."""
@@ -103,7 +110,8 @@ class WedgeLockResult:
             "tolerance_pct": per_mode(self.tolerance_pct), "sigma_pct": per_mode(self.sigma_pct),
             "between_extremes": per_mode(self.positions()),
             "clamped_within_tolerance": self.clamped_ok, "decision": self.decision, "reason": self.reason,
-            "notes": self.notes, "k_rot": self.k_rot(), "per_guide": fit is not None and fit is self.per_guide,
+            "notes": self.notes, "warnings": self.warnings(), "k_rot": self.k_rot(),
+            "per_guide": fit is not None and fit is self.per_guide,
             "before": summary(before), "after": summary(after), "significance": self.tests,
             "start": {} if fit is None else fit.by_fixture(fit.problem.p0),
             "history": [] if fit is None else [

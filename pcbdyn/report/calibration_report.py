@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 
-from ..units import from_si
+from ..units import from_si, printed_unit
 from .files import save_figure
 from .update_report import format_correlation
 
@@ -43,7 +43,7 @@ def with_rows(cal) -> dict:
             continue
         sd = float(cal.std[i])
         out[name] = {"initial": float(cal.problem.p0[i]), "updated": float(cal.result.p[i]),
-                     "std": sd if math.isfinite(sd) else None, "display_unit": par.unit}
+                     "std": sd if math.isfinite(sd) else None, "display_unit": printed_unit(par.unit)}
     return out
 
 

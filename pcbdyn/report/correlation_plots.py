@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from .files import atomic_path
+from .labels import place_labels
 
 CMAP = "coolwarm"
 
@@ -36,8 +37,9 @@ def _save(fig, path) -> None:
     plt.close(fig)
 
 
-def mac_matrix(path, M, pairs, f_test, f_model) -> None:
-    """The MAC matrix (test modes down, model modes across) with values and the pairs framed."""
+def mac_matrix(path, M, pairs, f_test, f_model, title: str = "MAC (pairs framed in red)",
+               rows: str = "test mode") -> None:
+    """The MAC matrix (``rows`` modes down, model modes across) with values and the pairs framed."""
     plt = _plt()
     from matplotlib.patches import Rectangle
 
@@ -54,8 +56,8 @@ def mac_matrix(path, M, pairs, f_test, f_model) -> None:
     ax.set_xticks(range(na), [f"{j + 1}\n{f:.0f}" for j, f in enumerate(f_model)], fontsize=7)
     ax.set_yticks(range(nt), [f"{i + 1}: {f:.0f}" for i, f in enumerate(f_test)], fontsize=7)
     ax.set_xlabel("model mode / frequency [Hz]")
-    ax.set_ylabel("test mode: frequency [Hz]")
-    ax.set_title("MAC (pairs framed in red)")
+    ax.set_ylabel(f"{rows}: frequency [Hz]")
+    ax.set_title(title)
     fig.colorbar(im, ax=ax, fraction=0.046, pad=0.04)
     _save(fig, path)
 
@@ -172,9 +174,10 @@ def shape_overlays(out_dir, model, outline, pairs, test_xy, test_w, model_at_tes
     return names
 
 
-def comac_map(path, outline, xy, values, labels) -> None:
-    """COMAC per measured DOF at its point on the board outline (low = test and model disagree); on a
-    structure in 3-D (``outline`` None, ``xy`` the points (k, 3)) a 3-D map."""
+def comac_map(path, outline, xy, values, labels, lines=None) -> None:
+    """COMAC per measured DOF at its point on the board outline (low = test and model disagree), over the
+    test's wireframe ``lines`` (n, 2, 3) [m] when given; on a structure in 3-D (``outline`` None, ``xy`` the
+    points (k, 3)) a 3-D map."""
     plt = _plt()
     lo = min(0.9, float(np.min(values)))
     if outline is None:
@@ -187,13 +190,16 @@ def comac_map(path, outline, xy, values, labels) -> None:
     xy = np.asarray(xy) * 1e3
     fig, ax = plt.subplots(figsize=(6.0, 5.6))
     _outline(ax, outline)  # lo spreads the usual 0.9-1 range over the colours
+    if lines is not None:
+        from matplotlib.collections import LineCollection
+
+        ax.add_collection(LineCollection(np.asarray(lines)[:, :, :2] * 1e3, colors="0.55", linewidths=0.8, zorder=2))
     sc = ax.scatter(xy[:, 0], xy[:, 1], c=values, cmap="RdYlGn", vmin=lo, vmax=1.0, s=60, edgecolors="k", zorder=3)
-    worst = np.argsort(values)[: min(5, len(values))]
-    for i in worst:
-        ax.annotate(f"{labels[i]}\n{values[i]:.2f}", xy[i], textcoords="offset points", xytext=(6, 4), fontsize=7)
     ax.set_aspect("equal")
     ax.set_xlabel("x [mm]")
     ax.set_ylabel("y [mm]")
     ax.set_title("COMAC per point over the pairs (five lowest labelled)")
     fig.colorbar(sc, ax=ax, fraction=0.046, pad=0.04, label="COMAC")
+    worst = np.argsort(values)[: min(5, len(values))]
+    place_labels(ax, xy[worst], [f"{labels[i]}\n{values[i]:.2f}" for i in worst], fontsize=7)
     _save(fig, path)

@@ -1,5 +1,6 @@
 """Reports of a correlation (``pcbdyn correlate``): the pair table, CSV tables and the pictures (MAC
-matrix, frequency plot, COMAC map, shape overlays of the z-measured DOFs)."""
+matrix, AutoMAC of the model at the test points, frequency plot, COMAC map, shape overlays of the
+z-measured DOFs)."""
 
 from __future__ import annotations
 
@@ -18,7 +19,8 @@ def format_pairs(pairs) -> str:
     rows = ["  ".join(f"{h:>12}" for h in HEADER)]
     for p in pairs:
         rows.append("  ".join([f"{p.test + 1:>12d}", f"{p.model + 1:>12d}", f"{p.f_test:>12.2f}",
-                               f"{p.f_model:>12.2f}", f"{p.df_pct:>+12.2f}", f"{p.mac_combined:>12.3f}"]))
+                               f"{p.f_model:>12.2f}", f"{p.df_pct:>+12.2f}", f"{p.mac_combined:>12.3f}"])
+                    + ("" if p.used else "  (beyond the frequency limit: not used for updating)"))
     return "\n".join(rows)
 
 
@@ -43,17 +45,24 @@ def z_rows(test_modes):
     return rows, np.sign(d[rows, 2])
 
 
-def write_outputs(out: Path, board, bm, modes, test_modes, corr) -> list:
-    """CSV tables and PNG pictures under ``out``; returns the names written (relative to ``out``)."""
+def write_outputs(out: Path, board, bm, modes, test_modes, corr, wireframe=None) -> list:
+    """CSV tables and PNG pictures under ``out``; returns the names written (relative to ``out``).
+    ``wireframe`` (n, 2): the test's lines between point ids (UFF trace lines and elements), drawn under the
+    points."""
     pairing = corr.pairing
-    written = ["pairs.csv", "comac.csv", "mac_matrix.png", "frequencies.png", "comac.png"]
+    written = ["pairs.csv", "comac.csv", "mac_matrix.png", "automac.png", "frequencies.png", "comac.png"]
     write_text(out / "pairs.csv", pairs_csv(pairing.pairs))
     xyz = test_modes.dof_xyz()
     write_text(out / "comac.csv", comac_csv(corr.dof_labels, xyz, corr.comac))
     plots.mac_matrix(out / "mac_matrix.png", pairing.mac, pairing.pairs, test_modes.frequencies, modes.frequencies)
+    plots.mac_matrix(out / "automac.png", pairing.automac, [], modes.frequencies, modes.frequencies,
+                     "AutoMAC of the model at the test points (high off the diagonal: aliased)", "model mode")
     plots.frequency_plot(out / "frequencies.png", pairing.pairs)
     outline = getattr(board, "outline", None)  # a board's; a structure in 3-D has none
-    plots.comac_map(out / "comac.png", outline, xyz if outline is None else xyz[:, :2], corr.comac, corr.dof_labels)
+    pts = test_modes.points
+    lines = None if wireframe is None or not len(wireframe) else pts.xyz[pts.index(np.asarray(wireframe).ravel())]
+    plots.comac_map(out / "comac.png", outline, xyz if outline is None else xyz[:, :2], corr.comac, corr.dof_labels,
+                    None if lines is None else lines.reshape(-1, 2, 3))
     rows, sign = z_rows(test_modes)
     if rows.size and outline is not None:  # the overlays show w on a plate
         model_w = pairing.model_shapes(modes.shapes)[2::6]

@@ -6,7 +6,7 @@ import numpy as np
 
 #: SI unit of an effect -> (display unit, factor from SI)
 DISPLAY = {"kg": ("g", 1e3), "kg*m^2": ("kg*mm^2", 1e6), "N/m": ("N/mm", 1e-3), "N*m/rad/m": ("N*m/rad/m", 1.0),
-           "N*m^2": ("N*m^2", 1.0), "1": ("%", 100.0)}
+           "N*m^2": ("N*m^2", 1.0), "1": ("%", 100.0), "Pa": ("GPa", 1e-9)}
 
 
 def shown(value: float, unit: str) -> tuple:
@@ -58,6 +58,7 @@ def plot_evidence(path, board, evidence, effects) -> None:
     """Where the residual points: the chi^2 a point mass (and a ground spring) at each node would
     remove once the declared parameters are fitted, with the effects found marked."""
     from .correlation_plots import _plt, _save
+    from .labels import place_labels
 
     kinds = list(evidence)
     if getattr(board, "outline", None) is None:  # a structure in 3-D: 3-D maps
@@ -72,7 +73,8 @@ def plot_evidence(path, board, evidence, effects) -> None:
                 ax.scatter(*np.asarray(e["at_mm"], float)[:, None], marker="*", s=200, c="r", edgecolors="w")
         _save(fig, path)
         return
-    fig, axes = _plt().subplots(1, max(len(kinds), 1), figsize=(5.5 * max(len(kinds), 1), 5.0), squeeze=False)
+    fig, axes = _plt().subplots(1, max(len(kinds), 1), figsize=(5.5 * max(len(kinds), 1), 5.0), squeeze=False,
+                                layout="constrained")
     outline = np.vstack([board.outline.vertices, board.outline.vertices[:1]]) * 1e3
     for ax, kind in zip(axes[0], kinds):
         xy, gain = evidence[kind]
@@ -81,8 +83,9 @@ def plot_evidence(path, board, evidence, effects) -> None:
         fig.colorbar(sc, ax=ax, label="chi^2 removed")
         for e in effects:
             ax.plot(*e["at_mm"], "r*", ms=14, mec="w")
-            ax.annotate(e["type"], e["at_mm"], color="r", xytext=(4, 4), textcoords="offset points")
         ax.set(title=f"evidence for a {kind.replace('_', ' ')}", xlabel="x [mm]", ylabel="y [mm]", aspect="equal")
+    for ax in axes[0][:len(kinds)]:
+        place_labels(ax, [e["at_mm"] for e in effects], [e["type"] for e in effects], color="r")
     _save(fig, path)
 
 

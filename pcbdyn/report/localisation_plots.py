@@ -1,6 +1,6 @@
 """Pictures of error localisation: indicator maps on the board, the epsilon-condition-number
 curve used to choose the rank (thesis Fig. 5.13a), the selection order and descending ratios
-(Figs. 5.5, 5.6) and success-ratio charts (Fig. 5.14)."""
+(Figs. 5.5, 5.6) with the parameters named, and success-ratio charts (Fig. 5.14)."""
 
 from __future__ import annotations
 
@@ -92,28 +92,39 @@ def condition_curve_plot(ax, curve, rank: int | None = None):
     ax.set_title("epsilon-condition number")
 
 
+#: most parameters a panel of the localisation figure names (one row each)
+NAMED = 15
+
+
+def _named_bars(ax, values, labels, highlight=()):
+    """Horizontal bars, one row per label from the top, the ``highlight`` rows coloured."""
+    y = np.arange(len(labels))
+    ax.barh(y, values, color=["C3" if k in highlight else "C0" for k in range(len(labels))])
+    ax.set_yticks(y, labels, fontsize=8)
+    ax.set_ylim(len(labels) - 0.5, -0.5)
+
+
 def localisation_figure(path, subset, names) -> Path:
-    """Four panels of one localisation (as thesis Fig. 5.13): condition curve, selection order,
-    residue descending ratios and the subset solution."""
+    """Three panels of one localisation (as thesis Fig. 5.13), parameters by name: the condition curve,
+    the parameters in their selection order with their residue descending ratios (Figs. 5.5-5.6, eq.
+    5.60; those retained in red) and the subset solution (the largest changes, the selected in red)."""
     plt = _pyplot()
-    fig, axs = plt.subplots(2, 2, figsize=(10, 7))
-    condition_curve_plot(axs[0, 0], subset.condition_curve, subset.rank)
-    order = np.asarray(subset.order)
-    axs[0, 1].plot(np.arange(1, order.size + 1), order + 1, "o")
-    axs[0, 1].set_xlabel("selection order")
-    axs[0, 1].set_ylabel("parameter number")
-    axs[0, 1].set_title("selection order (Fig. 5.5)")
-    if len(subset.descending_ratio):
-        axs[1, 0].bar(np.arange(1, len(subset.descending_ratio) + 1), subset.descending_ratio)
-    axs[1, 0].set_xlabel("selection order")
-    axs[1, 0].set_ylabel("dRr [%]")
-    axs[1, 0].set_title("residue descending ratio (eq. 5.60)")
-    axs[1, 1].bar(np.arange(1, len(subset.x) + 1), subset.x)
-    for i in subset.selected:
-        axs[1, 1].annotate(names[i], (i + 1, subset.x[i]), fontsize=7, ha="center")
-    axs[1, 1].set_xlabel("parameter number")
-    axs[1, 1].set_ylabel("relative change")
-    axs[1, 1].set_title(f"{subset.method} solution")
+    fig, axs = plt.subplots(1, 3, figsize=(14, 5), gridspec_kw={"width_ratios": [1.1, 1, 1]})
+    condition_curve_plot(axs[0], subset.condition_curve, subset.rank)
+    ratio = np.asarray(subset.descending_ratio, float)[:NAMED]
+    order = np.asarray(subset.order, int)[: ratio.size]
+    _named_bars(axs[1], ratio, [f"{k + 1}. {names[i]}" for k, i in enumerate(order)],
+                highlight=range(len(subset.retained)))
+    axs[1].set_xlabel("residue descending ratio dRr [%]")
+    axs[1].set_title(f"selection order ({len(order)} of {len(names)}; retained in red)")
+    x = np.asarray(subset.x, float)
+    chosen = [int(i) for i in subset.selected]
+    rows = (chosen + [int(i) for i in np.argsort(-np.abs(x), kind="stable") if i not in chosen])[:max(NAMED,
+                                                                                                   len(chosen))]
+    _named_bars(axs[2], x[rows], [names[i] for i in rows], highlight=range(len(chosen)))
+    axs[2].axvline(0.0, color="0.3", lw=0.8)
+    axs[2].set_xlabel("relative change")
+    axs[2].set_title(f"{subset.method} solution (selected in red)")
     fig.tight_layout()
     return save_figure(fig, path, dpi=110)
 

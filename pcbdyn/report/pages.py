@@ -49,9 +49,10 @@ def correlate_page(out: Path, board_toml, test_uff, board, label: str, pairing, 
     page.table("Lowest COMAC", pd.DataFrame([{"DOF": k, "COMAC": v} for k, v in lowest]),
                note="COMAC per measured DOF over the pairs (thesis eq. 2.4); low values mark where test and model "
                     "differ")
-    main = [n for n in ("mac_matrix.png", "frequencies.png", "comac.png") if n in written]
-    page.pictures("MAC matrix, frequencies and COMAC", [out / n for n in main],
-                  ["MAC matrix (pairs framed)", "model against test frequency", "COMAC per point"])
+    captions = {"mac_matrix.png": "MAC matrix (pairs framed)", "automac.png": "AutoMAC of the model at the test points",
+                "frequencies.png": "model against test frequency", "comac.png": "COMAC per point"}
+    main = [n for n in captions if n in written]
+    page.pictures("MAC matrix, frequencies and COMAC", [out / n for n in main], [captions[n] for n in main])
     overlays = [n for n in written if n.endswith(".png") and n not in main]
     if overlays:
         page.pictures("Mode shapes, test over model", [out / n for n in overlays], [Path(n).stem for n in overlays])

@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from .correlation_plots import _plt, _save
+from .labels import place_labels
 
 #: code -> (marker, colour, legend)
 STYLE = {
@@ -16,6 +17,8 @@ STYLE = {
     "v": ("^", "tab:blue", "frequency + shape"),
     "s": ("s", "tab:green", "stable (all three)"),
 }
+#: offsets [points] of a mode's number above the chart: rows tried from the lowest
+ROWS = [(0, 2), (0, 11), (0, 20)]
 
 
 def stabilisation_chart(path, result, frfs) -> None:
@@ -30,10 +33,8 @@ def stabilisation_chart(path, result, frfs) -> None:
         if on.any():
             ax.plot(c.frequency[on], c.order[on], linestyle="none", marker=marker, markersize=4, mfc="none",
                     mec=colour, label=f"{label} ({int(on.sum())})")
-    for k, f in enumerate(result.modes.frequencies):
+    for f in result.modes.frequencies:
         ax.axvline(f, color="tab:red", linewidth=0.8, alpha=0.6)
-        ax.text(f, 1.0, str(k + 1), transform=ax.get_xaxis_transform(), color="tab:red", fontsize=7,
-                ha="center", va="bottom")
     ax.set_xlim(lo, hi)
     ax.set_xlabel("frequency [Hz]")
     ax.set_ylabel("model order (poles)")
@@ -43,7 +44,10 @@ def stabilisation_chart(path, result, frfs) -> None:
     mag.semilogy(frfs.frequencies[band], mean, color="0.35", linewidth=0.8)
     mag.set_ylabel(f"mean |H| [{frfs.units}]")
     n = result.modes.n_modes
-    ax.set_title(f"\nstabilisation chart, LSCF orders up to {2 * result.max_order}: {n} mode(s) chosen "
-                 f"({result.selection})")
+    ax.set_title(f"stabilisation chart, LSCF orders up to {2 * result.max_order}: {n} mode(s) chosen "
+                 f"({result.selection})", pad=8 + 9 * len(ROWS))
     ax.legend(loc="upper left", fontsize=7, framealpha=0.9)
+    # the chosen modes' numbers above the chart, a row higher where a neighbour's would overlap
+    place_labels(ax, [(f, 1.0) for f in result.modes.frequencies], [str(k + 1) for k in range(n)],
+                 xycoords=ax.get_xaxis_transform(), offsets=ROWS, color="tab:red", fontsize=7)
     _save(fig, path)

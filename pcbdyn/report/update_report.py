@@ -6,20 +6,22 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..units import from_si
+from ..units import from_si, printed_unit
 from .files import save_figure
 
 #: SI unit of the JSON values for the display units the input files use (others are SI already)
-SI_UNITS = {"mm": "m", "g": "kg"}
+SI_UNITS = {"mm": "m", "g": "kg", "GPa": "Pa"}
 
 
 def parameter_rows(problem, p) -> list:
-    """One dict per parameter: name, unit, initial/updated (in the board's unit), change %, bound hit."""
+    """One dict per parameter: name, unit, initial/updated (in the unit printed for the board's,
+    :func:`pcbdyn.units.printed_unit`: a modulus in GPa), change %, bound hit."""
     lo, hi = problem.bounds
     rows = []
     for i, (par, v0, v) in enumerate(zip(problem.parameters, problem.p0, p)):
         hit = "lower" if np.isclose(v, lo[i], rtol=1e-6) else "upper" if np.isclose(v, hi[i], rtol=1e-6) else ""
-        rows.append({"name": par.name, "unit": par.unit, "initial": from_si(v0, par.unit), "updated": from_si(v, par.unit),
+        u = printed_unit(par.unit)
+        rows.append({"name": par.name, "unit": u, "initial": from_si(v0, u), "updated": from_si(v, u),
                      "change_pct": 100.0 * (v / v0 - 1.0), "bound_hit": hit, "log_scale": i in problem.log_scale})
     return rows
 
@@ -105,7 +107,7 @@ def update_json(problem, res, rows, before, after, what: dict, method: str, solv
                        for r, v0, v in zip(rows, problem.p0, res.p)},
         "before": _summary(before), "after": _summary(after), "iterations": res.iterations,
         "converged": bool(res.converged), "reason": res.reason, "status": what["status"],
-        "status_details": what["details"], "method": method, "solver": solver,
+        "status_details": what["details"], "warnings": what["warnings"], "method": method, "solver": solver,
         "history": [{"iteration": h["iteration"], "p": np.asarray(h["p"]).tolist(),
                      "max_freq_error_pct": h["max_freq_error_pct"], "condition_stacked": _finite(h["condition_stacked"]),
                      "rank": h.get("rank"), "set_aside": h.get("set_aside", [])} for h in res.history],

@@ -66,31 +66,37 @@ def summary_lines(a) -> list:
     return lines + [f"note: {n}" for n in a.notes]
 
 
-def board_map(path, board, model, a) -> None:
-    """RMS relative displacement over the board (grey) with each part's footprint coloured by its
-    margin (red fails Steinberg's criterion, green passes)."""
+def margin_map(path, board, model, field_mm, field_label: str, parts, margin_label: str, title: str) -> None:
+    """A response over the board (grey, ``field_mm`` per node) with each part's footprint coloured by
+    its margin (red fails, green passes); ``parts`` have ``ref`` and ``margin``."""
     from matplotlib.colors import TwoSlopeNorm
     from matplotlib.patches import Polygon
 
     plt = _plt()
-    fig, ax = plt.subplots(figsize=(7.0, 7.0))
+    (x0, y0), (x1, y1) = board.outline.bbox
+    fig, ax = plt.subplots(figsize=(7.5, float(np.clip(6.0 * (y1 - y0) / (x1 - x0), 3.0, 7.5)) + 2.0))
     _outline(ax, board.outline)
-    z = np.nan_to_num(a.node_z_rms) * 1e3
-    cf = ax.tricontourf(_shell_triangulation(model), z, levels=12, cmap="Greys", alpha=0.6)
-    fig.colorbar(cf, ax=ax, fraction=0.046, pad=0.02, label="RMS relative displacement [mm]")
+    cf = ax.tricontourf(_shell_triangulation(model), np.nan_to_num(field_mm), levels=12, cmap="Greys", alpha=0.6)
+    fig.colorbar(cf, ax=ax, fraction=0.046, pad=0.02, label=field_label)
     cmap, norm = plt.get_cmap("RdYlGn"), TwoSlopeNorm(vmin=-1.0, vcenter=0.0, vmax=1.0)
     corners = {c.ref: c.corners() for c in board.components}
-    for p in a.parts:
+    for p in parts:
         m = float(np.clip(p.margin, -1.0, 1.0))
         ax.add_patch(Polygon(corners[p.ref] * 1e3, closed=True, facecolor=cmap(norm(m)), edgecolor="k", alpha=0.9))
         x, y = corners[p.ref].mean(axis=0) * 1e3
         ax.text(x, y, f"{p.ref}\n{100 * p.margin:+.0f} %", ha="center", va="center", fontsize=8)
     sm = plt.cm.ScalarMappable(norm=norm, cmap=cmap)
-    fig.colorbar(sm, ax=ax, orientation="horizontal", fraction=0.05, pad=0.1,
-                 label="margin z_allow / (3 z_rms) - 1 (clipped at +-100 %)")
-    ax.set(aspect="equal", xlabel="x [mm]", ylabel="y [mm]",
-           title=f"{board.name}: margin per part under {a.psd.name} ({a.input_grms:.1f} grms, {a.axis})")
+    fig.colorbar(sm, ax=ax, orientation="horizontal", fraction=0.05, pad=0.1, label=f"{margin_label} (clipped at +-100 %)")
+    ax.set(aspect="equal", xlabel="x [mm]", ylabel="y [mm]")
+    ax.set_title(title, fontsize=10)
     _save(fig, path)
+
+
+def board_map(path, board, model, a) -> None:
+    """RMS relative displacement over the board with each part coloured by its margin."""
+    margin_map(path, board, model, a.node_z_rms * 1e3, "RMS relative displacement [mm]", a.parts,
+               "margin z_allow / (3 z_rms) - 1",
+               f"{board.name}: margin per part under {a.psd.name} ({a.input_grms:.1f} grms, {a.axis})")
 
 
 def spectra_plot(path, a) -> None:
@@ -128,22 +134,35 @@ def write_outputs(out: Path, board, model, a) -> list:
     return ["parts.csv", "modes.csv", "response_psd.csv", "board_map.png", "response_psd.png"]
 
 
-def html_page(out: Path, board_toml, board, a, inputs: dict) -> Path:
-    """report.html in ``out`` (after :func:`write_outputs`): verdicts, tables, pictures, inputs."""
+def verdict(parts, criterion: str) -> str:
+    """'2 of 6 part(s) fail: U1, U3' or 'all 6 part(s) pass Steinberg's <criterion>'."""
+    failing = [p.ref for p in parts if not p.ok]
+    return f"{len(failing)} of {len(parts)} part(s) fail: {', '.join(failing)}" if failing else \
+        f"all {len(parts)} part(s) pass Steinberg's {criterion}"
+
+
+def verdict_page(command: str, board, board_toml, subtitle: str, inputs: dict, summary: list, parts_df, parts,
+                 note: str):
+    """The head of the page of ``vibe`` and ``shock``: title, inputs, summary and the parts table
+    (rows coloured by verdict); the caller adds its pictures and tables and writes it."""
     from .html import Page, describe_file
 
-    failing = [p.ref for p in a.parts if not p.ok]
-    verdict = f"{len(failing)} of {len(a.parts)} part(s) fail: {', '.join(failing)}" if failing else \
-        f"all {len(a.parts)} part(s) pass Steinberg's criterion"
-    page = Page(f"pcbdyn vibe: {board.name}",
-                subtitle=f"{a.psd.name}, {a.input_grms:.2f} grms along {a.axis}: {verdict}")
+    page = Page(f"pcbdyn {command}: {board.name}", subtitle=subtitle)
     page.items("Inputs", {"board": describe_file(board_toml), **inputs})
-    page.text("Summary", summary_lines(a))
-    page.table("Parts, worst margin first", parts_table(a), status=["good" if p.ok else "bad" for p in a.parts],
-               note="z: RMS relative displacement normal to the board at the part's centre; z_allow: Steinberg's "
-                    "allowable (2e7 reversals at 3 sigma) for a part where the board's displacement is measured; "
-                    "r: Steinberg's position factor read from the model (z / largest z on the board); life: three-band "
-                    "technique and Miner's rule at the zero up-crossing rate nu0.")
+    page.text("Summary", summary)
+    page.table("Parts, worst margin first", parts_df, status=["good" if p.ok else "bad" for p in parts], note=note)
+    return page
+
+
+def html_page(out: Path, board_toml, board, a, inputs: dict) -> Path:
+    """report.html in ``out`` (after :func:`write_outputs`): verdicts, tables, pictures, inputs."""
+    page = verdict_page("vibe", board, board_toml,
+                        f"{a.psd.name}, {a.input_grms:.2f} grms along {a.axis}: {verdict(a.parts, 'criterion')}",
+                        inputs, summary_lines(a), parts_table(a), a.parts,
+                        "z: RMS relative displacement normal to the board at the part's centre; z_allow: Steinberg's "
+                        "allowable (2e7 reversals at 3 sigma) for a part where the board's displacement is measured; "
+                        "r: Steinberg's position factor read from the model (z / largest z on the board); life: "
+                        "three-band technique and Miner's rule at the zero up-crossing rate nu0.")
     page.pictures("Board map and response spectra", [out / "board_map.png", out / "response_psd.png"],
                   ["margin per part over the RMS relative displacement", "input and response acceleration PSDs"])
     page.table("Modes", modes_table(a))

@@ -14,11 +14,10 @@ import re
 
 import numpy as np
 
-from ..units import shown
-from .data import Dofs, Modes, Points, TestDataError
+from ..units import LENGTHS, shown
+from .data import FILE_FLOOR_HZ, Dofs, Modes, Points, TestDataError, check_frequencies
 from .uff_write import _atomic
 
-_LENGTH = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "um": 1e-6, "in": 0.0254}
 _HEAD = re.compile(r"^\s*([A-Za-z][A-Za-z0-9 ]*?)\s*(?:[\[(]\s*([^\])]*)\s*[\])]|_(mm|cm|m|um|in))?\s*$")
 
 
@@ -64,9 +63,9 @@ def _length_col(path, df, cols, name, unit, required=True):
     u = u or unit
     if u is None:
         raise TestDataError(f"{path}: column '{col}' has no unit; write it as '{name} [mm]' (or '{name} [m]')")
-    if u not in _LENGTH:
-        raise TestDataError(f"{path}: column '{col}': unit '{u}' is not one of {', '.join(_LENGTH)}")
-    return numbers(path, df, col) * _LENGTH[u]
+    if u not in LENGTHS:
+        raise TestDataError(f"{path}: column '{col}': unit '{u}' is not one of {', '.join(LENGTHS)}")
+    return numbers(path, df, col) * LENGTHS[u]
 
 
 def read_points_csv(path, unit: str | None = None):
@@ -149,7 +148,7 @@ def read_modes_csv(freq_path, shapes_path) -> Modes:
     scale = {None: 1.0, "hz": 1.0, "khz": 1e3}.get((u or "hz").lower())
     if scale is None:
         raise TestDataError(f"{freq_path}: frequency unit '{u}' is not Hz or kHz")
-    f = numbers(freq_path, df, col) * scale
+    f = check_frequencies(numbers(freq_path, df, col) * scale, str(freq_path), floor=FILE_FLOOR_HZ)
     zeta = numbers(freq_path, df, cols["damping ratio"][0]) if "damping ratio" in cols else None
     mpc = numbers(freq_path, df, cols["mpc"][0]) if "mpc" in cols else None
     sf, scols = _table(shapes_path)

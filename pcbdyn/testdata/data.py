@@ -146,16 +146,29 @@ def _which(i: int, n: int, numbers) -> str:
     return f" (mode {int(numbers[i])})"
 
 
-def check_frequencies(frequencies, where: str = "modes", numbers=None) -> np.ndarray:
+#: [Hz] the lowest frequency a file's elastic mode may have: below it a mode is a rigid-body mode (which a
+#: file marks as such, with 0 Hz, and pcbdyn does not pair) or a value written in the wrong unit
+FILE_FLOOR_HZ = 0.01
+
+
+def check_frequencies(frequencies, where: str = "modes", numbers=None, floor: float = 0.0) -> np.ndarray:
     """Measured natural frequencies [Hz] as floats: each a finite number above 0 (0 Hz or below is a rigid-body
-    mode or a mistyped value). The one home of this rule: :class:`Modes` and the readers (which give ``where``:
-    the file, dataset or table row) call it. ``numbers``: the modes' numbers, to name the one refused."""
+    mode or a mistyped value) and, with ``floor`` (the readers of files pass :data:`FILE_FLOOR_HZ`), not below
+    it. The one home of this rule: :class:`Modes` (whose simulated modes keep floor 0) and the readers (which
+    give ``where``: the file, dataset or table row) call it. ``numbers``: the modes' numbers, to name the one
+    refused."""
     f = np.asarray(frequencies, dtype=float).ravel()
     bad = np.flatnonzero(~(np.isfinite(f) & (f > 0)))
     if bad.size:
         i = int(bad[0])
         raise TestDataError(f"{_at(where)}frequency {f[i]:g} Hz{_which(i, f.size, numbers)}: a measured mode's "
                             "frequency is a finite number above 0")
+    low = np.flatnonzero(f < floor)
+    if low.size:
+        i = int(low[0])
+        raise TestDataError(f"{_at(where)}frequency {f[i]:g} Hz{_which(i, f.size, numbers)} is below {floor:g} Hz, "
+                            "where no elastic mode is measured: a rigid-body mode (remove it from the file) or a "
+                            "value in another unit (give it in Hz)")
     return f
 
 
@@ -348,11 +361,14 @@ def excitations(frfs: FRFs) -> list:
 
 @dataclass
 class TestData:
-    """What one test file holds: points, and optionally modes, FRFs; datasets that were skipped."""
+    """What one test file holds: points, and optionally modes, FRFs; datasets that were skipped; the test's
+    wireframe (n, 2) of point ids (trace lines, element edges) and its elements [(descriptor, node ids)]."""
 
     points: Points
     modes: Modes | None = None
     frfs: FRFs | None = None
     skipped: list = field(default_factory=list)
+    wireframe: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int64))
+    elements: list = field(default_factory=list)
 
     __test__ = False

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .data import Modes, TestDataError, check_frequencies
+from .data import FILE_FLOOR_HZ, Modes, TestDataError, check_frequencies
 from .uff import read_uff
 
 #: configuration names of a frequency table that mean the base configuration
@@ -16,6 +16,12 @@ BASE_NAMES = ("base", "c1", "")
 
 def read_modes(path) -> Modes:
     """The measured modes of a UFF file; a clear error when there are none."""
+    return read_test(path).modes
+
+
+def read_test(path):
+    """What a UFF test file holds (:class:`.data.TestData`: its modes, points and wireframe), with a clear
+    error when it has no modes."""
     from ..domain import MAX_MODES
 
     data = read_uff(path)
@@ -26,7 +32,22 @@ def read_modes(path) -> Modes:
         what = " (it holds FRFs only: identify modes from them first)" if data.frfs is not None else ""
         raise TestDataError(f"{path}: no mode shapes (UFF dataset 55) in the file{what}; export the test's mode "
                             "shapes as dataset 55, or write a test with 'pcbdyn simulate-test'")
-    return data.modes
+    return data
+
+
+def read_geometry(path):
+    """The measurement points of a points CSV (point, x, y, z with units in the header) or of the geometry
+    of a UFF file (datasets 15, 2411), for test files that carry none."""
+    from .csvio import read_points_csv
+
+    path = Path(path)
+    if path.suffix.lower() == ".csv":
+        return read_points_csv(path)[0]
+    points = read_uff(path).points
+    if not len(points):
+        raise TestDataError(f"{path}: no geometry (UFF datasets 15 or 2411); give a points CSV (point, x [mm], "
+                            "y [mm], z [mm]) or a UFF file with the points")
+    return points
 
 
 def _configuration(structure, name, source) -> str:
@@ -71,6 +92,6 @@ def read_frequency_table(path, structure) -> list:
                                 f"{MAX_MODES}")
         if np.unique(nc).size < nc.size:
             raise TestDataError(f"{path.name}: configuration {name}: a mode number is given twice; give each mode once")
-        check_frequencies(fc, f"{path.name}: configuration {name}", nc)
+        check_frequencies(fc, f"{path.name}: configuration {name}", nc, floor=FILE_FLOOR_HZ)
         out.append((cfg, Modes.frequencies_only(fc, nc)))
     return out

@@ -30,6 +30,7 @@ import re
 import numpy as np
 
 from .data import (
+    FILE_FLOOR_HZ,
     Dofs,
     FRFs,
     Modes,
@@ -40,51 +41,13 @@ from .data import (
     check_frequencies,
     check_shapes,
 )
+from .uff_fields import Cursor, label, numbers
+from .uff_geometry import PARSERS, Geometry, geometry
 from .uff_write import write_uff
 
-_NUM = re.compile(rb"[-+]?(?:(?:\d+\.\d*|\.\d+|\d+)(?:[ED][-+]?\d+)?|nan|inf(?:inity)?)", re.IGNORECASE)
 _SPEC_KIND = {8: "receptance", 11: "mobility", 12: "accelerance"}
 _G = 9.80665
 _TAG = b"    -1"
-
-
-def _numbers(line: bytes, where: str, nan: bool = False) -> list:
-    """The numbers on one data line; any other character on it, or a value that is not finite (``nan``:
-    NaN allowed, an FRF value not measured), is an error naming ``where``."""
-    rest = _NUM.sub(b" ", line).strip()
-    if rest:
-        text = line.decode("latin-1").strip()[:60]
-        raise TestDataError(f"{where}: '{rest.decode('latin-1')[:20]}' is not a number (the line reads '{text}')")
-    out = [float(t.replace(b"D", b"E").replace(b"d", b"e")) for t in _NUM.findall(line)]
-    if not all(math.isfinite(v) or (nan and math.isnan(v)) for v in out):
-        text = line.decode("latin-1").strip()[:60]
-        raise TestDataError(f"{where}: a value is not a finite number (the line reads '{text}'); write a number there")
-    return out
-
-
-class _Cursor:
-    """Reads the numbers of a dataset's lines record by record, across line breaks.
-
-    ``take(n, what, end=True)`` returns the next n numbers; with ``end`` the record must finish
-    there (no numbers left on its last line). ``first`` is the 0-based line of ``lines[0]`` in the
-    dataset, for the messages."""
-
-    def __init__(self, lines, first: int):
-        self.lines, self.first = lines, first
-        self.i = 0
-        self.buf = []
-
-    def take(self, n: int, what: str, end: bool = True) -> list:
-        while len(self.buf) < n:
-            if self.i >= len(self.lines):
-                raise TestDataError(f"the dataset ends before {what} ({len(self.buf)} of {n} values found)")
-            self.buf.extend(_numbers(self.lines[self.i], f"{what}, line {self.first + self.i + 1} of the dataset"))
-            self.i += 1
-        out, self.buf = self.buf[:n], self.buf[n:]
-        if end and self.buf:
-            raise TestDataError(f"{what}: expected {n} values, found {n + len(self.buf)} "
-                                f"(line {self.first + self.i} of the dataset)")
-        return out
 
 
 # ---------------------------------------------------------------------------------------- structure
@@ -137,7 +100,7 @@ def _parse55(raw: bytes) -> dict:
     lines = raw.splitlines()
     if len(lines) < 9:
         raise TestDataError("the dataset is shorter than its header (8 records)")
-    cur = _Cursor(lines[7:], 7)
+    cur = Cursor(lines[7:], 7)
     _, analysis, data_ch, spec, dtype, ndv = (int(v) for v in cur.take(6, "record 6"))
     nint, nrval = (int(v) for v in cur.take(2, "record 7", end=False))
     ints = [int(v) for v in cur.take(nint, "record 7")]
@@ -171,63 +134,13 @@ def _node_records(lines, first: int):
         if not line.strip():
             continue
         if _INT_LINE.match(line):
-            nodes.append(_label(int(line), f"line {first + k + 1} of the dataset"))
+            nodes.append(label(int(line), f"line {first + k + 1} of the dataset"))
             vals.append([])
         elif not nodes:
             raise TestDataError(f"values before the first node number (line {first + k + 1} of the dataset)")
         else:
-            vals[-1].extend(_numbers(line, f"node {nodes[-1]}, line {first + k + 1} of the dataset"))
+            vals[-1].extend(numbers(line, f"node {nodes[-1]}, line {first + k + 1} of the dataset"))
     return nodes, vals
-
-
-def _label(n, where: str) -> int:
-    """A node label: a whole number from 1 to 2^31 - 1 (the standard's I10 field)."""
-    if not (n == int(n) and 1 <= n < 2**31):
-        raise TestDataError(f"{where}: node label {n:g} is not a whole number from 1 to 2147483647")
-    return int(n)
-
-
-_NODE_FIELDS = {4: "label, two coordinate systems, colour", 3: "x, y, z",
-                7: "label, two coordinate systems, colour, x, y, z"}
-
-
-def _parse_nodes(raw: bytes, t: int) -> dict:
-    """Dataset 2411 (4 integers on one line, x y z on the next, per node) or 15 (all 7 on one line)."""
-    shape = (4, 3) if t == 2411 else (7,)
-    rows, part = [], []
-    for k, line in enumerate(raw.splitlines()[2:], start=3):
-        if not line.strip():
-            continue
-        v = _numbers(line, f"line {k} of the dataset")
-        want = shape[len(part)]
-        if len(v) != want:
-            raise TestDataError(f"line {k} of the dataset has {len(v)} values; {want} expected ({_NODE_FIELDS[want]})")
-        part.append(v)
-        if len(part) == len(shape):
-            rows.append(sum(part, []))
-            part = []
-    if part:
-        raise TestDataError(f"node {int(part[0][0])} has no coordinates line (the dataset ends after its label line)")
-    v = np.array(rows, dtype=float).reshape(-1, 7)
-    for label in v[:, 0]:
-        _label(label, "a node record")
-    return {"type": t, "node_nums": v[:, 0], "x": v[:, 4], "y": v[:, 5], "z": v[:, 6]}
-
-
-def _parse164(raw: bytes) -> dict:
-    """Dataset 164: units code (record 1) and the four factors to SI (record 2)."""
-    lines = raw.splitlines()
-    if len(lines) < 4:
-        raise TestDataError("the dataset is shorter than its two records")
-    try:
-        code = int(lines[2][:10])
-    except ValueError:
-        raise TestDataError(f"record 1 '{lines[2][:10].decode('latin-1')}' is not a units code") from None
-    f = _Cursor(lines[3:], 3).take(4, "record 2 (length, force, temperature, offset)")
-    if not (f[0] > 0 and f[1] > 0 and f[2] > 0):
-        raise TestDataError(f"record 2: the length, force and temperature factors must be above 0, got {f[:3]} (a "
-                            "file in SI has 1.0 for each)")
-    return {"type": 164, "units_code": code, "length": f[0], "force": f[1], "temp": f[2], "temp_offset": f[3]}
 
 
 def _mode_from55(d: dict):
@@ -246,7 +159,7 @@ def _mode_from55(d: dict):
         return None
     if d["values"].shape[1] < 3:
         raise TestDataError("a mode shape needs 3 values per node (x, y, z); this one has fewer")
-    check_frequencies([freq], "record 8")
+    check_frequencies([freq], "record 8", floor=FILE_FLOOR_HZ)
     check_damping([zeta], 1, "record 8")
     nodes, counts = np.unique(d["nodes"], return_counts=True)
     if (counts > 1).any():
@@ -275,22 +188,16 @@ def real_modes(psi: np.ndarray):
     return phi, mpc
 
 
-def _units(dsets) -> tuple:
-    """(length, force) factors of dataset 164: file value = SI value * factor."""
-    for d in dsets:
-        if d.get("type") == 164:
-            return float(d["length"]), float(d["force"])
-    return 1.0, 1.0
-
-
 def read_uff(path, points: Points | None = None, frf_kind: str | None = None) -> TestData:
     """Points, modes and FRFs of a UFF file, in SI units and the board frame.
 
-    ``points``: coordinates to use when the file has no geometry (15/2411), or to replace it.
-    ``frf_kind``: receptance, mobility or accelerance, for FRFs whose dataset does not say
-    (ordinate data type 0). Unsupported datasets are listed in ``TestData.skipped``. FRFs share
-    one frequency axis; response/reference pairs absent from the file are NaN in ``H``. A DOF
-    written along a negative axis comes back along the positive axis with its values negated.
+    ``points``: coordinates to use when the file has no geometry (15/2411), or to replace it (its
+    directions are then global). ``frf_kind``: receptance, mobility or accelerance, for FRFs whose
+    dataset does not say (ordinate data type 0). Unsupported datasets are listed in
+    ``TestData.skipped``. FRFs share one frequency axis; response/reference pairs absent from the file
+    are NaN in ``H``. Every DOF's direction is global: a direction code means the axis of its node's
+    displacement system (:mod:`.uff_geometry`), signed as written. Files without a dataset 164 are read
+    in the units :func:`.uff_geometry.stated_units` states (metres by default).
     """
     import pyuff
 
@@ -318,10 +225,10 @@ def read_uff(path, points: Points | None = None, frf_kind: str | None = None) ->
                 else:
                     modes55.append(m)
                 continue
-            if t not in (15, 2411, 58, 164):
+            if t not in PARSERS and t != 58:
                 skipped.append((k + 1, t, "dataset type not used by pcbdyn"))
                 continue
-            d = _parse_nodes(raw, t) if t in (15, 2411) else _parse164(raw) if t == 164 else _read58(uff, k, raw)
+            d = PARSERS[t](raw) if t in PARSERS else _read58(uff, k, raw)
         except TestDataError as exc:
             raise TestDataError(f"{where}: {exc}") from None
         except Exception as exc:
@@ -333,14 +240,15 @@ def read_uff(path, points: Points | None = None, frf_kind: str | None = None) ->
                 frf58.append((k + 1, d))
             else:
                 skipped.append((k + 1, t, f"function type {d.get('func_type')} is not an FRF (4)"))
-    L, F = _units(dsets)
     try:
-        geo = _points(dsets, L) if points is None else points
+        geo = geometry(dsets, path)
+        if points is not None:
+            geo = Geometry(points, length=geo.length, force=geo.force)
         modes = _assemble_modes(modes55, geo) if modes55 else None
-        frfs = _assemble_frfs(frf58, geo, L, F, frf_kind) if frf58 else None
+        frfs = _assemble_frfs(frf58, geo, frf_kind) if frf58 else None
     except TestDataError as exc:
-        raise TestDataError(f"{path}: {exc}") from None
-    return TestData(geo, modes, frfs, skipped)
+        raise TestDataError(str(exc) if str(exc).startswith(path) else f"{path}: {exc}") from None
+    return TestData(geo.points, modes, frfs, skipped, geo.wireframe, geo.elements)
 
 
 def _is_binary(raw: bytes) -> bool:
@@ -362,7 +270,7 @@ def _read58(uff, k, raw) -> dict:
     d = uff.read_sets(k, header_only=True)
     vals = []
     for i, line in enumerate(raw.splitlines()[13:]):
-        vals.extend(_numbers(line, f"record 12, line {i + 14} of the dataset", nan=True))
+        vals.extend(numbers(line, f"record 12, line {i + 14} of the dataset", nan=True))
     v = np.array(vals)
     n = int(d["num_pts"])
     complex_ = d["ord_data_type"] in (5, 6)
@@ -393,19 +301,9 @@ def _checked58(d: dict) -> dict:
     return d
 
 
-def _points(dsets, L) -> Points:
-    ids, xyz = [], []
-    for d in dsets:
-        if d.get("type") in (15, 2411):
-            ids.append(np.asarray(d["node_nums"], dtype=float).astype(np.int64))
-            xyz.append(np.column_stack([d["x"], d["y"], d["z"]]).astype(float))
-    if not ids:
-        return Points(np.zeros(0, np.int64), np.zeros((0, 3)))
-    return Points(np.concatenate(ids), np.vstack(xyz) / L)
-
-
-def _assemble_modes(modes55, geo: Points) -> Modes:
-    """One Modes object from the 55 datasets: DOFs are the (node, axis) pairs nonzero in any mode.
+def _assemble_modes(modes55, geo: Geometry) -> Modes:
+    """One Modes object from the 55 datasets: DOFs are the (node, axis) pairs nonzero in any mode, each
+    along its node's displacement axis in the global frame.
 
     Nodes absent from a dataset are zero there (dataset 55, note 9)."""
     all_nodes = np.unique(np.concatenate([m[2] for m in modes55]))
@@ -415,9 +313,10 @@ def _assemble_modes(modes55, geo: Points) -> Modes:
         psi[np.searchsorted(all_nodes, nodes), :, j] = vals
     used = np.any(psi != 0, axis=2)
     node_of, axis_of = np.nonzero(used)
-    dofs = Dofs.from_codes(all_nodes[node_of], axis_of + 1)
+    dirs = [geo.direction(n, a + 1) for n, a in zip(all_nodes[node_of], axis_of)]
+    dofs = Dofs(all_nodes[node_of], np.array(dirs, float).reshape(-1, 3))
     shapes, mpc = real_modes(psi[node_of, axis_of, :])
-    return Modes(geo, dofs, [m[0] for m in modes55], shapes, [m[1] for m in modes55], mpc)
+    return Modes(geo.points, dofs, [m[0] for m in modes55], shapes, [m[1] for m in modes55], mpc)
 
 
 def _frf_scale(d, kind, L, F) -> float:
@@ -438,7 +337,7 @@ def _frf_scale(d, kind, L, F) -> float:
     return scale
 
 
-def _assemble_frfs(frf58, geo: Points, L, F, frf_kind) -> FRFs:
+def _assemble_frfs(frf58, geo: Geometry, frf_kind) -> FRFs:
     x0 = None
     resp, ref, kinds, entries = {}, {}, set(), []
     for k, d in frf58:
@@ -453,7 +352,7 @@ def _assemble_frfs(frf58, geo: Points, L, F, frf_kind) -> FRFs:
         n = int(d.get("num_pts", len(d["data"])))
         x = np.asarray(d["x"], dtype=float)[:n]  # some tools pad the last line (pyuff issue 22)
         try:
-            y = np.asarray(d["data"])[:n] * _frf_scale(d, kind, L, F)
+            y = np.asarray(d["data"])[:n] * _frf_scale(d, kind, geo.length, geo.force)
         except TestDataError as exc:
             raise TestDataError(f"dataset #{k}: {exc}") from None
         if x0 is None:
@@ -476,9 +375,9 @@ def _assemble_frfs(frf58, geo: Points, L, F, frf_kind) -> FRFs:
     H = np.full((x0.size, len(resp), len(ref)), np.nan + 0j)
     for i, j, y in entries:
         H[:, i, j] = y
-    rdofs = Dofs.from_codes([n for n, _ in resp], [c for _, c in resp])
-    fdofs = Dofs.from_codes([n for n, _ in ref], [c for _, c in ref])
-    return FRFs(geo, x0, H, kinds.pop(), rdofs, fdofs)
+    rdofs, fdofs = (Dofs([n for n, _ in keys], np.array([geo.direction(n, c) for n, c in keys]).reshape(-1, 3))
+                    for keys in (list(resp), list(ref)))
+    return FRFs(geo.points, x0, H, kinds.pop(), rdofs, fdofs)
 
 
 __all__ = ["read_uff", "write_uff", "real_modes"]

@@ -18,27 +18,19 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse as sp
 
-from ..fe.curvature import curvature_matrix
-from ..fe.probe import model_probe
 from . import steinberg
-from .base_excitation import AXES, BaseExcitation, base_excitation
+from .base_excitation import BaseExcitation, base_excitation
 from .damping import Damping, modal_damping
-from .parts import judged_parts
+from .parts import PartVerdict, judged_parts, part_readers, shell_nodes
 from .spectra import G, Psd, SineSweep, VibrationError, frequency_grid
 
 
 @dataclass
-class PartResult:
-    """Steinberg's check of one part (SI units; lives in hours, None where nothing moves)."""
+class PartResult(PartVerdict):
+    """Steinberg's check of one part (SI units; lives in hours, None where nothing moves); its
+    margin z_allow / (3 z) - 1 is negative when it fails Steinberg's 2e7-cycle criterion."""
 
-    ref: str
-    package: str
-    c: float
-    span_m: float
-    length_m: float
-    position_factor: float
     z_rms_m: float
     z_allow_m: float
     z_allow_board_m: float | None
@@ -52,19 +44,8 @@ class PartResult:
     sine_damage: float | None = None
 
     @property
-    def margin(self) -> float:
-        """z_allow / (3 z) - 1: negative when the part fails Steinberg's 2e7-cycle criterion."""
-        return 1.0 / self.ratio - 1.0 if self.ratio > 0 else float("inf")
-
-    @property
     def ok(self) -> bool:
         return self.ratio <= 1.0 and (self.damage or 0.0) < 1.0 and (self.sine_damage or 0.0) < 1.0
-
-    def to_dict(self) -> dict:
-        d = dict(self.__dict__)
-        d["margin"] = None if np.isinf(self.margin) else self.margin
-        d["ok"] = self.ok
-        return d
 
 
 @dataclass
@@ -121,25 +102,6 @@ class Assessment:
         }
 
 
-def _shell_nodes(model) -> np.ndarray:
-    return np.unique(np.concatenate([es.conn.ravel() for es in model.sets.values() if es.etype in ("quad4", "tri3")]))
-
-
-def _curvature_rows(model, parts) -> tuple:
-    """(along L, across L) curvature operators, each (n_parts, n_dof) sparse, averaged over the
-    sample points of each footprint; across L is along L turned by 90 degrees."""
-    samples = np.vstack([p.samples for p in parts])
-    C = curvature_matrix(model, samples)
-    per = samples.shape[0] // len(parts)
-    mean = sp.kron(sp.eye(len(parts)), np.full((1, per), 1.0 / per), format="csr")
-    kxx, kyy, kxy = (mean @ C[k::3] for k in range(3))
-    out = []
-    for angle in (np.array([p.angle for p in parts]), np.array([p.angle for p in parts]) + 0.5 * np.pi):
-        c, s = np.cos(angle), np.sin(angle)
-        out.append(sp.diags(c * c) @ kxx + sp.diags(s * s) @ kyy + sp.diags(c * s) @ kxy)
-    return tuple(out)
-
-
 def _sine(be: BaseExcitation, sine: SineSweep, B: np.ndarray, parts, results) -> None:
     """Peak displacement and Miner damage of the sweep(s) at each part."""
     f = frequency_grid(sine.f[0], sine.f[-1], be.frequencies, be.zeta)
@@ -147,6 +109,16 @@ def _sine(be: BaseExcitation, sine: SineSweep, B: np.ndarray, parts, results) ->
     for j, res in enumerate(results):
         res.sine_z_peak_m = float(z[:, j].max())
         res.sine_damage = sine.sweeps * steinberg.sweep_damage(f, z[:, j], res.z_allow_m, sine.rate)
+
+
+def board_excitation(board, bm, modes, K, M, damping: Damping, axis: str, probe_tol: float | None) -> tuple:
+    """(:class:`BaseExcitation` of the solved board along ``axis`` with the modal damping asked for,
+    where each mode's damping came from); a free board is refused naming its file."""
+    zeta, source = modal_damping(damping, bm.model, modes, probe_tol)
+    try:
+        return base_excitation(bm.model, modes, K, M, zeta, axis), source
+    except VibrationError as exc:
+        raise VibrationError(f"{board.path.name}: {exc}") from None
 
 
 def assess(board, bm, modes, K, M, psd: Psd, damping: Damping, *, axis: str = "z", duration: float | None = None,
@@ -159,14 +131,10 @@ def assess(board, bm, modes, K, M, psd: Psd, damping: Damping, *, axis: str = "z
     ``probe_tol`` [m]: how far off the board a test point of a UFF damping file may lie."""
     parts = judged_parts(board) if parts is None else parts
     model = bm.model
-    zeta, source = modal_damping(damping, model, modes, probe_tol)
-    try:
-        be = base_excitation(model, modes, K, M, zeta, axis)
-    except VibrationError as exc:
-        raise VibrationError(f"{board.path.name}: {exc}") from None
+    be, source = board_excitation(board, bm, modes, K, M, damping, axis, probe_tol)
     grid = frequency_grid(psd.f[0], psd.f[-1], be.frequencies, be.zeta)
     C0, C2 = be.covariance(psd, grid), be.covariance(psd, grid, moment=2)
-    nodes = _shell_nodes(model)
+    nodes = shell_nodes(model)
     node_z = np.full(model.nodes.shape[0], np.nan)
     node_z[nodes] = np.sqrt(be.variance(be.basis[6 * nodes + 2], C0))
     z_peak = float(np.nanmax(node_z))
@@ -177,12 +145,11 @@ def assess(board, bm, modes, K, M, psd: Psd, damping: Damping, *, axis: str = "z
     results = []
     accel_psd, z_psd = np.zeros((grid.size, len(parts))), np.zeros((grid.size, len(parts)))
     if parts:
-        centres = np.column_stack([np.array([p.at for p in parts]), np.zeros(len(parts))])
-        Bz = be.columns(model_probe(model, centres).P)
-        direction = np.eye(3)[AXES.index(axis)]
-        Ba = be.columns(model_probe(model, centres, direction).P, "acceleration")
+        read = part_readers(model, parts, axis)
+        Bz = be.columns(read["z"])
+        Ba = be.columns(read["acceleration"], "acceleration")
         Ca = be.covariance(psd, grid, "acceleration")
-        k_long, k_across = (np.sqrt(be.variance(be.columns(k), C0)) for k in _curvature_rows(model, parts))
+        k_long, k_across = (np.sqrt(be.variance(be.columns(read[k]), C0)) for k in ("curvature_along", "curvature_across"))
         z_rms, m2 = np.sqrt(be.variance(Bz, C0)), be.variance(Bz, C2)
         a_rms = np.sqrt(be.variance(Ba, Ca))
         accel_psd, z_psd = be.response_psd(Ba, psd, grid, "acceleration"), be.response_psd(Bz, psd, grid)

@@ -89,7 +89,7 @@ def modal_damping(damping: Damping, model, modes, tol: float | None = None) -> t
             raise VibrationError(f"{damping.path}: every damping ratio in the file is 0; export the identified "
                                  "modal damping with the shapes, or give --damping zeta=... or Q=...")
         try:
-            pairs = correlate(test, model, modes, tol=tol).pairing.pairs
+            pairs = [p for p in correlate(test, model, modes, tol=tol).pairing.pairs if p.used]
         except (ModelError, TestDataError) as exc:
             raise VibrationError(f"{damping.path}: the test points do not lie on the model: {exc}") from None
         if not pairs:

@@ -13,8 +13,11 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.sparse as sp
 
 from ..components.library import LibraryError, find_package
+from ..fe.curvature import curvature_matrix
+from ..fe.probe import model_probe
 from .spectra import VibrationError
 
 #: Steinberg's package constants by kind of part, for the message that asks for one
@@ -39,6 +42,31 @@ class Part:
     angle: float
     span: float
     samples: np.ndarray
+
+
+@dataclass
+class PartVerdict:
+    """What the part results of ``vibe`` and ``shock`` share: the part (reference, package, Steinberg
+    constant, board span B and length L [m], position factor r read from the model), the margin from
+    their ``ratio`` of response to allowable, and the JSON row (with the margin and ``ok``)."""
+
+    ref: str
+    package: str
+    c: float
+    span_m: float
+    length_m: float
+    position_factor: float
+
+    @property
+    def margin(self) -> float:
+        """allowable / response - 1: negative when the part fails (infinite when nothing moves)."""
+        return 1.0 / self.ratio - 1.0 if self.ratio > 0 else float("inf")
+
+    def to_dict(self) -> dict:
+        d = dict(self.__dict__)
+        d["margin"] = None if np.isinf(self.margin) else self.margin
+        d["ok"] = self.ok
+        return d
 
 
 def _chord(outline, centre, angle) -> float:
@@ -93,3 +121,35 @@ def judged_parts(board, exclude=()) -> list:
             f"source to the [package] table of the part's library file ({CONSTANTS_HINT}), give the part a library "
             f"package that has one, or leave it out with --exclude {missing[0][0]}")
     return parts
+
+
+def shell_nodes(model) -> np.ndarray:
+    """The nodes of the model's shells (the board), where board maps are drawn."""
+    return np.unique(np.concatenate([es.conn.ravel() for es in model.sets.values() if es.etype in ("quad4", "tri3")]))
+
+
+def _curvature_rows(model, parts) -> tuple:
+    """(along L, across L) curvature operators, each (n_parts, n_dof) sparse, averaged over the
+    sample points of each footprint; across L is along L turned by 90 degrees."""
+    samples = np.vstack([p.samples for p in parts])
+    C = curvature_matrix(model, samples)
+    per = samples.shape[0] // len(parts)
+    mean = sp.kron(sp.eye(len(parts)), np.full((1, per), 1.0 / per), format="csr")
+    kxx, kyy, kxy = (mean @ C[k::3] for k in range(3))
+    out = []
+    for angle in (np.array([p.angle for p in parts]), np.array([p.angle for p in parts]) + 0.5 * np.pi):
+        c, s = np.cos(angle), np.sin(angle)
+        out.append(sp.diags(c * c) @ kxx + sp.diags(s * s) @ kyy + sp.diags(c * s) @ kxy)
+    return tuple(out)
+
+
+def part_readers(model, parts, axis: str) -> dict:
+    """What is read at the parts, as operators on the model's DOFs (n_parts, n_dof): "z", the
+    displacement normal to the board at each centre; "acceleration", the motion along the shaken
+    ``axis`` there; "curvature_along" and "curvature_across", the curvatures along and across each
+    part's long side averaged over its footprint."""
+    centres = np.column_stack([np.array([p.at for p in parts]), np.zeros(len(parts))])
+    along, across = _curvature_rows(model, parts)
+    return {"z": model_probe(model, centres).P,
+            "acceleration": model_probe(model, centres, np.eye(3)["xyz".index(axis)]).P,
+            "curvature_along": along, "curvature_across": across}

@@ -34,6 +34,8 @@ STEINBERG_COEFF = 0.00022
 N_ALLOWABLE = 2.0e7
 #: fatigue exponent of lead wires and solder joints (Steinberg)
 B_EXPONENT = 6.4
+#: Steinberg's shock allowable over his vibration one (his eq. 11.23: 0.00132 B / (c h r sqrt(L)))
+SHOCK_FACTOR = 6.0
 #: Steinberg's three bands: (multiple of sigma, fraction of the cycles)
 BANDS = ((1.0, 0.683), (2.0, 0.271), (3.0, 0.0433))
 
@@ -47,6 +49,12 @@ def allowable_displacement(span: float, length: float, thickness: float, c: floa
         raise ValueError("span, length, thickness, c and r must all be positive")
     z_in = STEINBERG_COEFF * (span / INCH) / (c * (thickness / INCH) * r * np.sqrt(length / INCH))
     return float(z_in * INCH)
+
+
+def shock_allowable_displacement(span: float, length: float, thickness: float, c: float, r: float = 1.0) -> float:
+    """Steinberg's allowable peak board displacement [m] under shock: ``SHOCK_FACTOR`` times the
+    vibration allowable of :func:`allowable_displacement` (same arguments)."""
+    return SHOCK_FACTOR * allowable_displacement(span, length, thickness, c, r)
 
 
 def reference_cycles(b: float = B_EXPONENT) -> float:

@@ -95,3 +95,47 @@ def test_a_smaller_rerun_leaves_no_stale_files_and_keeps_the_users(tmp_path, mon
     assert files() == ["modes_loaded.csv", "modes_loaded.vtu", "notes.txt", "pcbdyn-manifest.json",
                        "png/modes_loaded_01.png", "png/modes_loaded_02.png", "png/sketch.png"]
     assert "removed 8 file(s) an earlier run wrote" in res.output
+
+
+def test_an_interrupt_while_pictures_are_drawn_leaves_the_earlier_run_whole(tmp_path, monkeypatch):
+    """Ctrl-C in the middle of the pictures (simulated: the renderer raises after its first picture): the
+    --out folder is the earlier run's, file for file, its manifest matching; it was half old, half new."""
+    import hashlib
+
+    import pcbdyn.report.pictures as pictures
+    from pcbdyn.report.manifest import MANIFEST
+
+    monkeypatch.setattr(pictures, "render_child", lambda *args: False)  # matplotlib 3-D views: quicker
+    board = write_board(tmp_path, PLATE.replace("modes = 4", "modes = 2"))
+    out = tmp_path / "out"
+    assert CliRunner().invoke(main, ["build", str(board), "--out", str(out)]).exit_code == 0
+    (out / "notes.txt").write_text("mine")
+    before = {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file()}
+    real = pictures.mode_pictures
+
+    def interrupted(vtu, model, frequencies, shapes, folder, **kw):
+        real(vtu, model, frequencies[:1], shapes[:, :1], folder, **kw)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(pictures, "mode_pictures", interrupted)
+    board.write_text(board.read_text().replace('E = "22 GPa"', 'E = "30 GPa"'))
+    res = CliRunner().invoke(main, ["build", str(board), "--out", str(out)])
+    assert res.exit_code == 1 and "Aborted" in res.output  # click turns Ctrl-C into "Aborted!"
+    assert {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file()} == before
+    listed = json.loads((out / MANIFEST).read_text())["files"]
+    assert len(listed) == 4 and all(hashlib.sha256((out / r).read_bytes()).hexdigest() == d for r, d in listed.items())
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["board.toml", "out"]
+
+
+def test_a_band_below_the_first_mode_is_an_answer_with_a_warning(tmp_path):
+    """[analysis] f_max below the first mode: exit 0, no modes, and the console and the JSON name the first
+    frequency above the band (the plate formula's (1,1) mode), not a silent empty table."""
+    board = write_board(tmp_path, PLATE.replace("[analysis]", '[analysis]\nf_max = "100 Hz"'))
+    js = tmp_path / "modes.json"
+    res = CliRunner().invoke(main, ["build", str(board), "--json", str(js)])
+    assert res.exit_code == 0, res.output
+    data = json.loads(js.read_text())
+    assert data["modes"] == []
+    first = float(data["warning"].split("the first is at ")[1].split(" Hz")[0])
+    assert first == pytest.approx(navier(1, 1), rel=0.01) and first > 100.0
+    assert f"warning: {data['warning']}" in res.output

@@ -1,4 +1,4 @@
-"""The thesis' own FE tables, reproduced from board.toml descriptions (shared/reference/README.md
+"""The thesis' own FE tables, reproduced from board.toml descriptions (tests/data/reference/README.md
 gives the assumptions: nu, spring units, locked edges, part layout)."""
 
 import numpy as np

@@ -199,6 +199,27 @@ def test_points_off_the_board_are_named(card, tmp_path):
     _fails(res, "mm.uff", "off the board", "board frame")
 
 
+def test_a_test_in_mm_without_units_is_refused_naming_the_option_and_pairs_with_it(card, tmp_path):
+    """The same test written in mm with no dataset 164 (as OROS and Simcenter export): a 162 x 178 "m" grid is
+    refused naming --units mm; with --units mm it pairs exactly as the file in metres."""
+    data = read_uff(card / "noisy.uff")
+    pts = Points(data.points.ids, data.points.xyz * 1000)
+    data.modes.points = pts
+    write_uff(tmp_path / "mm.uff", TestData(pts, data.modes))
+    text = (tmp_path / "mm.uff").read_text()
+    start = text.index("    -1\n   164")
+    (tmp_path / "mm.uff").write_text(text[:start] + text[text.index("    -1\n", start + 8) + 7:])
+    _fails(run("correlate", card / "board.toml", tmp_path / "mm.uff"), "mm.uff", "no dataset 164", "--units mm")
+    res = run("correlate", card / "board.toml", tmp_path / "mm.uff", "--units", "mm", "--json", tmp_path / "mm.json")
+    assert res.exit_code == 0, res.output
+    ref = run("correlate", card / "board.toml", card / "noisy.uff", "--json", tmp_path / "m.json")
+    assert ref.exit_code == 0, ref.output
+    mm, m = (json.loads((tmp_path / f).read_text()) for f in ("mm.json", "m.json"))
+    assert [(p["test_mode"], p["model_mode"]) for p in mm["pairs"]] == [(p["test_mode"], p["model_mode"])
+                                                                      for p in m["pairs"]]
+    np.testing.assert_allclose([p["mac"] for p in mm["pairs"]], [p["mac"] for p in m["pairs"]], rtol=1e-4)
+
+
 def test_no_pairs_is_a_clear_error(card, tmp_path):
     # noisy shapes never reach MAC 1, so nothing pairs at --min-mac 1
     res = run("correlate", card / "board.toml", card / "noisy.uff", "--min-mac", 1.0, "--json", tmp_path / "c.json")
@@ -261,3 +282,20 @@ def test_points_on_the_top_surface_read_the_mid_plane(card, tmp_path):
     assert modes[0] == modes[1]
     for key in ("mac", "df_pct"):
         np.testing.assert_allclose([p[key] for p in a["pairs"]], [p[key] for p in b["pairs"]], rtol=1e-9, atol=1e-9)
+
+
+def test_trace_lines_of_the_test_are_drawn_under_its_points(card, tmp_path):
+    """A test file with a trace line (UFF 82, as Test.Lab and ARTeMIS write the test's wireframe) reads it into
+    the test's wireframe, and correlate's COMAC map draws it: the picture differs from the one without."""
+    data = read_uff(card / "noisy.uff")
+    ids = data.points.ids[:4].tolist()
+    trace = ("    -1\n    82\n         1         5         8\nedge\n"
+             + "".join(f"{i:10d}" for i in ids + [0]) + "\n    -1\n")
+    (tmp_path / "traced.uff").write_text((card / "noisy.uff").read_text() + trace)
+    assert read_uff(tmp_path / "traced.uff").wireframe.tolist() == sorted(sorted(p) for p in zip(ids[:-1], ids[1:]))
+    for name in ("noisy", "traced"):
+        src = card / "noisy.uff" if name == "noisy" else tmp_path / "traced.uff"
+        res = run("correlate", card / "board.toml", src, "--out", tmp_path / name)
+        assert res.exit_code == 0, res.output
+    assert (tmp_path / "traced" / "comac.png").read_bytes() != (tmp_path / "noisy" / "comac.png").read_bytes()
+    assert (tmp_path / "traced" / "automac.png").stat().st_size > 5000

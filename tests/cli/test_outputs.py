@@ -45,11 +45,16 @@ def test_json_dash_writes_json_alone_on_stdout(card):
 
 
 def test_a_study_whose_out_is_a_file_fails_before_the_shots(tmp_path):
+    """``study`` takes ``--out`` like every command (it wrote where its study.toml's ``out`` said, beside the
+    example); an ``out`` left in the file is refused with the fix."""
     (tmp_path / "taken").write_text("x")
     spec = tmp_path / "study.toml"
+    spec.write_text('[study]\ncase = "simulated_free_pcb"\nlevels_pct = [0]\nshots = 1\n')
+    r = run(["study", spec, "--quiet", "--out", tmp_path / "taken"])
+    assert r.exit_code == 2 and "--out" in r.output and "is a file" in r.output and "building case" not in r.output
     spec.write_text('[study]\ncase = "simulated_free_pcb"\nlevels_pct = [0]\nshots = 1\nout = "taken"\n')
     r = run(["study", spec, "--quiet"])
-    assert r.exit_code == 2 and "[study] out = taken: is a file" in r.output and "building case" not in r.output
+    assert r.exit_code == 2 and "study.out" in r.output and "--out DIR" in r.output and "Traceback" not in r.output
 
 
 def test_update_on_the_thesis_data_says_the_model_cannot_fit(card, tmp_path):
@@ -130,3 +135,22 @@ def test_a_bug_is_one_line_with_a_log_not_a_traceback(card, monkeypatch):
     assert "internal error (a bug in pcbdyn" in line and "\n" not in line
     log = Path(line.rsplit("the traceback is in ", 1)[1])
     assert "something inside broke" in log.read_text() and "Traceback" in log.read_text()
+
+
+def test_a_modulus_is_printed_in_gpa(card, tmp_path):
+    """The parameter table printed E_board as 2.6e+10 Pa; it prints 26 GPa (the JSON keeps SI values)."""
+    js = tmp_path / "u.json"
+    r = run(["update", card, "--frequencies", TABLE, "--params", "E_board", "--max-iter", "1", "--out",
+             tmp_path / "out", "--json", js])
+    assert r.exit_code == 0, r.output
+    assert re.search(r"E_board\s+GPa\s+26\s+\d+\.\d+", r.output), r.output
+    e = json.loads(js.read_text())["parameters"]["E_board"]
+    assert (e["unit"], e["display_unit"], e["initial"]) == ("Pa", "GPa", 26e9)
+
+
+def test_a_folder_that_is_not_pcbdyns_is_refused_as_out_before_any_work(card, tmp_path):
+    """--out replaces its folder whole: the board's own folder (files, no manifest) is refused, untouched."""
+    before = sorted(p.name for p in tmp_path.iterdir())
+    r = run(["update", card, "--frequencies", TABLE, "--max-iter", "1", "--out", tmp_path])
+    assert r.exit_code == 2 and "not an output folder of pcbdyn" in r.output and "building the models" not in r.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == before

@@ -121,3 +121,50 @@ def test_a_pair_below_the_minimum_mac_cannot_displace_a_good_one():
     p = pair_modes(phi_x, phi_a, [100.0, 200.0], [100.0, 200.0], min_mac=0.5)
     assert [(q.test, q.model) for q in p.pairs] == [(0, 0)]
     assert p.unpaired_test == [1] and p.unpaired_model == [1]
+
+
+def test_model_modes_that_alias_on_a_sparse_grid_pair_by_frequency_and_are_reported():
+    """On a 3 x 3 grid near the sixth points of a square SS plate, the (1,2) and (5,2) modes read nearly alike
+    (sin(5 pi / 6) = sin(pi / 6), sin(5 pi / 2) = sin(pi / 2): AutoMAC 1 at the sixth points, 0.9 here). A test
+    of the (1,2) mode with channel errors that make it resemble (5,2) more: MAC alone pairs it at +470 %;
+    paired by frequency within what the grid cannot tell apart it goes to (1,2), and the pairing names the two
+    modes."""
+    a = b = 0.15
+    g = np.array([0.185, 0.5, 0.815]) * a
+    x, y = (v.ravel() for v in np.meshgrid(g, g, indexing="ij"))
+    mn = [(1, 1), (1, 2), (2, 1), (5, 2)]
+    phi_a, f_a = mode_set(x, y, mn, a, b)
+    f_a[2] *= 1.02  # (1,2) and (2,1): a pair split by 2 %, not a cluster
+    auto = automac(phi_a)[1, 3]
+    assert 0.8 < auto < 0.95
+    unit = phi_a / np.linalg.norm(phi_a, axis=0)
+    x12 = unit[:, 1] + 1.5 * unit[:, 3]  # errors towards what the grid cannot tell from (1,2)
+    phi_x = np.column_stack([phi_a[:, 0], x12, phi_a[:, 2]])
+    f_x = f_a[:3] * 1.02
+    M = mac(phi_x, phi_a)
+    assert M[1, 3] > M[1, 1] > 0.8
+    p = pair_modes(phi_x, phi_a, f_x, f_a)
+    assert [(q.test, q.model) for q in p.pairs] == [(0, 0), (1, 1), (2, 2)]
+    assert p.pairs[1].aliased == (3,) and all(q.used for q in p.pairs)
+    assert [(j, k) for j, k, _ in p.aliases] == [(1, 3)]
+    assert f"model modes 2 and 4 look alike at the test points (AutoMAC {auto:.2f})" in p.warnings()[0]
+
+
+def test_a_pair_beyond_the_frequency_limit_is_reported_and_not_used_for_updating():
+    """A test mode whose only look-alike model mode is 50 % higher: the pair is kept in the report, marked not
+    used, and the updating's pairing callable leaves that test mode out (-1)."""
+    from pcbdyn.problems import ShapePairing
+
+    x, y = grid(6, 6)
+    phi_a, f_a = mode_set(x, y, [(1, 1), (2, 1), (1, 2)])
+    phi_x = phi_a[:, [0, 2]]
+    f_x = np.array([f_a[0] * 1.01, f_a[2] / 1.5])
+    p = pair_modes(phi_x, phi_a, f_x, f_a, limit=0.3)
+    assert [(q.test, q.model, q.used) for q in p.pairs] == [(0, 0, True), (1, 2, False)]
+    assert p.pairs[1].df_pct == pytest.approx(50.0)
+    assert p.warnings() == ["test mode 2 pairs with model mode 3 at +50.0 %, beyond the 30 % limit: reported, not "
+                            "used for updating"]
+    assert p.to_dict()["pairs"][1]["used"] is False
+    pairing = ShapePairing(0.5)
+    assert pairing(f_a, phi_a, f_x, phi_x).tolist() == [0, -1]
+    assert pairing.warnings() == p.warnings()

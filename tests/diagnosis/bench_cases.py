@@ -311,7 +311,7 @@ def params_only(case: Case, board_path, uffs, max_iter: int = 10) -> dict:
     prob = UpdateProblem(load_board(board_path))
     cfgs = [prob.configuration(c, read_uff(u).modes, "freq")
             for c, u in zip(case.configs, uffs)]
-    res, before, after = run(prob, cfgs, "bounded", max_iter=max_iter)
+    res, before, after = run(prob, cfgs, "bounded", max_iter=max_iter, tol_freq_pct=1.0)
     return {"before": max(s["max_freq_error_pct"] for s in before),
             "after": max(s["max_freq_error_pct"] for s in after),
             "mean_mac_after": float(np.mean([q["mac"] for s in after for q in s["pairs"] if q["mac"] is not None])),

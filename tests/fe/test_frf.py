@@ -92,6 +92,21 @@ def test_free_model_rigid_modes_in_superposition():
         assert rel_err(Hm, Hd) < 1e-6
 
 
+def test_a_free_body_accelerance_at_0_hz_is_the_inverse_of_its_mass():
+    """At 0 Hz a unit force anywhere on a free chain accelerates it as a rigid body, 1 / sum(m) at every DOF
+    (the rigid term was -w^2 / -w^2 = 0 * inf there: NaN, written as NAN into every simulated test's FRFs);
+    with mass-proportional damping the limit is 0; the receptance has none."""
+    rng = np.random.default_rng(1)
+    ms = rng.uniform(0.1, 0.3, 6)
+    modes = solve_modes(chain(rng.uniform(1e4, 3e4, 5), ms, wall=False), n_modes=20)
+    A = frf_modal(modes, [0.0, 1e-3], ux(np.arange(1, 7)), ux(np.array([1, 4])), zeta=0.01, kind="accelerance")
+    np.testing.assert_allclose(A[0], 1.0 / ms.sum(), rtol=1e-9)
+    np.testing.assert_allclose(A[1], A[0], rtol=1e-6)
+    damped = frf_modal(modes, [0.0], ux(np.arange(1, 7)), ux(np.array([1, 4])), alpha=2.0, kind="accelerance")
+    assert np.all(damped == 0)
+    assert not np.isfinite(frf_modal(modes, [0.0], ux(np.array([1])), ux(np.array([1])), kind="receptance")).any()
+
+
 def sdof(k, m):
     model = Model([[0.0, 0.0, 0.0]])
     model.add("k", "spring", [[0]], SpringProperty((k, 0, 0, 0, 0, 0)))

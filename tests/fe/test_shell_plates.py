@@ -1,4 +1,4 @@
-"""Flat shell elements against published plate frequencies (shared/reference/plates.json)."""
+"""Flat shell elements against published plate frequencies (tests/data/reference/plates.json)."""
 
 
 import numpy as np

@@ -5,6 +5,7 @@ makes a mutated input file in a folder and reads it; :func:`outcome.classify` ju
 from __future__ import annotations
 
 import math
+import shutil
 import tomllib
 from dataclasses import dataclass
 from functools import cache
@@ -19,7 +20,7 @@ ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = ROOT / "examples"
 BOARDS = [EXAMPLES / n / "board.toml" for n in ("six_part_card", "plain_plate", "wedge_locked", "kicad_board")]
 BOARDS += sorted((ROOT / "tests" / "data" / "boards").glob("*.toml"))
-LIBRARY = sorted((ROOT / "pcbdyn" / "library").glob("*.toml"))
+LIBRARY = sorted((ROOT / "library").glob("*.toml"))
 
 
 @dataclass
@@ -110,7 +111,8 @@ def _library_value(doc, src):
 @cache
 def uff_seeds() -> tuple:
     """Two UFF files written by pcbdyn (units, points and six modes on the six-part card's grid; one with
-    FRFs too), in a folder of their own."""
+    FRFs too) and a test geometry with coordinate systems, trace lines and elements
+    (tests/data/uff/node_systems.uff), in a folder of their own."""
     import tempfile
 
     from pcbdyn.testdata import FRFs, Modes, TestData, read_points_csv, write_uff
@@ -130,7 +132,8 @@ def uff_seeds() -> tuple:
     resp = Dofs(pts.ids[:2], np.tile([0.0, 0.0, 1.0], (2, 1)))
     frfs = FRFs(pts, f, H, "receptance", resp, Dofs(pts.ids[:1], [0.0, 0.0, 1.0]))
     write_uff(folder / "frfs.uff", TestData(pts, modes.subset([0, 1]), frfs), binary=False)
-    return folder / "modes.uff", folder / "frfs.uff"
+    shutil.copy(Path(__file__).resolve().parents[1] / "data" / "uff" / "node_systems.uff", folder / "geometry.uff")
+    return folder / "modes.uff", folder / "frfs.uff", folder / "geometry.uff"
 
 
 @cache
@@ -145,7 +148,7 @@ def study_seeds() -> tuple:
         text = p.read_text()
         for rel in ("../six_part_card/board.toml", "../six_part_card/points.csv"):
             text = text.replace(f'"{rel}"', f'"{(p.parent / rel).resolve()}"')
-        (folder / p.name).write_text(text.replace('out = "', 'out = "/nonexistent-pcbdyn-fuzz/'))
+        (folder / p.name).write_text(text)
         out.append(folder / p.name)
     return tuple(out)
 
@@ -160,6 +163,16 @@ def joint_seed() -> tuple:
         f'[[boards]]\nboard = "{card / "board.toml"}"\nfrequencies = "{card / "measured_frequencies_table_7_2.csv"}"\n'
         f'[[boards]]\nboard = "{card / "board.toml"}"\ntest = "{uff_seeds()[0]}"\n')
     return (folder / "calibration.toml",)
+
+
+@cache
+def history_seed() -> tuple:
+    import tempfile
+
+    folder = Path(tempfile.mkdtemp(prefix="pcbdyn-fuzz-seeds-"))
+    (folder / "history.csv").write_text("# a sampled shock\ntime [ms],acceleration [g]\n0,0\n0.05,463\n0.1,882\n"
+                                        "0.15,1214\n0.2,1427\n0.25,1500\n0.3,1427\n0.35,1214\n0.4,882\n0.5,0\n")
+    return (folder / "history.csv",)
 
 
 @cache
@@ -241,6 +254,7 @@ def kinds(folder: Path) -> list:
     from pcbdyn.targets import parse
     from pcbdyn.testdata import read_points_csv
     from pcbdyn.testdata.measured import read_frequency_table
+    from pcbdyn.vibration.pulses import read_history, read_srs
     from pcbdyn.vibration.spectra import read_psd_csv
 
     points = tuple(EXAMPLES.glob("*/points.csv"))
@@ -257,6 +271,9 @@ def kinds(folder: Path) -> list:
         *csv_kind("frequencies.csv", lambda: tables, lambda p: read_frequency_table(p, six_part_card()),
                   "frequencies.csv", ("mode", "frequency_hz"), True),
         *csv_kind("psd.csv", psd_seed, read_psd_csv, "psd.csv", ("frequency", "psd"), False),
+        *csv_kind("history.csv", history_seed, read_history, "history.csv", ("time", "acceleration"), False),
+        *csv_kind("srs.csv", lambda: (EXAMPLES / "jedec_drop" / "jesd22_b111_srs.csv",), lambda p: read_srs(p, 10.0),
+                  "srs.csv", ("frequency", "acceleration"), False),
         Kind("test.uff", uff_seeds, lambda s, src, f: _uff(s, src, f), _read_uff),
         Kind("test.uff bytes", uff_seeds, lambda s, src, f: _raw(s, src, f, "test.uff", utf8=False), _read_uff),
         Kind("kicad bytes", lambda: (EXAMPLES / "kicad_board" / "board.kicad_pcb",),

@@ -289,8 +289,9 @@ def _datasets(lines) -> list:
 
 def mutate_uff(text: str, src: Source) -> tuple:
     """(mutated UFF text, known invalid): numbers and lines changed at random, or a random change or none and
-    then one known to be invalid (a mode's frequency at or below 0 or its damping ratio outside 0 to 1, a
-    shape value NaN, a node of a mode given twice, a length factor of 0)."""
+    then one known to be invalid (a mode's frequency at or below 0, or below the 0.01 Hz floor of an elastic
+    mode, or its damping ratio outside 0 to 1, a shape value NaN, a node of a mode given twice, a mode's shape
+    zero at every node, a length factor of 0)."""
     lines = text.split("\n")
     bad = src.integer(0, 2) == 0
     for _ in range(src.integer(0, 1) if bad else src.integer(1, 3)):
@@ -300,14 +301,15 @@ def mutate_uff(text: str, src: Source) -> tuple:
     sets = _datasets(lines)
     modes = [t for typ, t in sets if typ == 55 and t + 10 < len(lines)]
     units = [t for typ, t in sets if typ == 164 and t + 2 < len(lines)]
-    op = src.integer(0, 2)
+    op = src.integer(0, 3)
     invalid = False
     if op == 0 and modes:
         t = src.choice(modes)
         rec = lines[t + 8].split()
         if len(rec) >= 3:
             which = src.integer(0, 1)
-            rec[2 * which] = src.choice(["-1.50000E+02", "0.00000E+00"] if which == 0 else ["1.50000E+00", "-2.0E-02"])
+            rec[2 * which] = src.choice(["-1.50000E+02", "0.00000E+00", "1.00000E-09", "9.99000E-03"] if which == 0
+                                        else ["1.50000E+00", "-2.0E-02"])
             lines[t + 8] = " ".join(rec)
             invalid = True
     elif op == 1 and modes:
@@ -319,11 +321,25 @@ def mutate_uff(text: str, src: Source) -> tuple:
             else:
                 lines[node + 2:node + 2] = lines[node:node + 2]
             invalid = True
+    elif op == 3 and modes:
+        invalid = _zero_shape(lines, src.choice(modes))
     elif units:
         t = units[0]
         lines[t + 2] = "  0.00000000000000000D+00" + lines[t + 2][25:]
         invalid = True
     return "\n".join(lines), invalid
+
+
+def _zero_shape(lines, t: int) -> bool:
+    """Every value of the dataset 55 whose type line is ``t`` set to zero (a record with no motion); whether
+    the dataset held a node record to zero."""
+    end = next((k for k in range(t + 9, len(lines)) if lines[k].strip() == "-1"), len(lines))
+    changed = False
+    for k in range(t + 9, end):
+        if not _TYPE.match(lines[k]) and lines[k].split():
+            lines[k] = " ".join("0.00000E+00" for _ in lines[k].split())
+            changed = True
+    return changed
 
 
 def _uff_change(lines, src: Source) -> None:

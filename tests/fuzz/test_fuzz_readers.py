@@ -4,7 +4,7 @@ each input read as pcbdyn reads it. The property: the reader returns a result in
 finite, or raises one of pcbdyn's input errors, in one line, naming the file; an input known to be
 invalid (a quantity with a decimal comma, a bare unit, arithmetic or a non-finite number, a byte that is
 not UTF-8, a measured frequency at or below 0, a mode asked beyond the limit, ...) must be refused. Inputs
-per kind: PCBDYN_FUZZ_EXAMPLES (default 220: 23 kinds and the command runs make over 5,000 inputs); the
+per kind: PCBDYN_FUZZ_EXAMPLES (default 220: 27 kinds and the command runs make over 6,000 inputs); the
 examples are derandomised, so a run repeats; the long run with fresh seeds is benchmarks/fuzz_long.py."""
 
 import os

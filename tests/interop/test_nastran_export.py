@@ -82,7 +82,8 @@ def test_board_decks_read_by_pynastran_rebuild_to_the_same_frequencies(tmp_path,
     deck, read, df = check_round_trip(bm.model, tmp_path, example)
     want = expected_counts(bm.model)
     assert {k: read["card_count"].get(k, 0) for k in want} == want
-    assert read["card_count"]["EIGRL"] == 1 and read["eigrl"]["1"]["nd"] == N_MODES
+    rigid = 6 if example == "six_part_card" else 0  # the free card; Nastran counts its rigid-body modes in ND
+    assert read["card_count"]["EIGRL"] == 1 and read["eigrl"]["1"]["nd"] == N_MODES + rigid
     assert read["card_count"]["PSHELL"] == sum(es.etype in ("quad4", "tri3") for es in bm.model.sets.values())
     assert ("SPC1" in read["card_count"]) == bool(bm.model.fixed)
     # isotropic sections are exact; the laminate's rotary inertia is the one inexact quantity (noted)
@@ -203,3 +204,17 @@ def test_export_bad_input_gets_clear_errors(tmp_path):
     assert res.exit_code == 2 and "broken.toml" in res.output and "components[0].at" in res.output
     assert "Traceback" not in res.output
     assert not (tmp_path / "a.bdf").exists() and not (tmp_path / "b.bdf").exists()
+
+
+def test_eigrl_asks_a_free_board_for_its_rigid_body_modes_besides_the_elastic_ones(tmp_path):
+    """Nastran's EIGRL ND counts every root, rigid-body ones included: asking a free card for 7 gave 1
+    elastic mode and 6 rigid-body ones (the deck asked for 7); a wedge-locked board has none to add."""
+    for example, rigid in (("six_part_card", 6), ("wedge_locked", 0)):
+        board = EXAMPLES / example / "board.toml"
+        res = CliRunner().invoke(main, ["export", str(board), "--nastran", str(tmp_path / "m.bdf"), "--modes", 7,
+                                        "--json", str(tmp_path / "m.json")])
+        assert res.exit_code == 0, res.output
+        assert solve_modes(build_model(load_board(board)).model, n_modes=1).n_rigid == rigid
+        eigrl = re.search(r"^EIGRL\*\s+1\s+(\S+)$", (tmp_path / "m.bdf").read_text(), re.M)
+        assert int(eigrl.group(1)) == 7 + rigid
+        assert json.loads((tmp_path / "m.json").read_text())["eigrl_nd"] == 7 + rigid

@@ -1,7 +1,7 @@
 """A plain (non-editable) ``pip install`` carries what pcbdyn needs at run time: the component
-library is package data, so the bundled example builds from an installed copy, far from the
-source tree; and the library search order is the board's folder, PCBDYN_LIBRARY, then the
-shipped library."""
+library (``library/`` at the top of the repository) is package data, so the bundled example builds
+from an installed copy, far from the source tree; and the library search order is the board's folder,
+PCBDYN_LIBRARY, then the shipped library."""
 
 import importlib.metadata
 import importlib.util
@@ -48,8 +48,9 @@ def _clean_env() -> dict:
 
 def test_a_plain_install_in_a_fresh_venv_builds_the_example(tmp_path):
     src = tmp_path / "src"  # what a source distribution holds: no tests, no examples
-    shutil.copytree(ROOT / "pcbdyn", src / "pcbdyn", ignore=shutil.ignore_patterns("__pycache__"))
-    for name in ("pyproject.toml", "README.md"):
+    for folder in ("pcbdyn", "library"):
+        shutil.copytree(ROOT / folder, src / folder, ignore=shutil.ignore_patterns("__pycache__"))
+    for name in ("pyproject.toml", "setup.py", "README.md"):
         shutil.copy(ROOT / name, src / name)
     py = _venv_reusing_this_environment(tmp_path / "venv")
     isolation = ["--no-build-isolation"] if _can_build_wheels_here() else []  # else pip fetches setuptools
@@ -59,9 +60,13 @@ def test_a_plain_install_in_a_fresh_venv_builds_the_example(tmp_path):
 
     example = tmp_path / "card"
     shutil.copytree(ROOT / "examples" / "six_part_card", example)
-    where = subprocess.run([py, "-c", "import pcbdyn; print(pcbdyn.__file__)"], cwd=tmp_path, env=_clean_env(),
-                           capture_output=True, text=True, check=True).stdout
-    assert Path(where).is_relative_to(tmp_path / "venv"), where
+    where = subprocess.run([py, "-c", "import pcbdyn; from pcbdyn.components.library import shipped_library as s; "
+                                      "print(pcbdyn.__file__); print(s())"], cwd=tmp_path, env=_clean_env(),
+                           capture_output=True, text=True, check=True).stdout.split("\n")
+    assert Path(where[0]).is_relative_to(tmp_path / "venv"), where
+    installed = Path(where[1])
+    assert installed == Path(where[0]).parent / "library" and installed.is_relative_to(tmp_path / "venv"), where
+    assert sorted(p.name for p in installed.glob("*.toml")) == sorted(p.name for p in (ROOT / "library").glob("*.toml"))
     res = subprocess.run([tmp_path / "venv" / "bin" / "pcbdyn", "build", str(example / "board.toml"), "--no-pictures",
                           "--json", str(tmp_path / "modes.json")], cwd=tmp_path, env=_clean_env(),
                          capture_output=True, text=True)
@@ -72,7 +77,7 @@ def test_a_plain_install_in_a_fresh_venv_builds_the_example(tmp_path):
 
 def test_the_board_folder_then_pcbdyn_library_then_the_shipped_library(tmp_path, monkeypatch):
     shipped = shipped_library()
-    assert shipped.is_relative_to(Path(importlib.util.find_spec("pcbdyn").origin).parent)
+    assert shipped == ROOT / "library" and not (ROOT / "pcbdyn" / "library").exists()  # the source tree's
     assert {"PGA", "JLCC", "CQFP"} <= {p.stem for p in shipped.glob("*.toml")}
     board_dir, env_dir = tmp_path / "board", tmp_path / "env"
     for folder, mass in ((board_dir / "library", "1 g"), (env_dir, "2 g")):

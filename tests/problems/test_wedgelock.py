@@ -14,7 +14,7 @@ from pcbdyn.problems.wedgelock import fit_wedge_locks
 from pcbdyn.testdata import TestDataError
 from pcbdyn.testdata.measured import read_frequency_table
 
-#: the reference's tolerance for the card in wedge-locks (shared/reference/README.md: "Tables 7.12-7.15
+#: the reference's tolerance for the card in wedge-locks (tests/data/reference/README.md: "Tables 7.12-7.15
 #: 4 %"; its independent re-computation reached 1.7 %)
 REPRODUCIBILITY = 0.04
 

@@ -107,3 +107,29 @@ def test_board_without_guides(tmp_path):
     res = run("wedgelock", EXAMPLE.parent / "six_part_card" / "board.toml", "--frequencies",
               EXAMPLE / "measured_frequencies_table_7_12.csv")
     assert res.exit_code == 2 and "no [[fixtures]] of type \"wedge_lock\"" in res.output
+
+
+def test_a_sparse_grid_prints_the_pairing_s_aliasing_warnings(tmp_path):
+    """The test read at 6 points in two rows near the guides (issue 38): on them the card's first mode and its
+    eighth look alike (AutoMAC 0.99); wedgelock says so, and the clamped extreme still pairs test mode k with
+    model mode k (by frequency within what the grid cannot tell apart)."""
+    import numpy as np
+
+    from pcbdyn.testdata import Modes
+
+    td = simulated_test(TRUE_K, TRUE_K)
+    m = td.modes
+    xyz = np.round(m.dof_xyz(), 5)
+    xs, ys = np.unique(xyz[:, 0]), np.unique(xyz[:, 1])
+    keep = np.flatnonzero(np.isin(xyz[:, 0], xs[[2, 4, 6]]) & np.isin(xyz[:, 1], ys[[0, 6]]))
+    sparse = Modes(m.points, m.dofs.take(keep), m.frequencies, m.shapes[keep], m.damping)
+    (tmp_path / "board.toml").write_text(BOARD.read_text())
+    write_uff(tmp_path / "sparse.uff", TestData(m.points, sparse))
+    res = run("wedgelock", tmp_path / "board.toml", tmp_path / "sparse.uff", "--json", tmp_path / "w.json",
+              "--out", tmp_path / "out")
+    assert res.exit_code == 0, res.output
+    d = json.loads((tmp_path / "w.json").read_text())
+    assert any(w.startswith("configuration base: model modes 1 (") and "look alike" in w for w in d["warnings"])
+    assert all(f"warning: {w}" in res.stderr for w in d["warnings"])
+    assert [(q["test_mode"], q["model_mode"]) for q in d["extremes"]["clamped"]["pairs"]] == [(k, k) for k in
+                                                                                            range(1, 6)]

@@ -2,11 +2,13 @@
 pyuff, variants other tools write, and clear errors on files that cannot be read."""
 
 import os
+from pathlib import Path
+import re
 
 import numpy as np
 import pytest
 import pyuff
-from uff_helpers import E13, E20, fixed
+from uff_helpers import E13, E20, HEADER55, fixed
 
 from pcbdyn.correlation import mac
 from pcbdyn.testdata import Dofs, FRFs, Modes, Points, TestData, TestDataError, read_uff, real_modes, write_uff
@@ -117,18 +119,6 @@ def write_text(path, text):
     return path
 
 
-HEADER55 = """    -1
-    55
-NONE
-NONE
-NONE
-NONE
-NONE
-         1         2         2         8         2         3
-         2         4         1         1
-{rec8}
-"""
-
 
 def test_dataset_55_with_fields_run_together_and_d_exponents_reads(tmp_path):
     """Some exporters fill 13-character fields completely ("missing spaces", pyuff issue 84) or write
@@ -219,6 +209,35 @@ def test_a_uff_mode_obeys_the_rules_of_modes(tmp_path, freq, zeta):
         assert read_uff(path, points=point).modes.damping.tolist() == [zeta]
 
 
+@pytest.mark.parametrize("freq, shape, fault", [
+    (150.0, "0.0E+00 0.0E+00 0.0E+00", "record 10: the mode shape is zero at every DOF"),
+    (1e-9, "1.0E+00 2.0E+00 3.0E+00", "record 8: frequency 1e-09 Hz is below 0.01 Hz"),
+    (0.00999, "1.0E+00 2.0E+00 3.0E+00", "record 8: frequency 0.00999 Hz is below 0.01 Hz")])
+def test_a_file_mode_without_motion_or_below_the_elastic_floor_is_refused(tmp_path, freq, shape, fault):
+    """A dataset 55 record whose shape is zero at every node, or whose frequency is positive but below the 0.01 Hz
+    floor of an elastic mode (a rigid-body mode, or kHz read as Hz), is refused naming the dataset and record,
+    while modes pcbdyn simulates keep their own rule (any frequency above 0, a zero shape allowed); at the
+    floor itself a mode reads."""
+    point = Points([1], np.zeros((1, 3)))
+    rec8 = f"{freq:13.5E}{0.0:13.5E}{0.01:13.5E}{0.0:13.5E}"
+    path = write_text(tmp_path / "m.uff", HEADER55.format(rec8=rec8) + f"         1\n {shape}\n    -1\n")
+    with pytest.raises(TestDataError, match=rf"m\.uff: dataset #1 \(type 55\): {re.escape(fault)}"):
+        read_uff(path, points=point)
+    values = [[float(v)] for v in shape.split()]
+    assert Modes(point, Dofs.from_codes([1, 1, 1], [1, 2, 3]), [freq], values).frequencies[0] == freq
+    at_floor = write_text(tmp_path / "f.uff", HEADER55.format(rec8=f"{0.01:13.5E}{0.0:13.5E}{0.01:13.5E}{0.0:13.5E}")
+                          + "         1\n 1.0E+00 2.0E+00 3.0E+00\n    -1\n")
+    assert read_uff(at_floor, points=point).modes.frequencies.tolist() == [0.01]
+
+
+def test_a_frequency_table_row_below_the_elastic_floor_is_refused(tmp_path):
+    from pcbdyn.testdata.measured import read_frequency_table
+
+    table = write_text(tmp_path / "freq.csv", "configuration,mode,frequency_hz\nbase,1,1e-9\nbase,2,250.0\n")
+    with pytest.raises(TestDataError, match=r"freq\.csv: configuration base: frequency 1e-09 Hz \(mode 1\) is below"):
+        read_frequency_table(table, None)
+
+
 def test_a_failed_write_leaves_the_old_file_untouched(tmp_path, monkeypatch):
     from pcbdyn.testdata import uff_write
 
@@ -258,3 +277,24 @@ def test_binary_58b_with_a_stray_line_break_before_the_end_tag_reads(tmp_path):
     path.write_bytes(raw[:end] + b"\r\n" + raw[end:])
     back = read_uff(path)
     assert rel(back.frfs.H, data.frfs.H) < 1e-12
+
+
+def test_node_coordinate_systems_place_points_and_turn_directions_global():
+    """tests/data/uff/node_systems.uff (written by hand, checked by hand): SYS1 (dataset 18: origin at x = 10 mm,
+    +x towards the origin, xz point below) has axes -X, +Y, -Z; SYS2 is defined in SYS1 (its origin, +x along
+    SYS1's y, xz point on SYS1's x) and has axes +Y, -Z, -X; CS3 (dataset 2420, rows the axes) is a quarter
+    turn about z: +Y, -X, +Z. Node 1's displacements refer to SYS1, node 2's to SYS2, node 3's coordinates
+    and displacements to CS3, node 4 is global. Each measured value keeps its number and takes its axis' global
+    direction; the trace line and the elements give the wireframe's edges once each."""
+    data = read_uff(Path(__file__).resolve().parents[1] / "data" / "uff" / "node_systems.uff")
+    np.testing.assert_allclose(data.points.xyz, [[0, 0, 0], [0.1, 0, 0], [-0.1, 0.1, 0], [0, 0.1, 0]], atol=1e-15)
+    m = data.modes
+    want = {1: ([[-1, 0, 0], [0, 1, 0], [0, 0, -1]], [1.0, 2.0, 3.0]), 2: ([[-1, 0, 0]], [1.0]),
+            3: ([[0, 1, 0], [-1, 0, 0], [0, 0, 1]], [-1.0, 0.5, 2.0]), 4: ([[0, 0, 1]], [-1.0])}
+    scale = m.shapes[0, 0]  # the real shape keeps the file's values up to one factor
+    for node, (axes, values) in want.items():
+        rows = np.flatnonzero(m.dofs.point_ids == node)
+        np.testing.assert_array_equal(m.dofs.directions[rows], axes)
+        np.testing.assert_allclose(m.shapes[rows, 0] / scale, values, rtol=1e-6)
+    assert data.wireframe.tolist() == [[1, 2], [1, 3], [1, 4], [2, 3], [3, 4]]
+    assert data.elements == [(44, [1, 2, 3, 4]), (11, [1, 3])]

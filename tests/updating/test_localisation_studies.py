@@ -143,8 +143,9 @@ def test_study_command(tmp_path):
 
     toml = tmp_path / "study.toml"
     toml.write_text('[study]\nlevels_pct = [0, 0.5]\nshots = 2\nmethods = ["tls-qrf", "svd-qr"]\n'
-                    'workers = 1\nout = "res"\n[case]\nerrors_mm = { "23" = 3.4 }\n')
-    res = CliRunner().invoke(main, ["study", str(toml), "--json", str(tmp_path / "s.json"), "--quiet"])
+                    'workers = 1\n[case]\nerrors_mm = { "23" = 3.4 }\n')
+    res = CliRunner().invoke(main, ["study", str(toml), "--json", str(tmp_path / "s.json"), "--quiet",
+                                    "--out", str(tmp_path / "res")])
     assert res.exit_code == 0, res.output
     data = json.loads((tmp_path / "s.json").read_text())
     assert data["true_errors"] == ["t23"]
@@ -240,10 +241,12 @@ def test_board_study_command(tmp_path):
     text = example.read_text().replace("../six_part_card/", f"{CARD}/").replace("shots = 20", "shots = 2")
     text = text.replace("levels_pct = [0, 1, 2, 5]", "levels_pct = [0, 1]").replace('equations = ["qms", "fbm"]',
                                                                                    'equations = ["qms"]')
-    (tmp_path / "study.toml").write_text(text.replace('out = "board_study_out"\n', "workers = 1\n"))
+    (tmp_path / "study.toml").write_text(text.replace("[truth]", "workers = 1\n\n[truth]"))
     res = CliRunner().invoke(main, ["study", str(tmp_path / "study.toml"), "--json", str(tmp_path / "s.json"),
-                                    "--quiet"])
+                                    "--quiet", "--out", str(tmp_path / "out")])
     assert res.exit_code == 0, res.output
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["pcbdyn-manifest.json", "shots.csv",
+                                                                     "success_ratios.png", "summary.csv"]
     data = json.loads((tmp_path / "s.json").read_text())
     assert data["true_errors"] == ["t_PGA"]
     assert {r["method"]: r["mean"] for r in data["summary"] if r["level_pct"] == 0.0}["tls-qrf"] == 100.0

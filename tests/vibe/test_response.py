@@ -5,7 +5,7 @@ position factors and the curvature operator against the plate's sine shape."""
 import numpy as np
 import pytest
 import scipy.sparse as sp
-from vibe_plates import A, B, navier, solve, write_plate
+from vibe_plates import A, B, navier, solve, write_free_plate, write_plate
 from scipy.integrate import quad_vec, trapezoid
 
 from pcbdyn.fe.curvature import curvature_matrix
@@ -111,11 +111,7 @@ def test_two_modes_match_direct_integration_of_the_directly_solved_frf(tmp_path)
 
 
 def test_free_board_is_refused(tmp_path):
-    path = tmp_path / "free.toml"
-    path.write_text(f'[board]\nname = "free"\noutline = {{ width = "{A * 1e3:g} mm", height = "{B * 1e3:g} mm" }}\n'
-                    'thickness = "1.6 mm"\nmaterial = { E = "22 GPa", nu = 0.15, rho = "1850 kg/m^3" }\n'
-                    'mesh_size = "20 mm"\n[analysis]\nmodes = 3\n')
-    board, bm, modes, K, M = solve(path, 2000.0)
+    board, bm, modes, K, M = solve(write_free_plate(tmp_path), 2000.0)
     from pcbdyn.vibration import VibrationError
 
     with pytest.raises(VibrationError, match=r"free.toml: the model is free .*declare how the board is held in "

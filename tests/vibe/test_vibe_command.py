@@ -67,6 +67,27 @@ def test_files_are_written(full_run):
     assert not list(out.glob(".*"))  # nothing half-written left behind
 
 
+def test_a_spectrum_below_the_fundamental_is_judged(plate, tmp_path):
+    """20-100 Hz under a 350 Hz fundamental: no mode lies in the analysis band (twice the top); the
+    first modes are solved all the same and the board follows the base quasi-statically (it was an
+    internal error)."""
+    (tmp_path / "low.csv").write_text("frequency [Hz],psd [g^2/Hz]\n20,0.04\n100,0.04\n")
+    js = tmp_path / "low.json"
+    res = run("vibe", plate, "--psd", tmp_path / "low.csv", "--json", js)
+    assert res.exit_code == 0, res.output
+    data = json.loads(js.read_text())
+    assert len(data["modes"]) == 3 and data["modes"][0]["frequency_hz"] > 300.0
+    # at the centre the (1, 1) mode (phi Gamma = 16 / pi^2) carries the board below resonance:
+    # |1 + c r^2 / (1 - r^2 + 2 i zeta r)|, r = f / f1, integrated over the flat band
+    f1 = data["modes"][0]["frequency_hz"]
+    f = np.linspace(20.0, 100.0, 2001)
+    r, zeta = f / f1, data["modes"][0]["damping_ratio"]
+    t2 = np.abs(1 + 16 / np.pi**2 * r**2 / (1 - r**2 + 2j * zeta * r)) ** 2
+    expected = np.sqrt(0.04 * np.trapezoid(t2, f))
+    centre = next(p for p in data["parts"] if p["ref"] == "U1")
+    assert centre["accel_rms_g"] == pytest.approx(expected, rel=0.01)
+
+
 def test_more_damping_less_response(plate, tmp_path):
     out = {}
     for damping in ("zeta=0.02", "Q=25"):  # Q = 25 is zeta = 0.02: the same run

@@ -31,6 +31,15 @@ def write_plate(folder, mesh_mm: float, parts=(), extra: str = ""):
     return path
 
 
+def write_free_plate(folder):
+    """free.toml: the plate with no fixture at all (a free board, which base excitation refuses)."""
+    path = folder / "free.toml"
+    path.write_text(f'[board]\nname = "free"\noutline = {{ width = "{A * 1e3:g} mm", height = "{B * 1e3:g} mm" }}\n'
+                    f'thickness = "{T * 1e3:g} mm"\nmaterial = {{ E = "{E / 1e9:g} GPa", nu = {NU}, '
+                    f'rho = "{RHO:g} kg/m^3" }}\nmesh_size = "20 mm"\n[analysis]\nmodes = 3\n')
+    return path
+
+
 def navier(m: int, n: int) -> float:
     """Kirchhoff frequency [Hz] of the (m, n) mode of the simply supported plate."""
     D = E * T**3 / (12 * (1 - NU**2))
