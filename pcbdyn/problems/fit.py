@@ -17,7 +17,10 @@ the answer, and what it means.
    :func:`shape_noise_estimate`, and the fit finished with that).
 3. Starts: parameters on a log scale or with wide bounds are scanned (:mod:`pcbdyn.updating.scan`); each
    basin found is fitted, the best kept and the others reported.
-4. The fit: the trust-region iteration of :func:`pcbdyn.updating.driver.update`.
+4. The fit: the trust-region iteration of :func:`pcbdyn.updating.driver.update`, its modes paired by MAC
+   without the frequency limit (:data:`pcbdyn.correlation.pairing.FREQ_LIMIT`: from tens of percent off
+   few pairs are within it; the trust region keeps a pair the linearisation misreads from doing harm),
+   the correlation tables with it.
 5. The verdict, the first that applies: "cannot fit" (chi^2 above what its degrees of freedom allow at
    :data:`ALPHA_FIT`, or fewer than :data:`MIN_PAIRED` of the measured modes paired), "error grew" (a configuration ends worse than it started), "on a bound", "not
    determined" (with the direction the data leave open), "not converged", "converged". Only a
@@ -39,6 +42,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from scipy.stats import chi2 as chi2_dist
 
+from ..correlation.pairing import FREQ_LIMIT
 from ..updating.driver import update
 from ..updating.iteration import build_equations, objective_rows, unpaired
 from ..updating.scan import scan, scanned
@@ -138,13 +142,13 @@ def frequency_sigma(modes, f_pct: float, model_pct=None) -> np.ndarray:
 
 
 def configurations(problem, tests, method: str, f_pct: float, shape_pct: float, model=None,
-                   min_mac: float = 0.5, corrected: bool = False) -> list:
+                   min_mac: float = 0.5, corrected: bool = False, limit: float = FREQ_LIMIT) -> list:
     """The driver configurations of ``tests`` for ``method``: "freq" (frequencies, MAC-paired with shapes),
     "modal" (frequencies and shapes), "qms"/"fbm" (one per measured mode, :meth:`~.problem.UpdateProblem.
     mode_configurations`); frequencies weighted by :func:`frequency_sigma`, shapes by their noise. ``model``:
     the model's own errors (frequencies [%], signed; shapes, relative, or None), per test configuration and
     measured mode (:func:`.discretisation.model_errors`), in the noise and, with ``corrected``, taken out of
-    the measured frequencies."""
+    the measured frequencies. ``limit``: pairs further apart in frequency are left out (relative)."""
     out = []
     f_model, s_model = model if model is not None else ([None] * len(tests), [None] * len(tests))
     for (k, c, m), e, es in zip(tests, f_model, s_model):
@@ -154,10 +158,10 @@ def configurations(problem, tests, method: str, f_pct: float, shape_pct: float, 
             out += problem.mode_configurations(c, m, method, min_mac=min_mac, structure=k)
         elif method == "modal":
             rel = shape_pct / 100.0 / math.sqrt(3.0)
-            out.append(problem.configuration(c, m, "modal", min_mac=min_mac, structure=k, sigma=sig,
+            out.append(problem.configuration(c, m, "modal", min_mac=min_mac, structure=k, sigma=sig, limit=limit,
                                              shape_noise=rel if es is None else np.hypot(rel, es[0])))
         else:
-            out.append(problem.configuration(c, m, "freq", min_mac=min_mac, structure=k, sigma=sig))
+            out.append(problem.configuration(c, m, "freq", min_mac=min_mac, structure=k, sigma=sig, limit=limit))
     return out
 
 
@@ -193,7 +197,7 @@ def fit(problem, measured, *, method: str = "freq", noise=(None, None), shapes: 
     f_pct, shape_pct = (v if v is not None else d for v, d in zip(noise, DEFAULT_NOISE))
     model = None if model_pct is None else (model_pct, [None] * len(tests))
     check = configurations(problem, tests, "freq", f_pct, shape_pct, model, min_mac)
-    base = configurations(problem, tests, "freq", f_pct, shape_pct, model, min_mac, True) if model else check
+    base = configurations(problem, tests, "freq", f_pct, shape_pct, model, min_mac, model is not None, np.inf)
     why = None
     if method == "freq" and all(m.shapes is not None for _, _, m in tests) and shapes != "never":
         weak = weak_directions(base, problem.p0, problem.names) if shapes == "auto" else ["asked for"]
@@ -203,10 +207,8 @@ def fit(problem, measured, *, method: str = "freq", noise=(None, None), shapes: 
             method = "modal"
             say(f"mode shapes join the objective: {why}")
 
-    def build(model):
-        if method == "freq":
-            return configurations(problem, tests, "freq", f_pct, shape_pct, model, min_mac, True) if model else check
-        return configurations(problem, tests, method, f_pct, shape_pct, model, min_mac, model is not None)
+    def build(model):  # MAC alone pairs in a fit: from tens of percent off, no pair is within the limit
+        return configurations(problem, tests, method, f_pct, shape_pct, model, min_mac, model is not None, np.inf)
 
     cfgs = build(model)
     ranges = scanned(problem.p0, problem.bounds, problem.log_scale) if scan_start else []
@@ -231,7 +233,7 @@ def fit(problem, measured, *, method: str = "freq", noise=(None, None), shapes: 
     runs[best], keys[best] = res, (res.history[-1]["unpaired"], res.history[-1]["objective"])
     before, after = correlation_state(check, problem.p0), correlation_state(check, res.p)
     judged = cfgs if method in ("freq", "modal") else configurations(problem, tests, "freq", f_pct, shape_pct, model,
-                                                                     min_mac, model is not None)
+                                                                     min_mac, model is not None, np.inf)
     out = Fit(problem, cfgs, res.p, res, before, after, "", [], _verdict(judged, res.p, problem),
               {"frequency_pct": f_pct, "shape_pct": shape_pct if method == "modal" else None,
                "shape_estimated": method == "modal" and not stated[1],

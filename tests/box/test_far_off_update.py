@@ -50,7 +50,8 @@ def far_off(tmp_path_factory):
 def test_the_box_converges_from_far_off(far_off):
     r, d, tmp = far_off
     assert d["status"] == "converged" and "diverged" not in r.output and d["verdict"]["fits"]
-    assert d["before"]["max_freq_error_pct"] > 40
+    # at the start some modes are more than 30 % off (reported, not paired for updating): all 14 pair after
+    assert d["before"]["max_freq_error_pct"] > 15 and len(d["before"]["pairs"]) < len(d["after"]["pairs"]) == 14
     truth = {"E_upper": 70e9, "rho_upper": 2700.0, "h_side": 0.01, "h_back": 0.01, "h_upper_x": 0.01,
              "h_upper_y": 0.01}
     for name, v in d["parameters"].items():
