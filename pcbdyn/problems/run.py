@@ -9,7 +9,7 @@ import warnings
 import numpy as np
 
 from ..updating.driver import update
-from ..updating.iteration import build_equations
+from ..updating.iteration import paired_states
 from ..updating.solvers import RankDeficiencyWarning
 
 #: the frequency criterion (thesis eq. 7.2, max |df| in %) an update stops at unless told otherwise: the
@@ -20,9 +20,10 @@ TOL_FREQ_PCT = 0.1
 def correlation_state(configs, p) -> list:
     """Per configuration at ``p``: the pairs (as in ``pcbdyn correlate``: test_mode, model_mode
     (1-based, elastic modes), f_test_hz, f_model_hz, df_pct, mac), the max |df| in percent (None for
-    a configuration none of whose modes pairs) and the pairing's warnings (model modes the test grid
+    a configuration none of whose modes pairs; also when none of any configuration's pairs: a test of
+    another structure is reported, not refused) and the pairing's warnings (model modes the test grid
     cannot tell apart, pairs beyond the frequency limit: reported, not used)."""
-    _, _, states = build_equations(configs, p)
+    states = paired_states(configs, p)
     out = []
     for cfg, st in zip(configs, states):
         pairs = []

@@ -125,6 +125,12 @@ def _state(cfg: Configuration, p, pairing):
     return out
 
 
+def paired_states(configs, p, pairing=None) -> list:
+    """Each configuration's state at ``p`` (:func:`paired_state` of its solved modes; "set_aside" where
+    nothing pairs), without its equations."""
+    return [_state(c, np.asarray(p, float), pairing) for c in configs]
+
+
 def paired_state(cfg: Configuration, lam, Phi, pairing=None) -> dict:
     """The measured modes of ``cfg`` paired among the computed eigenpairs (lam, Phi): "pairs" (analytical
     index per measured mode, -1 unpaired), "used" (the paired measured modes), their partners' "lam",
@@ -293,7 +299,7 @@ def build_equations(configs, p, pairing: Callable | None = None, stack_reduce: b
     """
     configs = [configs] if isinstance(configs, Configuration) else list(configs)
     p = np.asarray(p, float)
-    states = [_state(c, p, pairing) for c in configs]
+    states = paired_states(configs, p, pairing)
     active = [(c, st) for c, st in zip(configs, states) if not st.get("set_aside")]
     if not active:
         raise UpdatingError("no measured mode of any configuration found an analytical partner; check that test and "
