@@ -15,30 +15,39 @@ def analyse(board, config, stds: dict | None = None) -> dict:
     """Build and solve one configuration and print its table; returns what :func:`write_results` writes
     (``stds``: the library's family standard deviations, :func:`pcbdyn.problems.uncertainty.library_uncertainty`,
     propagated to each frequency)."""
-    from ..correlation import static_mass
-    from ..report.modes import format_table, mode_table
+    from ..fe.effective_mass import effective_mass
+    from ..report.modes import format_table, free_note, mode_table
 
     label = config or "base"
     bm, modes, K, M = solve_structure(board, config)
-    mass = static_mass(M)
-    table = mode_table(bm, modes, M)
+    em = effective_mass(bm.model.nodes, M, modes.shapes)
+    mass = float(em.totals[2])
+    table = mode_table(bm, modes, em)
+    std = None
     if stds is not None:
         from ..problems.uncertainty import frequency_std
 
-        table.insert(2, "frequency_std_hz", frequency_std(bm, modes, stds))
+        std = frequency_std(bm, modes, stds)
+        table.insert(2, "+- sd [Hz]", std)
     click.echo(f"\n{board.name} [{label}]: {mass * 1e3:.2f} g, {bm.model.n_dof} DOFs, "
                f"{sum(len(es.conn) for es in bm.model.sets.values() if es.etype in ('quad4', 'tri3'))} shells"
                + (f", {modes.n_rigid} rigid-body modes" if modes.n_rigid else ""))
     warning = empty_band(board, bm, modes, K, M)
     click.echo(f"warning: {warning}\n" if warning else format_table(table) + "\n")
+    note = free_note(modes.n_rigid)
+    if note and not warning:
+        click.echo(f"note: {note}\n")
     summary = {
         "configuration": label,
-        "modes": [{"n": int(row.mode), "frequency_hz": float(row.frequency_hz), "eff_mass_z": float(row.eff_mass_z),
-                   "shape": row.shape, **({"frequency_std_hz": float(row.frequency_std_hz)} if stds is not None else {})}
-                  for row in table.itertuples()],
+        "modes": [{"n": k + 1, "frequency_hz": float(f), "effective_mass": fractions, "shape": shape,
+                   **({"frequency_std_hz": float(std[k])} if std is not None else {})}
+                  for k, (f, fractions, shape) in enumerate(zip(modes.frequencies, em.as_dicts(), table["shape"]))],
         "mass_kg": mass,
+        "centre_of_mass_m": em.centre.tolist(),
+        "inertia_kg_m2": dict(zip(("rx", "ry", "rz"), em.totals[3:].tolist())),
         "dofs": int(bm.model.n_dof),
         "rigid_body_modes": int(modes.n_rigid),
+        **({"effective_mass_note": note} if note else {}),
         **({"warning": warning} if warning else {}),
     }
     return {"config": config, "model": bm, "modes": modes, "table": table, "summary": summary}
@@ -65,7 +74,7 @@ def write_results(board, solved: dict, out: Path, pictures: bool = True) -> None
     config, bm, modes = solved["config"], solved["model"], solved["modes"]
     label = config or "base"
     stem = f"modes_{label}"
-    write_text(out / f"{stem}.csv", solved["table"].to_csv(index=False))
+    write_text(out / f"{stem}.csv", solved["table"].to_csv(index=False, float_format="%.6g"))
     vtu = out / f"{stem}.vtu"
     write_modes_vtu(vtu, bm.model, modes.frequencies, modes.shapes)
     if pictures:
@@ -97,7 +106,7 @@ def uncertainty_note(stds: dict) -> str:
                 "write frequencies, mass and DOF count as JSON", html=True)
 @library_option()
 def command(board_toml, config, all_configs, out, json_path, no_pictures, html, uncertainty):
-    """Predict a board's resonances: frequencies, effective masses in z, mode shapes."""
+    """Predict a board's resonances: frequencies, effective masses, mode shapes."""
     from ..problems import load_structure
     from ..report.files import write_json
 
@@ -123,7 +132,7 @@ def command(board_toml, config, all_configs, out, json_path, no_pictures, html, 
                 if html:
                     from ..report.pages import build_page
 
-                    page = run.final(build_page(run.path, board_toml, board, results))
+                    page = run.final(build_page(run.path, board_toml, board, solved))
     if json_path is not None:
         data = dict(results[0]) if len(results) == 1 else {**results[0], "configurations": results}
         data["board"] = board.name

@@ -74,8 +74,8 @@ def command(board_toml, test_uff, config, min_mac, n_modes, out, json_path, html
             if html:
                 from ..report.pages import correlate_page
 
-                written.append(correlate_page(run.path, board_toml, test_uff, board, label, pairing,
-                                              dict(zip(corr.dof_labels, corr.comac.tolist())), written).name)
+                written.append(correlate_page(run.path, board_toml, test_uff, board, config, corr, written, bm,
+                                              modes, test_modes).name)
         done(t0)
         click.echo(f"results written to {out}/ ({len(written)} files)", err=True)
     if json_path is not None:

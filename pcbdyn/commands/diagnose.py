@@ -5,7 +5,8 @@ the catalogue of effects (point masses and inertias, ground springs, edge stiffn
 stiffness, stiffeners, line masses) for the fewest that explain it, estimated together with the
 parameters (:func:`pcbdyn.diagnosis.pipeline.diagnose`). Prints the effects and the correlation as
 given / parameters only / with the effects; writes ``<board>.diagnosed.toml`` declaring them next
-to the original, the evidence map and tables in ``--out``, and JSON.
+to the original, the evidence map and tables in ``--out`` (with ``--html``, a page showing the effects
+on the modes of the model that declares them), and JSON.
 """
 
 from __future__ import annotations
@@ -15,7 +16,8 @@ from pathlib import Path
 import click
 
 from ..diagnosis import KINDS
-from .common import done, folder_outputs, input_errors, library_option, measured_configurations, parse_noise, result_path, step, units_option
+from .common import (done, folder_outputs, input_errors, library_option, measured_configurations, parse_noise, result_path,
+                     solve_structure, step, units_option)
 
 
 @click.command("diagnose")
@@ -39,12 +41,12 @@ from .common import done, folder_outputs, input_errors, library_option, measured
               help="a Dask scheduler address (tcp://host:8786): the finer-mesh solves and the full trial fits run "
                    "on that cluster, the rest on local processes (the findings do not depend on where they run)")
 @folder_outputs("folder for the board with the effects declared, the evidence map and tables",
-                "write effects, before/after and statistics as JSON",
+                "write effects, before/after and statistics as JSON", html=True,
                 force="replace an earlier <board>.diagnosed.toml beside the board (default: a numbered name)")
 @library_option()
 @units_option
 def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size, quick, workers, scheduler, out, force,
-            json_path):
+            json_path, html):
     """Find the effects a board model lacks from modal tests: TEST_UFF (with mode shapes) of the base
     configuration and NAME=FILE for each perturbed configuration of board.toml (e.g. c2=test2.uff)."""
     from ..diagnosis.pipeline import diagnose
@@ -79,11 +81,15 @@ def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size,
         from ..report.manifest import replacing
 
         with replacing(out, "pcbdyn diagnose") as run:  # the earlier --out stays whole until all is written
-            enriched = _enriched(board, d, result_path(run.path, board_toml, "diagnosed"), run.final)
+            staged = result_path(run.path, board_toml, "diagnosed")
+            enriched = _enriched(board, d, staged, run.final)
             write_text(run.path / "effects.txt", rep.format_effects(d.effects) + "\n")
             write_text(run.path / "correlation.txt", rep.format_states(d.before, d.parameters_only, d.after) + "\n")
             if d.evidence:
                 rep.plot_evidence(run.path / "evidence.png", board, d.evidence, d.effects)
+            if html:
+                page = run.final(_page(run.path, board_toml, board, d, staged if enriched is not None else None))
+                click.echo(f"page written to {page}", err=True)
     if json_path is not None:
         write_json(json_path, {
             "effects": d.effects, "noise_only": d.noise_only, "message": d.message,
@@ -91,6 +97,26 @@ def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size,
             "after": rep.summary(d.after), "parameters": d.parameters, "statistics": d.statistics,
             "enriched_board": None if enriched is None else str(enriched),
         })
+
+
+def _page(folder, board_toml, board, d, enriched):
+    """report.html in ``folder``: the effects on the modes of the board that declares them (``enriched``,
+    its file; the board as given when there is none or it cannot be read)."""
+    from ..domain import StructureError
+    from ..problems import load_structure
+    from ..report import diagnosis_report as rep
+
+    shown = board
+    if enriched is not None:
+        try:
+            shown = load_structure(enriched)
+        except StructureError as exc:
+            click.echo(f"note: the page shows the model as given: {exc}", err=True)
+    bm, modes, _, _ = solve_structure(shown, None)
+    title = board.name + (" with the effects" if shown is not board else "")
+    evidence = folder / "evidence.png"
+    return rep.html_page(folder, board_toml, board, d, (title, bm, modes, shown.outlines(None)),
+                         evidence if evidence.is_file() else None)
 
 
 def _enriched(board, d, path, final=lambda p: p):

@@ -73,4 +73,4 @@ def command(board_toml, pulse_text, history_csv, srs_csv, combination, damping_t
               "axis": axis, "SRS": f"Q = {s.srs_q:g}, {s.srs_f[0]:g}-{s.srs_f[-1]:.5g} Hz at 1/12 octave",
               "combination": s.combination.upper() if s.combination else None,
               "excluded parts": ", ".join(exclude) or None}
-    report_verdict("shock", report, s, board_toml, board, bm.model, inp.name, inputs, out, json_path, html)
+    report_verdict("shock", report, s, board_toml, board, bm.model, inp.name, inputs, out, json_path, html, config)

@@ -71,13 +71,13 @@ def parse_frf_freqs(text) -> list:
               help="modal methods: the model on a mesh twice as fine at the fitted parameters, whose mesh error "
                    "joins the noise and is taken out of the measured frequencies")
 @folder_outputs("folder for board.updated.toml, the iteration plot and tables (default: board.updated.toml beside "
-                "the board)", "write parameters, status, before/after and history as JSON",
+                "the board)", "write parameters, status, before/after and history as JSON", html=True,
                 force="replace an earlier board.updated.toml beside the board (default: a numbered name), and write "
                       "it even when the fit did not converge")
 @library_option()
 @units_option
 def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping, solver, params, max_iter, tol_pct,
-            mesh_size, noise, mesh_check, out, force, json_path):
+            mesh_size, noise, mesh_check, out, force, json_path, html):
     """Update a structure's [[parameters]] against modal tests: TEST_UFF for the base configuration and
     NAME=FILE for each perturbed configuration of board.toml (e.g. c2=test2.uff), or measured
     frequencies (--frequencies CSV)."""
@@ -143,6 +143,14 @@ def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping,
                 rep.plot_iterations(staged.path / "iterations.png", problem, res)
                 write_text(staged.path / "parameters.txt", rep.format_parameters(rows) + "\n")
                 write_text(staged.path / "correlation.txt", rep.format_correlation(before, after) + "\n")
+                if html:
+                    from ..fe.modal import solve_modes
+
+                    built = problem.system(None).at(res.p)
+                    modes = solve_modes(built.model, n_modes=board.analysis.modes, f_max=board.analysis.f_max)
+                    page = staged.final(rep.html_page(staged.path, board_toml, board, rows, before, after, what,
+                                                      (built, modes), staged.path / "iterations.png"))
+                    click.echo(f"page written to {page}", err=True)
     click.echo(f"\n{board.name}: {what['status']} after {res.iterations} iteration(s) ({res.reason})")
     for line in what["details"]:
         click.echo(f"  note: {line}")

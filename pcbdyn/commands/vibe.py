@@ -71,11 +71,11 @@ def command(board_toml, psd_text, sine_csv, sweep_rate, sweeps, damping_text, du
               "axis": axis, "duration": None if seconds is None else f"{seconds:g} s",
               "chassis frequency": None if chassis is None else f"{chassis:g} Hz",
               "excluded parts": ", ".join(exclude) or None}
-    report_verdict("vibe", report, a, board_toml, board, bm.model, psd.name, inputs, out, json_path, html)
+    report_verdict("vibe", report, a, board_toml, board, bm.model, psd.name, inputs, out, json_path, html, config)
 
 
 def report_verdict(name: str, report, result, board_toml, board, model, input_name: str, inputs: dict, out, json_path,
-                   html: bool) -> None:
+                   html: bool, config=None) -> None:
     """The end of ``vibe`` and ``shock``: print the summary and the parts table of ``result`` (through
     its ``report`` module), write its files into ``out`` (the page with ``html``, the manifest) and
     the JSON, with the files written."""
@@ -90,7 +90,7 @@ def report_verdict(name: str, report, result, board_toml, board, model, input_na
         with replacing(out, f"pcbdyn {name}") as run:  # the earlier --out stays whole until all is written
             written = report.write_outputs(run.path, board, model, result)
             if html:
-                written.append(report.html_page(run.path, board_toml, board, result, inputs).name)
+                written.append(report.html_page(run.path, board_toml, board, result, inputs, model, config).name)
         done(t0)
         click.echo(f"results written to {out}/ ({len(written)} files)", err=True)
     if json_path is not None:

@@ -101,3 +101,65 @@ def enriched_effects(diagnosis) -> list:
                 d[key] = (np.asarray(e[f"{key}_mm"]) / 1e3).tolist()
         out.append(d)
     return out
+
+
+def effect_outlines(effects) -> list:
+    """The effects found as outlines for a 3-D view (kind "effect", labelled with their type and size):
+    a point at ``at_mm``, or its path, segment or polygon; 2 coordinates on a board, 3 on a box."""
+    out = []
+    for e in effects:
+        v, u = shown(e["magnitude"], e["unit"])
+        key = next((k for k in ("path_mm", "segment_mm", "polygon_mm") if k in e), "at_mm")
+        pts = np.asarray(e[key], float).reshape(-1, np.asarray(e["at_mm"]).size) / 1e3
+        out.append({"kind": "effect", "label": f"{e['type']} {v:.3g} {u}", "closed": key == "polygon_mm",
+                    "xy" if pts.shape[1] == 2 else "xyz": pts.tolist()})
+    return out
+
+
+def states_table(before, params_only, after):
+    """Per configuration and test mode: frequency errors and MAC as given, with the parameters fitted and
+    with the effects (the rows of :func:`format_states`)."""
+    import pandas as pd
+
+    rows = []
+    for b, p, a in zip(before["configurations"], params_only["configurations"], after["configurations"]):
+        for qb, qp, qa in zip(b["modes"], p["modes"], a["modes"]):
+            rows.append({"configuration": b["configuration"], "test mode": qb["test_mode"],
+                         "f_test [Hz]": qb["f_test_hz"], "df given [%]": qb["df_pct"],
+                         "df parameters [%]": qp["df_pct"], "df with effects [%]": qa["df_pct"],
+                         "MAC given": qb["mac"], "MAC with effects": qa["mac"]})
+    return pd.DataFrame(rows)
+
+
+def html_page(out, board_toml, board, d, shown_model, evidence_png=None):
+    """report.html in ``out``: the effects found, the correlation before and after, an animated 3-D view of
+    the modes of ``shown_model`` = (title, built model, modes, outlines) with the effects drawn on it, and
+    the evidence map."""
+    import pandas as pd
+
+    from .html import Page, describe_file
+    from .view3d import shapes_view
+
+    page = Page(f"pcbdyn diagnose: {board.name}", subtitle=d.message)
+    page.items("Inputs", {"board": describe_file(board_toml)})
+    rows = []
+    for e in d.effects:
+        v, u = shown(e["magnitude"], e["unit"])
+        s, _ = shown(e["uncertainty"], e["unit"])
+        rows.append({"type": e["type"], "parameter": e["parameter"], "plate": e.get("plate", "-"),
+                     "at [mm]": ", ".join(f"{c:.1f}" for c in e["at_mm"]), "magnitude": v, "+-": s, "unit": u})
+    if rows:
+        page.table("Effects found", pd.DataFrame(rows))
+    else:
+        page.text("Effects found", ["none: " + d.message])
+    page.table("Correlation as given, with the parameters fitted, with the effects",
+               states_table(d.before, d.parameters_only, d.after))
+    title, built, modes, outlines = shown_model
+    if modes.frequencies.size:
+        page.view3d("Effects found, on the modes of the model", shapes_view(
+            title, built.model, list(outlines) + effect_outlines(d.effects), modes.shapes,
+            [f"mode {k + 1}: {f:.1f} Hz" for k, f in enumerate(modes.frequencies)]),
+            note="red: the effects found, labelled with their size (hover over them)")
+    if evidence_png is not None:
+        page.pictures("Evidence", [evidence_png], ["chi^2 a point effect at each node would remove"])
+    return page.write(out / "report.html")

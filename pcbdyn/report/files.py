@@ -23,14 +23,27 @@ def write_text(path, text: str) -> None:
         tmp.write_text(text)
 
 
-def save_figure(fig, path, **options) -> Path:
+def save_figure(fig, path, colours: int | None = None, **options) -> Path:
     """A matplotlib figure saved to ``path`` atomically (format from its suffix; ``options`` for
-    savefig, e.g. dpi) and closed; returns ``path``."""
+    savefig, e.g. dpi) and closed; returns ``path``. ``colours``: a PNG of that many colours (256 keep
+    a mode picture's shading; the file is about a third of the full-colour one, so that a page
+    embedding many stays small)."""
+    import io
+
     import matplotlib.pyplot as plt
 
     path = Path(path)
     with atomic_path(path) as tmp:
-        fig.savefig(tmp, format=path.suffix.lstrip(".") or "png", **options)
+        if colours is None:
+            fig.savefig(tmp, format=path.suffix.lstrip(".") or "png", **options)
+        else:
+            from PIL import Image
+
+            buf = io.BytesIO()
+            fig.savefig(buf, format="png", **options)
+            buf.seek(0)
+            with Image.open(buf) as im:
+                im.convert("RGB").quantize(colours).save(tmp, format="PNG", optimize=True)
     plt.close(fig)
     return path
 

@@ -12,6 +12,9 @@ Use from a command (after its tables and PNG files are written)::
     page.text("Octave rule", ["f_board / f_chassis = 2.5: forward rule holds"])
     page.write(out / "report.html")
 
+``page.view3d("Modes in 3-D", mode_view(...))`` adds an animated 3-D view (:mod:`.view3d`); the
+first one brings plotly.js into the page. A click on a picture shows it full size.
+
 Each call adds one section, in order; ``table`` takes a pandas DataFrame (column names carry
 their units, e.g. "z_rms [mm]") or a list of dicts; numbers are shown with 4 significant digits.
 ``status`` (optional, one per row) colours rows "bad" or "good". ``write`` adds the versions
@@ -31,8 +34,10 @@ import numpy as np
 
 from .files import write_text
 
+#: the size a page keeps under by leaving out optional pictures [bytes]
+PAGE_BYTES = 14_500_000
 #: the libraries whose versions a page records
-VERSIONED = ("pcbdyn", "numpy", "scipy", "pandas", "matplotlib", "pint", "pyuff", "jinja2")
+VERSIONED = ("pcbdyn", "numpy", "scipy", "pandas", "matplotlib", "pint", "pyuff", "jinja2", "plotly")
 
 
 def _cell(v) -> str:
@@ -90,15 +95,39 @@ class Page:
                               "rows": list(zip(rows, status)), "text_cols": text_cols})
         return self
 
-    def pictures(self, title: str, paths, captions=None, note: str | None = None) -> "Page":
+    def pictures(self, title: str, paths, captions=None, note: str | None = None, optional: bool = False) -> "Page":
+        """PNG files with captions. ``optional``: pictures that another section shows too (the mode
+        shapes of a 3-D view); the last of them are left out, and named, when the page would pass
+        :data:`PAGE_BYTES`."""
         paths = [Path(p) for p in paths]
         captions = list(captions) if captions is not None else [p.stem for p in paths]
         pics = []
         for p, cap in zip(paths, captions):
             if not p.is_file():
                 raise FileNotFoundError(f"picture {p} for the page section '{title}' does not exist")
-            pics.append({"data": base64.b64encode(p.read_bytes()).decode("ascii"), "caption": cap})
-        self.sections.append({"kind": "pictures", "title": title, "note": note, "pictures": pics})
+            pics.append({"data": base64.b64encode(p.read_bytes()).decode("ascii"), "caption": cap,
+                         "file": f"{p.parent.name}/{p.name}"})
+        self.sections.append({"kind": "pictures", "title": title, "note": note, "pictures": pics,
+                              "optional": optional})
+        return self
+
+    def _fit(self, html_bytes: int) -> bool:
+        """Leave out the last optional pictures, as many as the page passes :data:`PAGE_BYTES` by;
+        False when nothing was left out."""
+        excess, dropped = html_bytes - PAGE_BYTES, False
+        for s in reversed(self.sections):
+            while excess > 0 and s["kind"] == "pictures" and s.get("optional") and s["pictures"]:
+                pic = s["pictures"].pop()
+                excess -= len(pic["data"]) + len(pic["caption"])
+                s.setdefault("left_out", []).insert(0, pic["file"])
+                s["note"] = (f"{len(s['left_out'])} picture(s) left out to keep the page under "
+                             f"{PAGE_BYTES / 1e6:g} MB (the 3-D view shows every mode): {', '.join(s['left_out'])}")
+                dropped = True
+        return dropped
+
+    def view3d(self, title: str, view: dict, note: str | None = None) -> "Page":
+        """An animated 3-D view of modes: ``view`` from :func:`pcbdyn.report.view3d.mode_view`."""
+        self.sections.append({"kind": "view3d", "title": title, "note": note, "view": view})
         return self
 
     def text(self, title: str, paragraphs, note: str | None = None) -> "Page":
@@ -114,10 +143,19 @@ class Page:
         made = datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
         sections = self.sections + [{"kind": "items", "title": "Versions", "note": f"made {made}",
                                      "rows": list(versions().items())}]
+        scripts = None
+        if any(s["kind"] == "view3d" for s in sections):
+            from .view3d import scripts as view_scripts
+
+            scripts = view_scripts()
         return env.get_template("page.html").render(title=self.title, subtitle=self.subtitle, sections=sections,
-                                                    version=versions()["pcbdyn"])
+                                                    version=versions()["pcbdyn"], scripts=scripts)
 
     def write(self, path) -> Path:
-        """Write the page atomically; returns its path."""
-        write_text(path, self.render())
+        """Write the page atomically, leaving out optional pictures while it would pass
+        :data:`PAGE_BYTES`; returns its path."""
+        html = self.render()
+        while self._fit(len(html.encode("utf-8"))):
+            html = self.render()
+        write_text(path, html)
         return Path(path)

@@ -1,4 +1,6 @@
-"""Mode tables: frequency, effective mass fraction in z, and a short shape description."""
+"""Mode tables: frequency, effective masses (:mod:`pcbdyn.fe.effective_mass`) in percent with their
+running sums, and a short shape description. One table, with the units in its headers, is what the
+console, the CSV file and the HTML page show."""
 
 from __future__ import annotations
 
@@ -6,19 +8,7 @@ import numpy as np
 import pandas as pd
 from scipy.interpolate import griddata
 
-
-def z_translation(n_dof: int) -> np.ndarray:
-    r = np.zeros(n_dof)
-    r[2::6] = 1.0
-    return r
-
-
-def effective_mass_fraction_z(M, shapes: np.ndarray) -> np.ndarray:
-    """Effective modal mass in z over the total mass: (phi^T M r)^2 / (r^T M r) for
-    mass-normalised phi and r the unit rigid translation in z."""
-    r = z_translation(M.shape[0])
-    Mr = M @ r
-    return (shapes.T @ Mr) ** 2 / float(r @ Mr)
+from ..fe.effective_mass import AXES
 
 
 def nodal_lines(nodes: np.ndarray, w: np.ndarray, n_grid: int = 41) -> tuple[int, int]:
@@ -48,22 +38,41 @@ def describe(nodes, w) -> str:
     return f"({m},{n}) nodal lines"
 
 
-def mode_table(bm, modes, M) -> pd.DataFrame:
-    """One row per elastic mode: n, frequency_hz, mass fraction in z, shape description (nodal lines of
-    a plate; a structure in 3-D describes its modes itself, ``mode_descriptions``: the plates that move)."""
-    frac = effective_mass_fraction_z(M, modes.shapes)
+def mass_columns(em) -> dict:
+    """{header: percent per mode}: each mode's effective mass in x, y, z and effective inertia about the
+    axes rx, ry, rz through the centre of mass, then their running sums, rounded to 0.01 %."""
+    cols = {f"m_eff {a} [%]": np.round(100.0 * em.fractions[:, k], 2) for k, a in enumerate(AXES)}
+    cols.update({f"sum {a} [%]": np.round(100.0 * em.cumulative[:, k], 2) for k, a in enumerate(AXES)})
+    return cols
+
+
+#: what the effective-mass columns of a table are
+MASS_NOTE = ("effective mass: each mode's share of the mass moved by a rigid translation along x, y, z and of the "
+             "moment of inertia about the axes rx, ry, rz through the centre of mass; sum: the running sum over the "
+             "modes")
+
+
+def free_note(n_rigid: int) -> str | None:
+    """Why the elastic modes of a free structure show no effective mass (None when it is held)."""
+    if not n_rigid:
+        return None
+    return (f"free structure: its {n_rigid} rigid-body modes carry all of its mass and inertia; the elastic modes "
+            "are mass-orthogonal to every rigid motion, so their effective masses are zero")
+
+
+def mode_table(bm, modes, em) -> pd.DataFrame:
+    """One row per elastic mode: mode, frequency [Hz], the effective masses of ``em``
+    (:func:`mass_columns`) and the shape (nodal lines of a plate; a structure in 3-D describes its
+    modes itself, ``mode_descriptions``: the plates that move)."""
     w = modes.shapes[2::6]
     own = getattr(bm, "mode_descriptions", None)
     return pd.DataFrame({
         "mode": np.arange(1, modes.frequencies.size + 1),
-        "frequency_hz": modes.frequencies,
-        "eff_mass_z": frac,
+        "frequency [Hz]": modes.frequencies,
+        **mass_columns(em),
         "shape": own(modes.shapes) if own else [describe(bm.model.nodes, w[:, j]) for j in range(w.shape[1])],
     })
 
 
 def format_table(df: pd.DataFrame) -> str:
-    out = df.rename(columns={"frequency_hz": "frequency [Hz]", "frequency_std_hz": "+- sd [Hz]",
-                             "eff_mass_z": "eff. mass z [%]"}).copy()
-    out["eff. mass z [%]"] = 100.0 * out["eff. mass z [%]"]
-    return out.to_string(index=False, float_format=lambda v: f"{v:.2f}")
+    return df.to_string(index=False, float_format=lambda v: f"{v:.2f}")

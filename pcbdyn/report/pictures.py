@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import temporary_folder
-from .files import atomic_path
+from .files import save_figure
 from .pictures3d import mode_pictures_3d
 from .rendering import CMAP, OTHER, QUANTITY, STYLE, picture_names, render_child, trim
 
@@ -117,9 +117,7 @@ def mode_pictures(vtu: Path, model, frequencies, shapes, out_dir: Path, prefix: 
             view = plt.imread(Path(views) / name) if renderer == "pyvista" else None
             head = f"{title}: mode {k + 1}, {f:.1f} Hz" if title else f"mode {k + 1}, {f:.1f} Hz"
             fig = mode_figure(tri, w, outlines, head, view)
-            with atomic_path(out_dir / name) as tmp:
-                fig.savefig(tmp, format="png", dpi=100, bbox_inches="tight", pad_inches=0.15)
-            plt.close(fig)
+            save_figure(fig, out_dir / name, colours=256, dpi=100, bbox_inches="tight", pad_inches=0.15)
     return renderer
 
 

@@ -1,7 +1,8 @@
 """PNG pictures of the mode shapes of a structure in 3-D (a ribbed box): no view of it is a plane, so
 each picture shows the whole deformed structure twice, from the back, right and above (isometric) and
-from the opposite side (into an open front), coloured by the magnitude of the displacement |u| scaled so that
-max |u| = 1, with one colour bar "|u| (normalised)". Ribs (beams) are drawn as lines; the outlines the
+from the opposite side (into an open front), coloured by the displacement along the outward normal over the
+largest |u|, with its sign (:func:`.rendering.normal_displacement`: plates moving out red, in blue), with one
+colour bar. Ribs (beams) are drawn as lines; the outlines the
 structure gives (plain data ``{"kind", "label", "xyz": [[x, y, z], ...] in metres, "closed"}``) label
 its plates, ribs, supported edges and masses. The first view is rendered by pyvista from the VTU in a
 child process (:func:`pcbdyn.report.rendering.render_pyvista`), with matplotlib in its place when that
@@ -14,22 +15,16 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import temporary_folder
-from .files import atomic_path
-from .rendering import CMAP, OTHER, STYLE, picture_names, render_child, trim
+from .files import save_figure
+from .rendering import CMAP, OTHER, QUANTITY_3D, STYLE, normal_displacement, picture_names, render_child, trim
 
-QUANTITY_3D = "|u| (normalised)"
 #: warp of the pictures: max |u| drawn as this fraction of the structure's largest extent
 WARP = 0.08
 
 
-def magnitudes(model, shapes) -> np.ndarray:
-    """|u| at the nodes (n_nodes, n_modes), each mode scaled to max |u| = 1."""
-    u = np.linalg.norm(shapes.reshape(model.n_nodes, 6, -1)[:, :3], axis=1)
-    return u / np.maximum(u.max(axis=0), 1e-300)
-
-
-def _view(fig, slot, model, shape, mag, outlines, azim: float, title: str):
-    """A matplotlib 3-D view of the deformed shells (faces coloured by the mean |u| of their nodes) and
+def _view(fig, slot, model, shape, signed, outlines, azim: float, title: str):
+    """A matplotlib 3-D view of the deformed shells (faces coloured by the mean of ``signed``, the
+    normal displacement in [-1, 1], over their nodes) and
     beams, with the outlines' labels, seen from azimuth ``azim``."""
     from matplotlib import colormaps
     from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
@@ -42,7 +37,7 @@ def _view(fig, slot, model, shape, mag, outlines, azim: float, title: str):
     cmap = colormaps[CMAP]
     for es in model.sets.values():
         if es.etype in ("quad4", "tri3"):
-            faces = Poly3DCollection(moved[es.conn], facecolors=cmap(mag[es.conn].mean(axis=1)),
+            faces = Poly3DCollection(moved[es.conn], facecolors=cmap(0.5 + 0.5 * signed[es.conn].mean(axis=1)),
                                      edgecolors=(0.4, 0.4, 0.4, 0.35), linewidths=0.2)
             ax.add_collection3d(faces)
         elif es.etype == "beam2":
@@ -63,8 +58,9 @@ def _view(fig, slot, model, shape, mag, outlines, azim: float, title: str):
     return ax
 
 
-def mode_figure_3d(model, shape, mag, outlines, title: str, view3d=None):
-    """The figure of one mode: ``shape`` its full-length vector, ``mag`` |u| at the nodes (max 1),
+def mode_figure_3d(model, shape, signed, outlines, title: str, view3d=None):
+    """The figure of one mode: ``shape`` its full-length vector, ``signed`` its normal displacement at
+    the nodes (:func:`.rendering.normal_displacement`),
     ``view3d`` the pyvista image of the first view (an RGB array) or None to draw it with matplotlib."""
     import matplotlib.pyplot as plt
     from matplotlib.cm import ScalarMappable
@@ -73,15 +69,15 @@ def mode_figure_3d(model, shape, mag, outlines, title: str, view3d=None):
     fig = plt.figure(figsize=(13.0, 5.6))
     grid = fig.add_gridspec(1, 3, width_ratios=(1.0, 1.0, 0.04), wspace=0.2)
     if view3d is None:
-        _view(fig, grid[0, 0], model, shape, mag, outlines, 45.0, "from the back, right, above")
+        _view(fig, grid[0, 0], model, shape, signed, outlines, 45.0, "from the back, right, above")
     else:
         ax = fig.add_subplot(grid[0, 0])
         ax.imshow(trim(view3d))
         ax.set_axis_off()
         ax.set_title("from the back, right, above", fontsize=9)
-    _view(fig, grid[0, 1], model, shape, mag, outlines, -135.0, "from the front, left, above")
-    fig.colorbar(ScalarMappable(Normalize(0.0, 1.0), CMAP), cax=fig.add_subplot(grid[0, 2]), label=QUANTITY_3D,
-                 ticks=np.linspace(0, 1, 5))
+    _view(fig, grid[0, 1], model, shape, signed, outlines, -135.0, "from the front, left, above")
+    fig.colorbar(ScalarMappable(Normalize(-1.0, 1.0), CMAP), cax=fig.add_subplot(grid[0, 2]), label=QUANTITY_3D,
+                 ticks=np.linspace(-1, 1, 5))
     fig.suptitle(title)
     return fig
 
@@ -96,16 +92,14 @@ def mode_pictures_3d(vtu: Path, model, frequencies, shapes, out_dir: Path, prefi
     import matplotlib.pyplot as plt
 
     names = picture_names(prefix, len(frequencies))
-    mag = magnitudes(model, shapes)
+    signed = normal_displacement(model, shapes)
     with temporary_folder("pcbdyn-views") as views:
-        renderer = "pyvista" if render_child(vtu, Path(views), names, "magnitude") else "matplotlib"
+        renderer = "pyvista" if render_child(vtu, Path(views), names, "normal") else "matplotlib"
         for k, (name, f) in enumerate(zip(names, frequencies)):
             view = plt.imread(Path(views) / name) if renderer == "pyvista" else None
             head = f"{title}: mode {k + 1}, {f:.1f} Hz" if title else f"mode {k + 1}, {f:.1f} Hz"
-            fig = mode_figure_3d(model, shapes[:, k], mag[:, k], outlines, head, view)
-            with atomic_path(Path(out_dir) / name) as tmp:
-                fig.savefig(tmp, format="png", dpi=100, bbox_inches="tight", pad_inches=0.15)
-            plt.close(fig)
+            fig = mode_figure_3d(model, shapes[:, k], signed[:, k], outlines, head, view)
+            save_figure(fig, Path(out_dir) / name, colours=256, dpi=100, bbox_inches="tight", pad_inches=0.15)
     return renderer
 
 

@@ -13,7 +13,7 @@ from ..vibration.spectra import G
 from ..vibration.srs import PV_SEVERE, pseudo_velocity
 from .correlation_plots import _plt, _save
 from .files import write_text
-from .vibration_report import format_table, margin_map, verdict, verdict_page
+from .vibration_report import format_table, margin_map, modes_line, modes_section, verdict, verdict_page
 from .vibration_report import modes_table as vibration_modes_table
 
 __all__ = ["format_table", "html_page", "parts_table", "summary_lines", "write_outputs"]
@@ -64,7 +64,7 @@ def summary_lines(s) -> list:
     inp = s.input
     lines = [f"input: {inp.describe()}, along {s.axis}",
              f"damping: {s.damping.describe()}",
-             f"modes: {s.excitation.frequencies.size} up to {s.excitation.frequencies[-1]:.0f} Hz"]
+             modes_line(s)]
     if s.combination is not None:
         lines.append(f"modal peaks combined by {s.combination.upper()} (the modes left out: the zero-period "
                      "acceleration, statically)")
@@ -110,8 +110,9 @@ def write_outputs(out: Path, board, model, s) -> list:
     return ["parts.csv", "modes.csv", "srs.csv", "board_map.png", "srs.png"]
 
 
-def html_page(out: Path, board_toml, board, s, inputs: dict) -> Path:
-    """report.html in ``out`` (after :func:`write_outputs`): verdicts, tables, pictures, inputs."""
+def html_page(out: Path, board_toml, board, s, inputs: dict, model=None, config=None) -> Path:
+    """report.html in ``out`` (after :func:`write_outputs`): verdicts, tables, pictures, inputs and the
+    modes (:func:`.vibration_report.modes_section`)."""
     page = verdict_page("shock", board, board_toml, f"{s.input.name} along {s.axis}: {verdict(s.parts, 'shock criterion')}",
                         inputs, summary_lines(s), parts_table(s), s.parts,
                         "z: peak relative displacement normal to the board at the part's centre; z_allow: Steinberg's "
@@ -122,5 +123,5 @@ def html_page(out: Path, board_toml, board, s, inputs: dict) -> Path:
     page.pictures("Board map and shock response spectrum", [out / "board_map.png", out / "srs.png"],
                   ["margin per part over the peak relative displacement", "SRS and pseudo-velocity"])
     page.table("Shock response spectrum", srs_table(s))
-    page.table("Modes", modes_table(s))
+    modes_section(page, board, s, modes_table(s), model, config)
     return page.write(out / "report.html")

@@ -113,3 +113,41 @@ def update_json(problem, res, rows, before, after, what: dict, method: str, solv
                      "rank": h.get("rank"), "set_aside": h.get("set_aside", [])} for h in res.history],
         "updated_board": None if dst is None else str(dst), **extra,
     }
+
+
+def correlation_rows(before, after) -> list:
+    """The rows of :func:`format_correlation` as dicts with units in the keys (a page's table)."""
+    out = []
+    for b, a in zip(before, after):
+        after_by = {q["test_mode"]: q for q in a["pairs"]}
+        for q in b["pairs"]:
+            r = after_by.get(q["test_mode"], {})
+            out.append({"configuration": b["configuration"], "test mode": q["test_mode"], "f_test [Hz]": q["f_test_hz"],
+                        "f before [Hz]": q["f_model_hz"], "df before [%]": q["df_pct"],
+                        "f after [Hz]": r.get("f_model_hz"), "df after [%]": r.get("df_pct"), "MAC after": r.get("mac")})
+    return out
+
+
+def html_page(out, board_toml, board, rows, before, after, what: dict, updated, iterations_png):
+    """report.html in ``out``: the status, the parameters, the correlation before and after, an animated
+    3-D view of the modes of the ``updated`` model = (built model, modes) and the iteration plot."""
+    import pandas as pd
+
+    from .html import Page, describe_file
+    from .view3d import shapes_view
+
+    page = Page(f"pcbdyn update: {board.name}", subtitle=what["status"])
+    page.items("Inputs", {"board": describe_file(board_toml)})
+    if what["details"]:
+        page.text("Notes", what["details"])
+    page.table("Parameters", pd.DataFrame([{"parameter": r["name"], "unit": r["unit"], "initial": r["initial"],
+                                            "updated": r["updated"], "change [%]": r["change_pct"],
+                                            "bound": r["bound_hit"] or "-"} for r in rows]))
+    page.table("Correlation before and after", pd.DataFrame(correlation_rows(before, after)))
+    built, modes = updated
+    if modes.frequencies.size:
+        page.view3d("Modes of the updated model", shapes_view(
+            f"{board.name} (updated)", built.model, board.outlines(None), modes.shapes,
+            [f"mode {k + 1}: {f:.1f} Hz" for k, f in enumerate(modes.frequencies)]))
+    page.pictures("Iterations", [iterations_png], ["parameters, largest frequency error and condition per iteration"])
+    return page.write(out / "report.html")

@@ -36,10 +36,20 @@ def parts_table(a) -> pd.DataFrame:
 
 
 def modes_table(a) -> pd.DataFrame:
+    """One row per mode: frequency, damping, effective masses in percent (:func:`.modes.mass_columns`)."""
+    from .modes import mass_columns
+
     be = a.excitation
     return pd.DataFrame({"mode": np.arange(1, be.frequencies.size + 1), "frequency [Hz]": be.frequencies,
-                         "damping ratio": be.zeta, "Q": 0.5 / be.zeta,
-                         "eff. mass [%]": 100.0 * be.effective_mass_fraction, "damping from": a.damping_source})
+                         "damping ratio": be.zeta, "Q": 0.5 / be.zeta, **mass_columns(a.effective_mass),
+                         "damping from": a.damping_source})
+
+
+def modes_line(a) -> str:
+    """How many modes the response sums, to where, and the share of the mass moved along the axis they carry."""
+    be = a.excitation
+    return (f"modes: {be.frequencies.size} up to {be.frequencies[-1]:.0f} Hz, {100 * a.effective_mass.share(a.axis):.2f} "
+            f"% of the mass moved along {a.axis} (static residual added for the rest)")
 
 
 def format_table(df: pd.DataFrame) -> str:
@@ -50,9 +60,7 @@ def summary_lines(a) -> list:
     """Inputs and board-level results, one line each, for the terminal and the page."""
     lines = [f"input: {a.psd.name}, {a.input_grms:.2f} grms along {a.axis} ({a.psd.source})",
              f"damping: {a.damping.describe()}",
-             f"modes: {a.excitation.frequencies.size} up to {a.excitation.frequencies[-1]:.0f} Hz, "
-             f"{100 * a.excitation.effective_mass_fraction.sum():.1f} % of the moving mass (static residual added "
-             "for the rest)",
+             modes_line(a),
              f"largest RMS relative displacement on the board: {a.z_peak_m * 1e3:.4g} mm"]
     if a.duration is not None:
         lines.append(f"duration: {a.duration:g} s per axis")
@@ -154,8 +162,22 @@ def verdict_page(command: str, board, board_toml, subtitle: str, inputs: dict, s
     return page
 
 
-def html_page(out: Path, board_toml, board, a, inputs: dict) -> Path:
-    """report.html in ``out`` (after :func:`write_outputs`): verdicts, tables, pictures, inputs."""
+def modes_section(page, board, a, table, model=None, config=None) -> None:
+    """The modes ``table`` of the result ``a`` (``vibe``'s or ``shock``'s) on its page and, given the FE
+    ``model`` of ``board`` (its configuration ``config``), an animated 3-D view of the modes used."""
+    from .modes import MASS_NOTE
+    from .view3d import shapes_view
+
+    page.table("Modes", table, note=MASS_NOTE)
+    be = a.excitation
+    if model is not None and be.frequencies.size:
+        page.view3d("Modes in 3-D", shapes_view(board.name, model, board.outlines(config), be.basis, [
+            f"mode {k + 1}: {f:.1f} Hz, Q = {0.5 / z:.3g}" for k, (f, z) in enumerate(zip(be.frequencies, be.zeta))]))
+
+
+def html_page(out: Path, board_toml, board, a, inputs: dict, model=None, config=None) -> Path:
+    """report.html in ``out`` (after :func:`write_outputs`): verdicts, tables, pictures, inputs and the
+    modes (:func:`modes_section`)."""
     page = verdict_page("vibe", board, board_toml,
                         f"{a.psd.name}, {a.input_grms:.2f} grms along {a.axis}: {verdict(a.parts, 'criterion')}",
                         inputs, summary_lines(a), parts_table(a), a.parts,
@@ -165,5 +187,5 @@ def html_page(out: Path, board_toml, board, a, inputs: dict) -> Path:
                         "three-band technique and Miner's rule at the zero up-crossing rate nu0.")
     page.pictures("Board map and response spectra", [out / "board_map.png", out / "response_psd.png"],
                   ["margin per part over the RMS relative displacement", "input and response acceleration PSDs"])
-    page.table("Modes", modes_table(a))
+    modes_section(page, board, a, modes_table(a), model, config)
     return page.write(out / "report.html")

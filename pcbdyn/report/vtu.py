@@ -33,11 +33,18 @@ def shell_grid(model):
 
 def write_modes_vtu(path, model, frequencies, shapes) -> None:
     """Write the mesh with arrays mode_<k> (displacement vectors, max |w| = 1; max |u| = 1 for a
-    structure in 3-D, :func:`pcbdyn.report.pictures.is_3d`) and field data 'frequency_hz'."""
+    structure in 3-D, :func:`pcbdyn.report.pictures.is_3d`, which also gets normal_<k>, the signed
+    displacement along the outward normal, :func:`.rendering.normal_displacement`) and field data
+    'frequency_hz'."""
     from .pictures import is_3d
+    from .rendering import normal_displacement
 
     grid = shell_grid(model)
     flat = not is_3d(model)
+    if not flat and len(frequencies):
+        normal = normal_displacement(model, shapes)
+        for j in range(len(frequencies)):
+            grid.point_data[f"normal_{j + 1}"] = normal[:, j]
     for j, f in enumerate(frequencies):
         u = shapes[:, j].reshape(-1, 6)[:, :3]
         scale = (np.max(np.abs(u[:, 2])) if flat else np.max(np.linalg.norm(u, axis=1))) or 1.0

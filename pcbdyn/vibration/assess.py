@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..fe.effective_mass import EffectiveMass, effective_mass, shortfall
 from . import steinberg
 from .base_excitation import BaseExcitation, base_excitation
 from .damping import Damping, modal_damping
@@ -63,6 +64,7 @@ class Assessment:
     grid: np.ndarray
     part_accel_psd: np.ndarray  # (n_grid, n_parts) absolute acceleration [(m/s^2)^2/Hz]
     part_z_psd: np.ndarray  # (n_grid, n_parts) relative displacement [m^2/Hz]
+    effective_mass: EffectiveMass | None = None
     octave: dict | None = None
     sine: SineSweep | None = None
     notes: list = field(default_factory=list)
@@ -88,10 +90,10 @@ class Assessment:
             "duration_s": self.duration,
             "damping": self.damping.describe(),
             "modes": [{"n": i + 1, "frequency_hz": float(f), "damping_ratio": float(z), "damping_source": s,
-                       "effective_mass_fraction": float(m)}
+                       "effective_mass": m}
                       for i, (f, z, s, m) in enumerate(zip(be.frequencies, be.zeta, self.damping_source,
-                                                           be.effective_mass_fraction))],
-            "effective_mass_fraction": float(be.effective_mass_fraction.sum()),
+                                                           self.effective_mass.as_dicts()))],
+            "effective_mass_fraction": self.effective_mass.share(self.axis),
             "z_peak_rms_m": self.z_peak_m,
             "parts": [p.to_dict() for p in self.parts],
             "octave_rule": self.octave,
@@ -113,12 +115,17 @@ def _sine(be: BaseExcitation, sine: SineSweep, B: np.ndarray, parts, results) ->
 
 def board_excitation(board, bm, modes, K, M, damping: Damping, axis: str, probe_tol: float | None) -> tuple:
     """(:class:`BaseExcitation` of the solved board along ``axis`` with the modal damping asked for,
-    where each mode's damping came from); a free board is refused naming its file."""
+    where each mode's damping came from, the modes' :class:`~pcbdyn.fe.effective_mass.EffectiveMass`,
+    notes: the shortfall when the modes carry < 90 % of the mass moved along ``axis``); a free board
+    is refused naming its file."""
     zeta, source = modal_damping(damping, bm.model, modes, probe_tol)
     try:
-        return base_excitation(bm.model, modes, K, M, zeta, axis), source
+        be = base_excitation(bm.model, modes, K, M, zeta, axis)
     except VibrationError as exc:
         raise VibrationError(f"{board.path.name}: {exc}") from None
+    em = effective_mass(bm.model.nodes, M, modes.shapes)
+    short = shortfall(em, axis, modes.frequencies)
+    return be, source, em, [] if short is None else [f"{short} (the static residual adds it back, without resonance)"]
 
 
 def assess(board, bm, modes, K, M, psd: Psd, damping: Damping, *, axis: str = "z", duration: float | None = None,
@@ -131,14 +138,13 @@ def assess(board, bm, modes, K, M, psd: Psd, damping: Damping, *, axis: str = "z
     ``probe_tol`` [m]: how far off the board a test point of a UFF damping file may lie."""
     parts = judged_parts(board) if parts is None else parts
     model = bm.model
-    be, source = board_excitation(board, bm, modes, K, M, damping, axis, probe_tol)
+    be, source, em, notes = board_excitation(board, bm, modes, K, M, damping, axis, probe_tol)
     grid = frequency_grid(psd.f[0], psd.f[-1], be.frequencies, be.zeta)
     C0, C2 = be.covariance(psd, grid), be.covariance(psd, grid, moment=2)
     nodes = shell_nodes(model)
     node_z = np.full(model.nodes.shape[0], np.nan)
     node_z[nodes] = np.sqrt(be.variance(be.basis[6 * nodes + 2], C0))
     z_peak = float(np.nanmax(node_z))
-    notes = []
     if be.frequencies[-1] < psd.f[-1]:
         notes.append(f"the modes found reach {be.frequencies[-1]:.0f} Hz, below the top of the spectrum "
                      f"({psd.f[-1]:.0f} Hz): the modes above respond statically only")
@@ -170,4 +176,4 @@ def assess(board, bm, modes, K, M, psd: Psd, damping: Damping, *, axis: str = "z
     order = np.argsort([r.margin for r in results], kind="stable")
     octave = None if chassis_hz is None else steinberg.octave_rule(float(be.frequencies[0]), chassis_hz)
     return Assessment(psd, damping, axis, duration, be, source, [results[i] for i in order],
-                      node_z, grid, accel_psd[:, order], z_psd[:, order], octave, sine, notes)
+                      node_z, grid, accel_psd[:, order], z_psd[:, order], em, octave, sine, notes)

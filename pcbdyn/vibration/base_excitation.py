@@ -44,11 +44,6 @@ class BaseExcitation:
     r: np.ndarray
     total_mass: float
 
-    @property
-    def effective_mass_fraction(self) -> np.ndarray:
-        """Gamma_r^2 / (r^T M r) per mode (the mass held by the supports never takes part)."""
-        return self.gamma**2 / self.total_mass
-
     def transfer(self, freqs, quantity: str = "displacement") -> np.ndarray:
         """g_k(f) (n_f, n_columns) per unit base acceleration: relative displacement of each basis
         column, or, for "acceleration", [1, -w^2 g] on the columns [r, basis]."""

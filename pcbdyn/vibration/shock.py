@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..fe.effective_mass import EffectiveMass
 from . import steinberg
 from .assess import board_excitation
 from .base_excitation import BaseExcitation
@@ -95,6 +96,7 @@ class ShockAssessment:
     srs_q: float
     combination: str | None  # SRS input only
     followed_s: float | None  # transient: the end of the time followed [s]
+    effective_mass: EffectiveMass | None = None
     notes: list = field(default_factory=list)
 
     @property
@@ -113,11 +115,11 @@ class ShockAssessment:
             "axis": self.axis,
             "damping": self.damping.describe(),
             "modes": [{"n": i + 1, "frequency_hz": float(f), "damping_ratio": float(z), "participation": float(g),
-                       "effective_mass_fraction": float(m), "damping_source": s}
+                       "effective_mass": m, "damping_source": s}
                       for i, (f, z, g, m, s) in enumerate(zip(be.frequencies, be.zeta, be.gamma,
-                                                              be.effective_mass_fraction, self.damping_source))],
+                                                              self.effective_mass.as_dicts(), self.damping_source))],
             "participation_unit": "kg^0.5",
-            "effective_mass_fraction": float(be.effective_mass_fraction.sum()),
+            "effective_mass_fraction": self.effective_mass.share(self.axis),
             "z_peak_m": self.z_peak_m,
             "followed_s": self.followed_s,
             "parts": [p.to_dict() for p in self.parts],
@@ -205,7 +207,7 @@ def assess_shock(board, bm, modes, K, M, inp: Transient | SrsSpec, damping: Damp
     ``probe_tol`` as in :func:`.assess.assess`."""
     parts = judged_parts(board) if parts is None else parts
     model = bm.model
-    be, source = board_excitation(board, bm, modes, K, M, damping, axis, probe_tol)
+    be, source, em, notes = board_excitation(board, bm, modes, K, M, damping, axis, probe_tol)
     nodes = shell_nodes(model)
     disp = {"nodes": be.basis[6 * nodes + 2]}
     acc = {}
@@ -213,8 +215,6 @@ def assess_shock(board, bm, modes, K, M, inp: Transient | SrsSpec, damping: Damp
         read = part_readers(model, parts, axis)
         disp.update({k: be.columns(read[k]) for k in ("z", "curvature_along", "curvature_across")})
         acc = {"acceleration": be.columns(read["acceleration"], "acceleration")}
-    notes = [f"modes to {be.frequencies[-1]:.0f} Hz ({100 * be.effective_mass_fraction.sum():.1f} % of the moving "
-             "mass); the modes above respond statically (static residual)"]
     timed = isinstance(inp, Transient)
     if timed:
         until = float(inp.t[-1]) + WINDOW_CYCLES / float(be.frequencies[0])
@@ -236,4 +236,5 @@ def assess_shock(board, bm, modes, K, M, inp: Transient | SrsSpec, damping: Damp
     node_z = np.full(model.nodes.shape[0], np.nan)
     node_z[nodes] = node_peak
     results = _part_results(board, parts, peaks, float(np.nanmax(node_z)), timed) if parts else []
-    return ShockAssessment(inp, damping, axis, be, source, results, node_z, f_srs, s_srs, q_srs, rule, until, notes)
+    return ShockAssessment(inp, damping, axis, be, source, results, node_z, f_srs, s_srs, q_srs, rule, until, em,
+                           notes)

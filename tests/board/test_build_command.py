@@ -32,10 +32,14 @@ def test_build_writes_every_output_and_matches_the_plate_formula(tmp_path):
     # mode 1 is the (1,1) half-sine: no interior nodal line, most of the mass moving in z
     assert data["modes"][0]["shape"].startswith("(0,0)")
     assert data["modes"][1]["shape"].startswith("(1,0)")  # (2,1): one nodal line across x
-    assert data["modes"][0]["eff_mass_z"] == pytest.approx(64 / np.pi**4, rel=0.02)  # (mean sin)^4 / (mean sin^2)^2
-    assert "frequency [Hz]" in res.output and "eff. mass z [%]" in res.output
+    first = data["modes"][0]["effective_mass"]
+    assert first["z"] == pytest.approx(64 / np.pi**4, rel=0.02)  # (mean sin)^4 / (mean sin^2)^2
+    assert sorted(first) == ["rx", "ry", "rz", "x", "y", "z"] and first["x"] < 1e-12 and first["y"] < 1e-12
+    assert "frequency [Hz]" in res.output and "m_eff z [%]" in res.output and "sum z [%]" in res.output
     csv = (out / "modes_base.csv").read_text().splitlines()
-    assert csv[0].startswith("mode,frequency_hz") and len(csv) == 5
+    assert csv[0].startswith("mode,frequency [Hz],m_eff x [%]") and len(csv) == 5
+    z_pct = float(csv[1].split(",")[csv[0].split(",").index("m_eff z [%]")])  # the same percent as the console
+    assert z_pct == pytest.approx(round(100 * first["z"], 2), abs=1e-9) and f"{z_pct:.2f}" in res.output
     import pyvista as pv
 
     grid = pv.read(str(out / "modes_base.vtu"))

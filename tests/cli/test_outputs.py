@@ -59,15 +59,21 @@ def test_a_study_whose_out_is_a_file_fails_before_the_shots(tmp_path):
 
 def test_update_on_the_thesis_data_says_the_model_cannot_fit(card, tmp_path):
     """Table 7.2 data, four parameters (issue 40): the card's model cannot fit its test within the noise
-    (chi^2 far above its degrees of freedom; with the mesh error in the noise it is still 3184 over 19), E_board ends on its bound and configuration c3
-    ends worse than it started: the status says so instead of "converged", and no updated board is
-    written without --force."""
+    (chi^2 far above its degrees of freedom; with the mesh error in the noise it is still 3184 over 19),
+    E_board ends on its bound and configuration c3 ends worse than it started: the status says so instead
+    of "converged", and no updated board is written without --force (the page is)."""
     js = tmp_path / "u.json"
-    r = run(["update", card, "--frequencies", TABLE, "--out", tmp_path / "out", "--json", js, "--no-mesh-check"])
+    r = run(["update", card, "--frequencies", TABLE, "--out", tmp_path / "out", "--json", js, "--no-mesh-check",
+             "--html"])
     assert r.exit_code == 0, r.output
     data = json.loads(js.read_text())
     assert data["status"] == "cannot fit" and not data["verdict"]["fits"]
     assert data["verdict"]["chi2"] > 10 * data["verdict"]["dof"] and data["verdict"]["dof"] == 23 - 4
+    page = (tmp_path / "out" / "report.html").read_text()  # the page animates the updated model's modes
+    assert 'data-title="Parameters"' in page and 'data-title="Correlation before and after"' in page
+    view = json.loads(re.search(r'class="view-data">(.*?)</script>', page, re.S).group(1))
+    base = next(c for c in data["after"]["configurations"] if c["configuration"] == "base")
+    assert view["labels"][0] == f"mode 1: {base['pairs'][0]['f_model_hz']:.1f} Hz"
     details = " ".join(data["status_details"])
     assert "the model cannot fit the test: chi^2" in details and "E_board stopped at its upper bound" in details
     assert "configuration c3: max |df| grew" in details

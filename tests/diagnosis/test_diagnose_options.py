@@ -5,6 +5,7 @@ in this process, in worker processes or on a Dask cluster give the same findings
 from __future__ import annotations
 
 import json
+import re
 import sys
 from pathlib import Path
 
@@ -56,11 +57,20 @@ def test_quick_finds_what_the_full_run_finds(case, default, tmp_path):
     """The first look: the standoff within the bench's tolerances (type, 15 mm, 30 %, after < 0.5 %),
     at the full run's place within one model element and its stiffness within 10 %; the progress
     names the one finer mesh level it measured."""
-    data, output = _diagnose(case, tmp_path, "--quick")
+    data, output = _diagnose(case, tmp_path, "--quick", "--html")
     assert not judge(CASE, case[2], data)
     _same_findings(data, default, 0.10, 1e3 * bc.MODEL_MESH)
     assert "level 1 of 1" in output and "level 2 of" not in output
     assert data["statistics"]["quick"] and not default["statistics"]["quick"]
+    # the page shows the effects found on the modes of the model that declares them (issue 44)
+    page = (tmp_path / "o" / "report.html").read_text()
+    assert 'data-title="Effects found"' in page and "Effects found, on the modes of the model" in page
+    view = json.loads(re.search(r'class="view-data">(.*?)</script>', page, re.S).group(1))
+    drawn = [o for o in view["scenes"][0]["outlines"] if o["kind"] == "effect"]
+    assert [o["label"].split()[0] for o in drawn] == [e["type"] for e in data["effects"]]
+    for o, e in zip(drawn, data["effects"]):
+        assert np.asarray(o["xyz"])[0, :2] == pytest.approx(e["at_mm"], abs=1e-3)
+    assert view["scenes"][0]["title"].endswith("with the effects") and len(view["labels"]) >= 1
 
 
 def test_scheduler_gives_the_same_findings(case, default, tmp_path):

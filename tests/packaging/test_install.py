@@ -68,11 +68,13 @@ def test_a_plain_install_in_a_fresh_venv_builds_the_example(tmp_path):
     assert installed == Path(where[0]).parent / "library" and installed.is_relative_to(tmp_path / "venv"), where
     assert sorted(p.name for p in installed.glob("*.toml")) == sorted(p.name for p in (ROOT / "library").glob("*.toml"))
     res = subprocess.run([tmp_path / "venv" / "bin" / "pcbdyn", "build", str(example / "board.toml"), "--no-pictures",
-                          "--json", str(tmp_path / "modes.json")], cwd=tmp_path, env=_clean_env(),
-                         capture_output=True, text=True)
+                          "--json", str(tmp_path / "modes.json"), "--out", str(tmp_path / "out"), "--html"],
+                         cwd=tmp_path, env=_clean_env(), capture_output=True, text=True)
     assert res.returncode == 0, res.stderr
     modes = json.loads((tmp_path / "modes.json").read_text())["modes"]
     assert len(modes) == 7 and modes[0]["frequency_hz"] == pytest.approx(197.9, abs=0.1)
+    page = (tmp_path / "out" / "report.html").read_text()
+    assert "pcbdyn: animated 3-D mode views" in page and "plotly.js v" in page  # view3d.js ships as package data
 
 
 def test_the_board_folder_then_pcbdyn_library_then_the_shipped_library(tmp_path, monkeypatch):

@@ -41,7 +41,11 @@ def test_json_keeps_the_contract(pulse_run):
     f = np.array([m["frequency_hz"] for m in data["modes"]])
     assert f[-1] <= 10.0 / 1e-3 and np.all(np.diff(f) > 0)  # modes to ten over the pulse's duration
     for m in data["modes"]:
-        assert {"frequency_hz", "damping_ratio", "participation"} <= set(m) and m["damping_ratio"] == 0.05
+        assert {"frequency_hz", "damping_ratio", "participation", "effective_mass"} <= set(m)
+        assert m["damping_ratio"] == 0.05 and sorted(m["effective_mass"]) == ["rx", "ry", "rz", "x", "y", "z"]
+    # the first mode of the simply supported plate carries 64 / pi^4 of its mass in z, as Gamma^2 / m says
+    assert data["modes"][0]["effective_mass"]["z"] == pytest.approx(64 / np.pi**4, rel=0.02)
+    assert data["effective_mass_fraction"] == pytest.approx(sum(m["effective_mass"]["z"] for m in data["modes"]))
     parts = data["parts"]
     assert [p["ref"] for p in parts] == ["U1", "U2"]  # the centre of a simply supported board first
     for p in parts:
@@ -58,6 +62,8 @@ def test_files_are_written(pulse_run):
     out = d / "out"
     for name in ("parts.csv", "modes.csv", "srs.csv", "board_map.png", "srs.png", "report.html"):
         assert (out / name).is_file() and (out / name).stat().st_size > 200, name
+    assert (out / "modes.csv").read_text().splitlines()[0].count("[%]") == 12  # m_eff and sum, x..rz
+    assert 'class="view3d"' in (out / "report.html").read_text()  # the modes in 3-D
     assert sorted(data["files"]) == sorted(p.name for p in out.iterdir() if p.name != "pcbdyn-manifest.json")
     assert "t_z [ms]" in (out / "parts.csv").read_text().splitlines()[0]
     assert (out / "srs.csv").read_text().splitlines()[0] == ("frequency [Hz],srs [g],pseudo velocity [m/s],"

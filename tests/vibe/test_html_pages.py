@@ -1,26 +1,20 @@
-"""The HTML pages of vibe, build and correlate, opened in real headless Chromium (Debian's
-chromium and chromium-driver, installed by scripts/setup.sh) driven by Selenium: every picture
-loads, every table is there, nothing is fetched from outside the page, and a screenshot is not
-blank. The page builder's escaping and its refusal of a missing picture are checked without a
-browser."""
+"""The HTML pages of vibe, build and correlate, opened in real headless Chromium (tests/browser.py:
+the network blocked) driven by Selenium: every picture loads (and opens at full size on a click),
+every table is there, nothing is fetched from outside the page, and a screenshot is not blank. The page builder's escaping and its
+refusal of a missing picture are checked without a browser."""
 
 import io
 import json
-import shutil
-import tempfile
 from pathlib import Path
 
 import numpy as np
 import pytest
+from browser import chromium, requests_made
 from click.testing import CliRunner
 from vibe_plates import write_plate
 
 from pcbdyn.cli import main
 from pcbdyn.report.html import Page
-
-CHROMIUM, DRIVER = Path("/usr/bin/chromium"), Path("/usr/bin/chromedriver")
-FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-         "--disable-background-networking", "--disable-component-update", "--disable-sync", "--window-size=1280,1600")
 
 
 def run(*args):
@@ -31,21 +25,8 @@ def run(*args):
 
 @pytest.fixture(scope="module")
 def browser():
-    if not (CHROMIUM.is_file() and DRIVER.is_file()):
-        pytest.skip("Debian's chromium and chromium-driver are not installed (scripts/setup.sh installs them)")
-    webdriver = pytest.importorskip("selenium.webdriver",
-                                    reason="selenium is a test dependency (pip install -e .[test])")
-    from selenium.webdriver.chrome.service import Service
-
-    profile = tempfile.mkdtemp(prefix="pcbdyn-chromium-")
-    opts = webdriver.ChromeOptions()
-    opts.binary_location = str(CHROMIUM)
-    for flag in (*FLAGS, f"--user-data-dir={profile}"):
-        opts.add_argument(flag)
-    driver = webdriver.Chrome(service=Service(str(DRIVER)), options=opts)
-    yield driver
-    driver.quit()
-    shutil.rmtree(profile, ignore_errors=True)
+    with chromium() as driver:
+        yield driver
 
 
 def open_page(browser, page: Path, shot: Path) -> dict:
@@ -53,11 +34,13 @@ def open_page(browser, page: Path, shot: Path) -> dict:
     browser.get(page.resolve().as_uri())
     state = browser.execute_script("""
         return {
-          images: Array.from(document.images).map(i => [i.complete, i.naturalWidth, i.naturalHeight]),
+          images: Array.from(document.querySelectorAll('figure img')).map(i => [i.complete, i.naturalWidth, i.naturalHeight]),
           tables: Array.from(document.querySelectorAll('table')).map(t => [t.dataset.title, t.rows.length]),
           fetched: performance.getEntriesByType('resource').map(e => e.name).filter(n => !n.startsWith('data:')),
           title: document.title,
+          views: document.querySelectorAll('.view3d').length,
         };""")
+    state["requested"] = requests_made(browser)
     png = browser.get_screenshot_as_png()
     shot.write_bytes(png)
     import matplotlib.image
@@ -74,7 +57,7 @@ def check(state, n_images, titles):
     assert all(ok and w > 50 and h > 50 for ok, w, h in state["images"]), state["images"]  # none missing
     assert [t for t, _ in state["tables"]] == titles
     assert all(rows >= 2 for _, rows in state["tables"])
-    assert state["fetched"] == []  # self-contained: nothing loaded from outside the page
+    assert state["fetched"] == [] and state["requested"] == []  # self-contained: nothing asked of the network
     assert state["nonwhite"] > 0.05 and state["colours"] > 20  # the screenshot is not blank
 
 
@@ -85,6 +68,18 @@ def test_vibe_page(browser, tmp_path):
     assert state["title"] == "pcbdyn vibe: simply supported plate"
     check(state, 2, ["Inputs", "Parts, worst margin first", "Modes", "Versions"])
     assert dict(state["tables"])["Parts, worst margin first"] == 3  # header and two parts
+    assert state["views"] == 1  # the modes used, in 3-D
+    # a picture opens at its full size on a click, and closes on another
+    figure = browser.find_element("css selector", "figure img")
+    figure.click()
+    hidden, natural, shown, small_natural, small_shown = browser.execute_script("""
+        const box = document.getElementById('lightbox'), img = box.querySelector('img');
+        return [box.hidden, img.naturalWidth, img.getBoundingClientRect().width, arguments[0].naturalWidth,
+                arguments[0].getBoundingClientRect().width];""", figure)
+    assert not hidden and natural == small_natural and shown == pytest.approx(natural, abs=1)
+    assert small_shown < 0.9 * natural  # the page shows it smaller
+    browser.find_element("id", "lightbox").click()
+    assert browser.execute_script("return document.getElementById('lightbox').hidden")
 
 
 def test_build_page(browser, tmp_path):
@@ -93,6 +88,7 @@ def test_build_page(browser, tmp_path):
     run("build", board, "--out", tmp_path / "out", "--html")
     state = open_page(browser, tmp_path / "out" / "report.html", tmp_path / "build.png")
     check(state, 3, ["Inputs", "Model [base]", "Modes [base]", "Versions"])
+    assert state["views"] == 1
 
 
 def test_correlate_page(browser, tmp_path):
@@ -106,13 +102,14 @@ def test_correlate_page(browser, tmp_path):
     run("correlate", board, tmp_path / "t.uff", "--out", tmp_path / "out", "--json", js, "--html")
     n_pairs = len(json.loads(js.read_text())["pairs"])
     state = open_page(browser, tmp_path / "out" / "report.html", tmp_path / "correlate.png")
-    check(state, 3 + n_pairs, ["Inputs", "Mode pairs", "Lowest COMAC", "Versions"])
+    check(state, 4 + n_pairs, ["Inputs", "Mode pairs", "Lowest COMAC", "Versions"])  # MAC, AutoMAC, f, COMAC
+    assert state["views"] == 1  # test and model side by side
 
 
 def test_page_escapes_text_and_refuses_a_missing_picture(tmp_path):
     page = Page("a <b> & c").table("t", [{"name [mm]": "<script>alert(1)</script>", "v": 1.234567}])
     html = page.render()
-    assert "<script>" not in html and "&lt;script&gt;" in html and "1.235" in html
+    assert "<script>alert" not in html and "&lt;script&gt;alert" in html and "1.235" in html
     assert "<title>a &lt;b&gt; &amp; c</title>" in html
     with pytest.raises(FileNotFoundError, match="picture .*nothing.png for the page section 'p' does not exist"):
         Page("x").pictures("p", [tmp_path / "nothing.png"])

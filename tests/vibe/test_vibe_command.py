@@ -181,3 +181,24 @@ def test_a_free_board_is_refused(tmp_path):
 def test_html_needs_out(plate, tmp_path):
     res = run("vibe", plate, "--psd", "gevs-qual", "--html")
     assert res.exit_code == 2 and "--html writes report.html into --out" in res.output
+
+
+def test_effective_masses_and_the_warning_when_the_modes_carry_too_little(full_run, plate, tmp_path):
+    """modes[].effective_mass holds fractions in x, y, z, rx, ry, rz; the first mode of a simply supported
+    plate carries 64 / pi^4 of its mass in z ((mean sin)^4 / mean sin^2 squared); their sum along the shaken
+    axis is effective_mass_fraction, and vibe warns when it is below 90 %. Shaken along x, the bending modes
+    of a flat board move none of its mass: warned."""
+    _, data, output = full_run
+    em = [m["effective_mass"] for m in data["modes"]]
+    assert all(sorted(e) == ["rx", "ry", "rz", "x", "y", "z"] for e in em)
+    assert em[0]["z"] == pytest.approx(64 / np.pi**4, rel=0.02)
+    share = data["effective_mass_fraction"]
+    assert share == pytest.approx(sum(e["z"] for e in em), rel=1e-12) and 0.8 < share < 1.0
+    warned = [n for n in data["notes"] if "of the mass moved along z (< 90 %)" in n]
+    assert bool(warned) == (share < 0.9), (share, data["notes"])
+    assert f"{100 * share:.2f} % of the mass moved along z" in output
+    js = tmp_path / "x.json"
+    assert run("vibe", plate, "--psd", "gevs-qual", "--axis", "x", "--json", js).exit_code == 0
+    x = json.loads(js.read_text())
+    assert x["effective_mass_fraction"] < 1e-6
+    assert any("of the mass moved along x (< 90 %)" in n for n in x["notes"]), x["notes"]
