@@ -59,6 +59,9 @@ class Kind:
 
 #: collections that are one table (targets ``<table>.<attribute>``); the others are arrays of tables
 TABLES = ("board",)
+#: collections whose entries are structures of their own: ``<collection>.<name>.<target of the entry>``
+#: (``cards.card1.components.U1.thickness``: a card's board.toml target, in a box.toml)
+NESTED = ("cards",)
 
 KINDS = {(k.collection, k.attribute): k for k in (
     Kind("board", "E", "Pa", "Young's modulus of the board", path=("material", "E")),
@@ -87,14 +90,16 @@ KINDS = {(k.collection, k.attribute): k for k in (
 
 @dataclass(frozen=True)
 class Target:
-    """A parsed target: ``collection``, entry ``name`` (None for a table) and ``attribute``."""
+    """A parsed target: ``collection``, entry ``name`` (None for a table) and ``attribute``; ``prefix``:
+    the nested entry it belongs to (``cards.card1``), or None."""
 
     collection: str
     name: str | None
     attribute: str
+    prefix: str | None = None
 
     def __str__(self) -> str:
-        return ".".join(p for p in (self.collection, self.name, self.attribute) if p is not None)
+        return ".".join(p for p in (self.prefix, self.collection, self.name, self.attribute) if p is not None)
 
     @property
     def kind(self) -> Kind:
@@ -110,7 +115,11 @@ def parse(text, collections=None) -> Target:
     """``text`` as a :class:`Target` of one of ``collections`` (default: any); TargetError otherwise,
     naming the target kinds there are."""
     parts = str(text).split(".")
+    if len(parts) > 3 and parts[0] in NESTED and parts[1] and (collections is None or parts[0] in collections):
+        inner = parse(".".join(parts[2:]))
+        return Target(inner.collection, inner.name, inner.attribute, f"{parts[0]}.{parts[1]}")
     patterns = [k.pattern for k in KINDS.values() if collections is None or k.collection in collections]
+    patterns += [f"{c}.<name>.<its target>" for c in NESTED if collections is not None and c in collections]
     table = len(parts) == 2 and parts[0] in TABLES
     if table or (len(parts) == 3 and parts[0] not in TABLES and all(parts)):
         if (parts[0], parts[-1]) in KINDS and (collections is None or parts[0] in collections):

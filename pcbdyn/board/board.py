@@ -164,7 +164,7 @@ def parse_board(data: dict, path: Path) -> Board:
     if "box" in data and "board" not in data:
         r.fail("top level", "describes a box ([box]); this command takes a board.toml ([board]): boxes are built, "
                             "tested, updated, localised and diagnosed by build, simulate-test, correlate, update, "
-                            "localize, diagnose and study")
+                            "localize, diagnose and study, and a box with [[cards]] is judged by vibe")
     r.table(data, "top level", ["board", "components", "fixtures", "masses", "configurations", "parameters",
                                 "analysis", "points", "line_masses", "stiffeners", "regions"], required=["board"])
     b = r.table(data["board"], "board", ["name", "outline", "thickness", "material", "stackup", "mesh_size",

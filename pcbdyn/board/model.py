@@ -77,10 +77,12 @@ def mesh_lines(board) -> list:
 
 
 def build_model(board, config: str | None = None, mesh_size: float | None = None,
-                shared_mesh: bool = False) -> BoardModel:
+                shared_mesh: bool = False, housed: bool = False) -> BoardModel:
     """The FE model of ``board`` in configuration ``config`` (None: the base configuration).
     ``shared_mesh``: every configuration's points are nodes, so that the models of all
-    configurations share one mesh node for node (diagnosis places effects by node)."""
+    configurations share one mesh node for node (diagnosis places effects by node). ``housed``: the
+    edge fixtures and standoffs hold nothing (a housing holds the card, :mod:`pcbdyn.box.system`); a
+    standoff still has its centre node, tied to its pad."""
     cfg = configuration_of(board, config, BoardError)
     check_mesh_size(board, mesh_size or board.mesh_size)
     named = mesh_points(board, cfg, shared_mesh)
@@ -128,13 +130,13 @@ def build_model(board, config: str | None = None, mesh_size: float | None = None
     supported = False
     for f in board.fixtures:
         if f.edge is not None:
-            for mk in supports.apply_edge(model, mesh, board.outline, f, q):
+            for mk in ([] if housed else supports.apply_edge(model, mesh, board.outline, f, q)):
                 add(*mk)
             supported = True
         elif f.type == "standoff":
             centre = int(model.add_nodes([[f.at[0], f.at[1], 0.0]])[0])
             point_nodes[f"fixtures.{f.name}"] = centre
-            for mk in supports.apply_standoff(model, centre, f, q):
+            for mk in supports.apply_standoff(model, centre, f, q, grounded=not housed):
                 add(*mk)
             supported = True
         elif f.type in ("point_spring", "edge_spring"):  # springs to ground that leave rigid motions free

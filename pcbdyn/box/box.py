@@ -5,23 +5,28 @@ configuration, measurement points on the plates, the updated box.toml."""
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+import tomlkit
 
 from .. import targets
 from ..atomic import write_checked
+from ..board import load_board
 from ..inputs import MAX_ENTRIES, MAX_NAME, Reader, read_toml
 from ..domain import Analysis, Configured
+from .cards import MAX_CARDS, holds, read_card
 from .entries import MAX_PLATES, RIB_MODELS, BoxError
 from .enrich import enriched_text
 from .model import BoxModel, build_model
 from .spec import (check_plates, read_configuration, read_joint, read_mass, read_materials, read_plate, read_rib,
                    read_support)
 
-#: the collections of box.toml that parameter targets address
-COLLECTIONS = ("plates", "ribs", "joints", "masses")
+#: the collections of box.toml that parameter targets address (``cards``: a card's own targets under
+#: ``cards.<card>.``, e.g. ``cards.card1.components.U1.thickness``)
+COLLECTIONS = ("plates", "ribs", "joints", "masses", "cards")
 #: [m] how far a measurement point may lie from the nearest plate's mid-surface (points on a face, on
 #: a rib's flank); farther ones are an error that names them
 POINT_TOL = 0.005
@@ -42,6 +47,11 @@ class Box(Configured):
     configurations: list = field(default_factory=list)
     parameters: list = field(default_factory=list)
     analysis: Analysis = field(default_factory=Analysis)
+    cards: list = field(default_factory=list)  # .cards.Card
+    holds: dict = field(default_factory=dict)  # {card name: [.cards.Hold]}
+
+    def card(self, name):
+        return next((c for c in self.cards if c.name == name), None)
 
     def plate(self, name):
         return next((p for p in self.plates if p.name == name), None)
@@ -56,6 +66,9 @@ class Box(Configured):
             t = targets.parse(target, COLLECTIONS)
         except targets.TargetError:
             return None
+        if t.prefix is not None:
+            card = self.card(t.prefix.split(".", 1)[1])
+            return None if card is None else card.board.quantity(str(t).split(".", 2)[2])
         if t.collection == "plates" and (p := self.plate(t.name)) is not None:
             if t.attribute == "E":
                 return None if p.material.orthotropic else p.material.E
@@ -70,7 +83,12 @@ class Box(Configured):
 
     # -------------------------------------------------------------------- domain-model interface
     def build(self, config: str | None = None, mesh_size: float | None = None, shared_mesh: bool = False) -> BoxModel:
-        """The FE model of configuration ``config`` (None: the base one); see :func:`.model.build_model`."""
+        """The FE model of configuration ``config`` (None: the base one); see :func:`.model.build_model`,
+        and with cards :func:`.system.build_system`."""
+        if self.cards:
+            from .system import build_system
+
+            return build_system(self, config, mesh_size, shared_mesh)
         return build_model(self, config, mesh_size, shared_mesh)
 
     def nearest_plates(self, xyz) -> tuple:
@@ -78,17 +96,22 @@ class Box(Configured):
         d = np.array([p.distance(xyz) for p in self.plates])
         return d.argmin(axis=0), d.min(axis=0)
 
+    def nearest_part(self, xyz) -> tuple:
+        """(index of the nearest plate or card (cards after the plates), distance [m]) of each point (k, 3)."""
+        d = np.array([p.distance(xyz) for p in self.plates] + [c.distance(xyz) for c in self.cards])
+        return d.argmin(axis=0), d.min(axis=0)
+
     def check_points(self, points, source) -> None:
         """A BoxError naming the points (``points.ids``, ``points.xyz`` [m]) of ``source`` farther than
         :data:`POINT_TOL` from every plate, with the nearest plate and how far it is."""
-        near, dist = self.nearest_plates(points.xyz)
+        near, dist = self.nearest_part(points.xyz)
         off = dist > POINT_TOL
         if off.any():
-            listed = "; ".join(f"{int(i)} at {np.round(x * 1e3, 3).tolist()} mm is {d * 1e3:.3g} mm from plate "
-                               f"'{self.plates[k].name}'"
+            names = [f"plate '{p.name}'" for p in self.plates] + [f"card '{c.name}'" for c in self.cards]
+            listed = "; ".join(f"{int(i)} at {np.round(x * 1e3, 3).tolist()} mm is {d * 1e3:.3g} mm from {names[k]}"
                                for i, x, d, k in zip(points.ids[off][:10], points.xyz[off][:10], dist[off][:10],
                                                      near[off][:10]))
-            raise BoxError(f"{Path(source).name}: {int(off.sum())} point(s) lie off every plate of {self.path.name} "
+            raise BoxError(f"{Path(source).name}: {int(off.sum())} point(s) lie off every plate{' and card' if self.cards else ''} of {self.path.name} "
                            f"(more than {POINT_TOL * 1e3:g} mm away): {listed}{' ...' if off.sum() > 10 else ''}. "
                            "Give the points in the box frame of the file and state their unit in the header (e.g. "
                            "'x [mm]')")
@@ -106,6 +129,7 @@ class Box(Configured):
                   for r in self.ribs]
         items += [item("fixture", f"{s.type} {s.plate}.{s.edge}", self.plate(s.plate).edge(s.edge))
                   for s in self.supports]
+        items += [item("plate", c.name, c.point(c.board.outline.vertices), True) for c in self.cards]
         added = self.configuration(config).masses if config else []
         items += [item("mass", m.name + (f" ({config})" if m in added else ""), [self.plate(m.plate).point(*m.at)])
                   for m in self.masses + added]
@@ -119,9 +143,24 @@ class Box(Configured):
 
     def write_updated(self, values: dict, dst, source: str = "pcbdyn update") -> Path:
         """``dst``: this box.toml with the parameters' ``values`` {name: SI} written into their targets
-        (comments and layout kept), checked by loading it before it replaces ``dst``."""
+        (comments and layout kept), checked by loading it before it replaces ``dst``. A card's targets go
+        to an updated copy of its board.toml, written beside it and named as ``dst`` is after the box
+        (box.updated.2.toml: card1.updated.2.toml), which the updated box then names."""
         assignments = {t: float(values[p.name]) for p in self.parameters if p.name in values for t in p.targets}
-        text = targets.updated_text(self.path.read_text(encoding="utf-8"), assignments)
+        dst = Path(dst)
+        tail = dst.name[len(self.path.stem):] if dst.name.startswith(self.path.stem) else f".{dst.name}"
+        doc = tomlkit.parse(self.path.read_text(encoding="utf-8"))
+        for i, card in enumerate(self.cards):
+            own = {t.split(".", 2)[2]: v for t, v in assignments.items() if t.startswith(f"cards.{card.name}.")}
+            path = board = card.board.path
+            if own:
+                path = board.with_name(board.stem + tail)
+                text = targets.updated_text(board.read_text(encoding="utf-8"), own)
+                write_checked(path, f"# {board.name} in {dst.name}, with {', '.join(own)} updated by {source}\n"
+                              + text, load_board, BoxError)
+            doc["cards"][i]["board"] = os.path.relpath(path.resolve(), dst.resolve().parent).replace(os.sep, "/")
+        text = targets.updated_text(tomlkit.dumps(doc), {t: v for t, v in assignments.items()
+                                                        if not t.startswith("cards.")})
         return write_checked(dst, f"# {self.path.name} with {', '.join(values)} updated by {source}\n" + text,
                              load_box, BoxError)
 
@@ -144,7 +183,7 @@ def parse_box(data: dict, path: Path) -> Box:
     """The Box of parsed box.toml ``data`` read from ``path``; a BoxError names the first bad field."""
     r = Reader(path, BoxError)
     r.table(data, "top level", ["box", "materials", "plates", "ribs", "supports", "joints", "masses",
-                                "configurations", "parameters", "analysis"], required=["box", "plates"])
+                                "configurations", "parameters", "analysis", "cards"], required=["box", "plates"])
     b = r.table(data["box"], "box", ["name", "mesh_size", "rib_model"])
     rib_model = r.choice(b.get("rib_model", "beam"), "box.rib_model", RIB_MODELS, "rib model",
                          {"beam": "eccentric beams", "shell": "shell strips"})
@@ -163,5 +202,7 @@ def parse_box(data: dict, path: Path) -> Box:
                           for i, e in enumerate(r.list(data, "configurations"))]
     r.unique([c.name for c in box.configurations], "configurations", "name")
     box.analysis = r.analysis(data)
+    box.cards = _named(r, data, "cards", read_card, path, limit=MAX_CARDS)
+    box.holds = {c.name: holds(r, box, c, f"cards[{i}]") for i, c in enumerate(box.cards)}
     box.parameters = targets.read_parameters(r, data, box.quantity, COLLECTIONS)
     return box

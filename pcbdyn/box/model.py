@@ -59,16 +59,21 @@ class BoxModel(ParametricModel):
         footprints = {f"plates.{p.name}": p.corners() for p in self.box.plates}
         return suspects, footprints, min(p.thickness for p in self.box.plates)
 
-    def mode_shares(self, shapes) -> np.ndarray:
-        """(n_plates, n_modes): each plate's share of each mode's kinetic energy (ribs with their plate)."""
-        sets = {p.name: [n for n in self.model.sets if n.startswith((f"plates.{p.name}", *(
+    def share_groups(self) -> dict:
+        """{label: element sets} of the parts a mode's energy is shared among: the plates (ribs with
+        their plate)."""
+        return {p.name: [n for n in self.model.sets if n.startswith((f"plates.{p.name}", *(
             f"ribs.{r.name}" for r in self.box.ribs if r.plate == p.name)))] for p in self.box.plates}
-        e = np.array([np.einsum("ij,ij->j", shapes, assemble(self.model, sets=s)[1] @ shapes) for s in sets.values()])
+
+    def mode_shares(self, shapes) -> np.ndarray:
+        """(n_parts, n_modes): each part's (:meth:`share_groups`) share of each mode's kinetic energy."""
+        e = np.array([np.einsum("ij,ij->j", shapes, assemble(self.model, sets=s)[1] @ shapes)
+                      for s in self.share_groups().values()])
         return e / np.maximum(e.sum(axis=0), 1e-300)
 
     def mode_descriptions(self, shapes) -> list:
-        """Per mode, the plates that carry most of its kinetic energy, e.g. "upper 71 %, left 12 %"."""
-        names = [p.name for p in self.box.plates]
+        """Per mode, the parts that carry most of its kinetic energy, e.g. "upper 71 %, left 12 %"."""
+        names = list(self.share_groups())
         out = []
         for col in self.mode_shares(shapes).T:
             order = np.argsort(col)[::-1]
@@ -187,18 +192,22 @@ def _hold(box, mesh, model, plate_map) -> None:
             model.fix([n], (3, 4, 5))
 
 
-def build_model(box, config: str | None = None, mesh_size: float | None = None, shared_mesh: bool = False) -> BoxModel:
+def build_model(box, config: str | None = None, mesh_size: float | None = None, shared_mesh: bool = False,
+                points=(), lines=(), bind: bool = True) -> BoxModel:
     """The FE model of ``box`` in configuration ``config`` (None: the base one); ``shared_mesh``: every
-    configuration's masses are nodes, so that all configurations share one mesh node for node."""
+    configuration's masses are nodes, so that all configurations share one mesh node for node.
+    ``points`` [(name, plate, xyz)]: more points that must be nodes (in ``point_nodes`` by name),
+    ``lines`` [(p0, p1)] more lines element edges follow: where cards meet the housing; ``bind``: the
+    box's parameters bound (a system binds them once its cards are in)."""
     cfg = configuration_of(box, config, BoxError)
-    named = _named_points(box, cfg, shared_mesh)
-    lines = [(box.plate(r.plate).point(*r.start), box.plate(r.plate).point(*r.end)) for r in box.ribs]
+    named = _named_points(box, cfg, shared_mesh) + list(points)
+    ribs = [(box.plate(r.plate).point(*r.start), box.plate(r.plate).point(*r.end)) for r in box.ribs]
     size = mesh_size or box.mesh_size
     check_mesh_size(f"{box.path.name}: box.mesh_size", min(min(p.lengths) for p in box.plates),
                     sum(float(np.linalg.norm(np.cross(p.u, p.v))) for p in box.plates), size, BoxError,
                     "the smallest plate's")
     try:
-        mesh = mesh_box(box.plates, lines, [p for _, _, p in named], size)
+        mesh = mesh_box(box.plates, ribs + list(lines), [p for _, _, p in named], size)
     except RuntimeError as exc:
         raise BoxError(f"{box.path.name}: box.mesh_size: meshing failed ({exc})") from None
     model = Model(mesh.nodes.copy())
@@ -211,7 +220,7 @@ def build_model(box, config: str | None = None, mesh_size: float | None = None, 
         for etype, conn in mesh.cells[p.name].items():
             name = f"plates.{p.name}" if etype == "quad4" else f"plates.{p.name}.{etype}"
             makers[name] = SetMaker(etype, plate_map[p.name][conn], keys, lambda q, p=p: _shell(p, q))
-    chains = [plate_map[r.plate][mesh.chain(*line, mesh.plate_nodes(r.plate))] for r, line in zip(box.ribs, lines)]
+    chains = [plate_map[r.plate][mesh.chain(*line, mesh.plate_nodes(r.plate))] for r, line in zip(box.ribs, ribs)]
     if box.rib_model == "beam":
         for r, chain in zip(box.ribs, chains):
             plate = box.plate(r.plate)
@@ -240,5 +249,6 @@ def build_model(box, config: str | None = None, mesh_size: float | None = None, 
     model.node_groups.update({name: np.array([n]) for name, n in point_nodes.items()})
     bm = BoxModel.assemble_from(model, q, makers, point_nodes=point_nodes, box=box, mesh=mesh, configuration=config,
                                 plate_map=plate_map)
-    bm.bind(box.parameters)
+    if bind:
+        bm.bind(box.parameters)
     return bm

@@ -24,6 +24,10 @@ def analyse(board, config, stds: dict | None = None) -> dict:
     mass = float(em.totals[2])
     table = mode_table(bm, modes, em)
     std = None
+    reduction = getattr(bm, "reduction_error", lambda *a: None)(modes, K, M)
+    if reduction is not None:
+        click.echo(f"cards reduced to their interface (Craig-Bampton: {', '.join(f'{c} {k} modes' for c, k in reduction['cards'].items())}): "
+                   f"largest frequency error against the full model {reduction['max_error_pct']:.3g} %")
     if stds is not None:
         from ..problems.uncertainty import frequency_std
 
@@ -37,10 +41,14 @@ def analyse(board, config, stds: dict | None = None) -> dict:
     note = free_note(modes.n_rigid)
     if note and not warning:
         click.echo(f"note: {note}\n")
+    shares = None
+    if hasattr(bm, "share_groups"):  # a structure in 3-D: each part's share of each mode's kinetic energy
+        shares = [dict(zip(bm.share_groups(), map(float, col))) for col in bm.mode_shares(modes.shapes).T]
     summary = {
         "configuration": label,
         "modes": [{"n": k + 1, "frequency_hz": float(f), "effective_mass": fractions, "shape": shape,
-                   **({"frequency_std_hz": float(std[k])} if std is not None else {})}
+                   **({"frequency_std_hz": float(std[k])} if std is not None else {}),
+                   **({"shares": shares[k]} if shares is not None else {})}
                   for k, (f, fractions, shape) in enumerate(zip(modes.frequencies, em.as_dicts(), table["shape"]))],
         "mass_kg": mass,
         "centre_of_mass_m": em.centre.tolist(),
@@ -48,6 +56,7 @@ def analyse(board, config, stds: dict | None = None) -> dict:
         "dofs": int(bm.model.n_dof),
         "rigid_body_modes": int(modes.n_rigid),
         **({"effective_mass_note": note} if note else {}),
+        **({"reduction": reduction} if reduction is not None else {}),
         **({"warning": warning} if warning else {}),
     }
     return {"config": config, "model": bm, "modes": modes, "table": table, "summary": summary}

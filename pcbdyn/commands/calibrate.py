@@ -62,10 +62,8 @@ def command(board_toml, test_uff, configs, freq_csv, joint_toml, families, with_
     from ..problems.calibration import calibrate, calibration_problem
     from ..problems.calibration_library import check_library, max_error, write_library
     from ..problems.joint import load_board_tests, read_joint
-    from ..problems.run import outcome
     from ..report import calibration_report as rep
     from ..report.files import write_json
-    from ..report.update_report import progress_line
     from ..units import to_si
 
     if board_toml is None and joint_toml is None:
@@ -87,9 +85,9 @@ def command(board_toml, test_uff, configs, freq_csv, joint_toml, families, with_
         done(t0)
         t0 = step(f"calibrating {', '.join(cal.families)} on {len(items)} board(s) with {method}/{solver}")
         cal = calibrate(cal, method, solver, (f_pct, shape_pct), mesh_error, max_iter=max_iter, tol_freq_pct=tol_pct,
-                        tol_param_pct=0.01, progress=lambda h: click.echo(progress_line(h), err=True))
+                        tol_param_pct=0.01, progress=lambda msg: click.echo(f"    {msg}", err=True))
         done(t0)
-        what = outcome(cal.problem, cal.result, cal.before, cal.after)
+        what = {"status": cal.fit.status, "details": cal.fit.details, "warnings": cal.fit.warnings}
         t0 = step(f"writing the library {library}")
         fams = write_library(cal, library)
         done(t0)
@@ -115,6 +113,7 @@ def command(board_toml, test_uff, configs, freq_csv, joint_toml, families, with_
             "families": fams, "before": summary(cal.before), "after": summary(cal.after), "library": str(library),
             "with": rep.with_rows(cal), "method": method, "solver": solver, "noise": cal.noise,
             "status": what["status"], "details": what["details"], "warnings": what["warnings"],
+            "verdict": cal.fit.verdict,
             "iterations": cal.result.iterations,
             "converged": bool(cal.result.converged), "reason": cal.result.reason,
             "boards": [str(it.structure.path) for it in cal.items],

@@ -20,14 +20,21 @@ model FRFs correlate (FDAC, see :func:`pcbdyn.updating.frf_lines.choose_frf_freq
 The before/after tables pair the file's modes (dataset 55) with the model by MAC; a file without
 modes is checked against its FRF peaks, paired by order. Damped data: frf-in with
 ``--damping diagonal|proportional|light`` or frf-direct; frf-out assumes little damping.
+
+The modal methods run :func:`pcbdyn.problems.fit.fit`: frequencies in units of the test noise
+(``--noise``, 0.2 % assumed) and of the model's mesh error (the model on a mesh twice as fine at the fitted
+parameters; ``--no-mesh-check`` skips it), log-scale and wide parameters scanned first, the shapes joining
+the objective where the frequencies leave a parameter open, a trust region, and the verdict: converged, on
+a bound, not determined (with the direction), or the model cannot fit the test (chi^2 against its degrees
+of freedom). A fit that did not converge writes no updated board unless ``--force``.
 """
 
 from __future__ import annotations
 
 import click
 
-from .common import (done, fail, folder_outputs, input_errors, library_option, measured_configurations, parse_extra, result_path,
-                     step, test_arguments, units_option)
+from .common import (done, fail, folder_outputs, input_errors, library_option, measured_configurations, parse_extra,
+                     parse_noise, result_path, step, test_arguments, units_option)
 
 def parse_frf_freqs(text) -> list:
     """'150,230 Hz' or '150,230' -> frequencies [Hz]."""
@@ -57,17 +64,25 @@ def parse_frf_freqs(text) -> list:
 @click.option("--tol", "tol_pct", type=float, default=0.1, show_default=True,  # problems.run.TOL_FREQ_PCT
               help="stop when the max frequency error is below this percentage (eq. 7.2)")
 @click.option("--mesh-size", default=None, help="override board.mesh_size, e.g. '10 mm'")
+@click.option("--noise", default=None,
+              help="the test's noise in percent, e.g. f=0.2,shape=2 (uniform bounds): the weights and the chi^2 "
+                   "verdict of the fit (default f=0.2,shape=2, assumed)")
+@click.option("--mesh-check/--no-mesh-check", default=True, show_default=True,
+              help="modal methods: the model on a mesh twice as fine at the fitted parameters, whose mesh error "
+                   "joins the noise and is taken out of the measured frequencies")
 @folder_outputs("folder for board.updated.toml, the iteration plot and tables (default: board.updated.toml beside "
                 "the board)", "write parameters, status, before/after and history as JSON", html=True,
-                force="replace an earlier board.updated.toml beside the board (default: a numbered name)")
+                force="replace an earlier board.updated.toml beside the board (default: a numbered name), and write "
+                      "it even when the fit did not converge")
 @library_option()
 @units_option
 def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping, solver, params, max_iter, tol_pct,
-            mesh_size, out, force, json_path, html):
+            mesh_size, noise, mesh_check, out, force, json_path, html):
     """Update a structure's [[parameters]] against modal tests: TEST_UFF for the base configuration and
     NAME=FILE for each perturbed configuration of board.toml (e.g. c2=test2.uff), or measured
     frequencies (--frequencies CSV)."""
     from ..problems import UpdateProblem, load_structure, run
+    from ..problems.fit import fit
     from ..problems.frf_tests import frf_configurations
     from ..problems.run import outcome
     from ..report import update_report as rep
@@ -79,6 +94,7 @@ def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping,
         fail("give either TEST_UFF (and NAME=FILE for other configurations) or --frequencies FILE.csv")
     if freq_csv is not None and method != "freq":
         fail("--frequencies holds no shapes: use --method freq")
+    noise = parse_noise(noise)
     with input_errors():
         board = load_structure(board_toml)
         ms = to_si(mesh_size, "mm", "--mesh-size") if mesh_size else None
@@ -90,32 +106,40 @@ def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping,
                                                     freqs, damping)
             for note in notes:
                 click.echo(f"note: {note}", err=True)
+        elif freq_csv is not None:
+            data = read_frequency_table(freq_csv, board)
+            click.echo("frequencies only: test mode n is paired with elastic model mode n (by order)", err=True)
         else:
-            if freq_csv is not None:
-                data = read_frequency_table(freq_csv, board)
-                click.echo("frequencies only: test mode n is paired with elastic model mode n (by order)", err=True)
-            else:
-                data = measured_configurations(board, test_uff, configs)
-            check = [problem.configuration(c, m, "freq") for c, m in data]
-            cfgs = check if method == "freq" else [q for c, m in data for q in problem.mode_configurations(c, m, method)]
+            data = measured_configurations(board, test_uff, configs)
         done(t0)
-        blocks = f" ({len(cfgs)} equation blocks)" if len(cfgs) != len(check) else ""
-        t0 = step(f"updating {len(problem.names)} parameter(s) with {method}/{solver} on {len(check)} test "
-                  f"configuration(s){blocks}")
-        res, before, after = run(problem, cfgs, solver, check=check, max_iter=max_iter, tol_freq_pct=tol_pct,
-                                 progress=lambda h: click.echo(rep.progress_line(h), err=True))
+        n_tests = len(check) if method.startswith("frf") else len(data)
+        t0 = step(f"updating {len(problem.names)} parameter(s) with {method}/{solver} on {n_tests} test "
+                  "configuration(s)")
+        if method.startswith("frf"):
+            blocks = f" ({len(cfgs)} equation blocks)" if len(cfgs) != len(check) else ""
+            click.echo(f"    {len(cfgs)} FRF configuration(s){blocks}", err=True)
+            res, before, after = run(problem, cfgs, solver, check=check, max_iter=max_iter, tol_freq_pct=tol_pct,
+                                     progress=lambda h: click.echo(rep.progress_line(h), err=True))
+            what, fitted = outcome(problem, res, before, after), None
+        else:
+            fitted = fit(problem, data, method=method, noise=noise, mesh_check=mesh_check, solver=solver,
+                         max_iter=max_iter, tol_freq_pct=tol_pct,
+                         progress=lambda msg: click.echo(f"    {msg}", err=True))
+            res, before, after = fitted.result, fitted.before, fitted.after
+            what = {"status": fitted.status, "details": fitted.details, "warnings": fitted.warnings}
         done(t0)
-        what = outcome(problem, res, before, after)
         rows = rep.parameter_rows(problem, res.p)
         source = f"pcbdyn update ({what['status']})"
+        written = what["status"] == "converged" or force
         if out is None:
-            dst = problem.write_updated(res.p, result_path(None, board_toml, "updated", force), source=source)
+            dst = problem.write_updated(res.p, result_path(None, board_toml, "updated", force),
+                                        source=source) if written else None
         else:
             from ..report.manifest import replacing
 
             with replacing(out, "pcbdyn update") as staged:  # the earlier --out stays whole until all is written
                 dst = staged.final(problem.write_updated(res.p, result_path(staged.path, board_toml, "updated"),
-                                                         source=source))
+                                                         source=source)) if written else None
                 rep.plot_iterations(staged.path / "iterations.png", problem, res)
                 write_text(staged.path / "parameters.txt", rep.format_parameters(rows) + "\n")
                 write_text(staged.path / "correlation.txt", rep.format_correlation(before, after) + "\n")
@@ -127,8 +151,7 @@ def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping,
                     page = staged.final(rep.html_page(staged.path, board_toml, board, rows, before, after, what,
                                                       (built, modes), staged.path / "iterations.png"))
                     click.echo(f"page written to {page}", err=True)
-    click.echo(f"\n{board.name}: {what['status']} after {res.iterations} iteration(s) ({res.reason}; best iterate "
-               f"{res.best_iteration})")
+    click.echo(f"\n{board.name}: {what['status']} after {res.iterations} iteration(s) ({res.reason})")
     for line in what["details"]:
         click.echo(f"  note: {line}")
     for line in what["warnings"]:
@@ -136,6 +159,10 @@ def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping,
     click.echo(rep.format_parameters(rows))
     click.echo("")
     click.echo(rep.format_correlation(before, after))
-    click.echo(f"\nupdated board written to {dst}", err=True)
+    if dst is None:
+        click.echo(f"\nno updated board written: the fit did not converge ({what['status']}); --force writes it anyway",
+                   err=True)
+    else:
+        click.echo(f"\nupdated board written to {dst}", err=True)
     if json_path is not None:
-        write_json(json_path, rep.update_json(problem, res, rows, before, after, what, method, solver, dst))
+        write_json(json_path, rep.update_json(problem, res, rows, before, after, what, method, solver, dst, fitted))

@@ -42,8 +42,10 @@ def command(board_toml, psd_text, sine_csv, sweep_rate, sweeps, damping_text, du
             exclude, out, json_path, html):
     """Judge a board under a random (and sine) vibration specification: RMS responses at every part,
     Steinberg's allowable displacement, fatigue life (three-band, Miner) and the octave rule."""
-    from ..board import BoardError, load_board
+    from ..board import load_board
+    from ..domain import StructureError
     from ..fe import ModelError
+    from ..problems import load_structure
     from ..report import vibration_report as report
     from ..testdata import TestDataError
     from ..units import UnitError, to_si
@@ -51,12 +53,17 @@ def command(board_toml, psd_text, sine_csv, sweep_rate, sweeps, damping_text, du
                              read_sine_csv)
 
     try:
-        board = load_board(board_toml)
+        board = load_structure(board_toml)
         psd = load_psd(psd_text)
         sine = read_sine_csv(sine_csv, sweep_rate, sweeps) if sine_csv is not None else None
         damping = parse_damping(damping_text)
         seconds = to_si(duration, "s", "--duration") if duration is not None else psd.duration
         chassis = to_si(chassis_freq, "Hz", "--chassis-freq") if chassis_freq is not None else None
+        if getattr(board, "cards", None):
+            return _system(board, board_toml, psd, sine, damping, seconds, axis, chassis, config, exclude, out,
+                           json_path, html)
+        if not hasattr(board, "components"):  # a box without cards: the board reader says what vibe takes
+            board = load_board(board_toml)
         parts = judged_parts(board, exclude)
         bm, modes, K, M = solve_structure(board, config, n_modes=MAX_MODES, f_max=analysis_band(psd, sine),
                                           min_modes=MIN_MODES)
@@ -64,7 +71,7 @@ def command(board_toml, psd_text, sine_csv, sweep_rate, sweeps, damping_text, du
         a = assess(board, bm, modes, K, M, psd, damping, axis=axis, duration=seconds, sine=sine, chassis_hz=chassis,
                    parts=parts, probe_tol=PROBE_TOL)
         done(t0)
-    except (BoardError, ModelError, TestDataError, UnitError, VibrationError) as exc:
+    except (StructureError, ModelError, TestDataError, UnitError, VibrationError) as exc:
         fail(str(exc))
     inputs = {"configuration": config or "base", "PSD": f"{psd_text} ({psd.source})",
               "sine sweep": str(sine_csv) if sine_csv else None, "damping": damping.describe(),
@@ -98,3 +105,41 @@ def report_verdict(name: str, report, result, board_toml, board, model, input_na
 
         write_json(json_path, {"board": board.name, "configuration": inputs["configuration"], **result.to_dict(),
                                "files": written})
+
+
+def _system(box, box_toml, psd, sine, damping, seconds, axis, chassis, config, exclude, out, json_path, html):
+    """vibe on a box with its cards: shaken at the housing's supports, every card's parts judged
+    (:func:`pcbdyn.vibration.system.assess_system`); per card, the tables and pictures in ``out/<card>/``."""
+    from ..report import vibration_report as report
+    from ..report.files import write_json
+    from ..vibration import analysis_band
+    from ..vibration.system import assess_system, card_parts
+
+    system, modes, K, M = solve_structure(box, config, n_modes=MAX_MODES, f_max=analysis_band(psd, sine),
+                                          min_modes=MIN_MODES)
+    t0 = step(f"random response of {len(system.cards)} card(s) to {psd.name} along {axis}")
+    a = assess_system(system, modes, K, M, psd, damping, axis=axis, duration=seconds, sine=sine, chassis_hz=chassis,
+                      parts=card_parts(system, exclude), probe_tol=PROBE_TOL)
+    done(t0)
+    source = "stated" if a.stated else "computed: the first mode mostly the housing's"
+    click.echo(f"\n{box.name} [{config or 'base'}] under {psd.name}, shaken at the housing's supports along {axis}; "
+               f"chassis resonance {'none found' if a.chassis_hz is None else f'{a.chassis_hz:.1f} Hz'} ({source})")
+    for name, ca in a.cards.items():
+        click.echo(f"\ncard {name} ({system.cards[name].card.board.path.name}):")
+        click.echo("\n".join(report.summary_lines(ca)))
+        click.echo("\n" + report.format_table(report.parts_table(ca)))
+    if html:
+        click.echo("note: --html is written for a board; a system's results are the tables and pictures per card",
+                   err=True)
+    written = []
+    if out is not None:
+        from ..report.manifest import replacing
+
+        with replacing(out, "pcbdyn vibe") as run:  # the earlier --out stays whole until all is written
+            for name, ca in a.cards.items():
+                pc = system.cards[name]
+                written += [f"{name}/{w}" for w in report.write_outputs(run.path / name, pc.card.board,
+                                                                          pc.local.model, ca)]
+        click.echo(f"results written to {out}/ ({len(written)} files)", err=True)
+    if json_path is not None:
+        write_json(json_path, {"box": box.name, "configuration": config or "base", **a.to_dict(), "files": written})

@@ -7,8 +7,9 @@ springs only if they explain the test significantly better than clamped guides. 
 FILE.csv`` (configuration, mode, frequency_hz) test mode n pairs with model mode n.
 
 Writes the tables (extremes, stiffness, before/after), the iteration history and the frequencies
-against the stiffness (``--out``), ``<board>.updated.toml`` with the fitted stiffness (springs only: into
-``--out``, else beside the board, never over an earlier one unless ``--force``), and ``--json``."""
+against the stiffness (``--out``), ``<board>.updated.toml`` with the fitted stiffness (springs whose fit
+converged only, unless ``--force``: into ``--out``, else beside the board, never over an earlier one
+unless ``--force``), and ``--json``."""
 
 from __future__ import annotations
 
@@ -28,14 +29,16 @@ from .common import (PROBE_TOL, done, fail, folder_outputs, input_errors, librar
                    "test noise and the model's mesh error explain)")
 @click.option("--noise", default=None,
               help="the test's noise in percent, e.g. f=0.2,shape=2 (uniform bounds; the frequency noise sets the "
-                   "tolerance and the weights; default f=0.2)")
+                   "tolerance and the weights, the shape noise weighs the shapes when they join the fit; default "
+                   "f=0.2,shape=2)")
 @click.option("--min-mac", type=click.FloatRange(0.0, 1.0), default=0.5, show_default=True,
               help="pairs with a lower MAC are dropped")
 @click.option("--mesh-size", default=None, help="override board.mesh_size, e.g. '10 mm'")
 @click.option("--max-iter", type=click.IntRange(min=1), default=20, show_default=True)
 @folder_outputs("folder for board.updated.toml (springs only), the tables and pictures (default: board.updated.toml "
                 "beside the board)", "write the extremes, the decision, the stiffness, before/after and the history as "
-                "JSON", force="replace an earlier board.updated.toml beside the board (default: a numbered name)")
+                "JSON", force="replace an earlier board.updated.toml beside the board (default: a numbered name), "
+                              "and write it even when the spring fit did not converge")
 @library_option()
 @units_option
 def command(board_toml, test_uff, configs, freq_csv, per_guide, tol_pct, noise, min_mac, mesh_size, max_iter, out,
@@ -52,7 +55,7 @@ def command(board_toml, test_uff, configs, freq_csv, per_guide, tol_pct, noise, 
 
     if (test_uff is None) == (freq_csv is None):
         fail("give either TEST_UFF (and NAME=FILE for other configurations) or --frequencies FILE.csv")
-    freq_noise, _ = parse_noise(noise)
+    freq_noise, shape_noise = parse_noise(noise)
     with input_errors():
         board = load_structure(board_toml)
         ms = to_si(mesh_size, "mm", "--mesh-size") if mesh_size else None
@@ -65,7 +68,7 @@ def command(board_toml, test_uff, configs, freq_csv, per_guide, tol_pct, noise, 
                 board.check_points(t.measured_points(), path)
         t0 = step("fitting the wedge-lock guides")
         result = fit_wedge_locks(board, tests, per_guide=per_guide, tol_pct=tol_pct, noise_pct=freq_noise,
-                                 mesh_size=ms, min_mac=min_mac, probe_tol=PROBE_TOL, max_iter=max_iter,
+                                 shape_noise_pct=shape_noise, mesh_size=ms, min_mac=min_mac, probe_tol=PROBE_TOL, max_iter=max_iter,
                                  progress=lambda msg: click.echo(f"    {msg}", err=True))
         done(t0)
     d = result.to_dict()
@@ -79,7 +82,11 @@ def command(board_toml, test_uff, configs, freq_csv, per_guide, tol_pct, noise, 
         click.echo("\n" + text)
     for line in d["warnings"]:
         click.echo(f"warning: {line}", err=True)
-    springs = d["decision"] == "springs"
+    status = next((f["status"] for f in d.get("fits", {}).values() if f["chosen"]), None)
+    springs = d["decision"] == "springs" and (status == "converged" or force)
+    if d["decision"] == "springs" and not springs:
+        click.echo(f"\nno updated board written: the spring fit did not converge ({status}); --force writes it anyway",
+                   err=True)
     if out is None:
         d["updated_board"] = _updated(result, result_path(None, board_toml, "updated", force)) if springs else None
     else:

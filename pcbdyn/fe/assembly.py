@@ -17,6 +17,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .elements import kernel
+from .frames import to_global
 from .mesh import NDOF
 
 #: element matrices are computed and summed this many cells at a time: it bounds the peak memory,
@@ -29,7 +30,16 @@ _NN = NDOF * NDOF
 def element_matrices(model, name: str, prop=None):
     """Element K and M of set ``name`` (optionally with another property), shape (n_cells, nd, nd)."""
     es = model.sets[name]
-    return kernel(es.etype)(model.nodes[es.conn], es.prop if prop is None else prop)
+    return _kernel(model, es, es.conn, es.prop if prop is None else prop)
+
+
+def _kernel(model, es, conn, prop):
+    """(Ke, Me) of cells ``conn`` of set ``es`` in global DOFs (a set in its own frame is computed in
+    its axes and turned, :mod:`.frames`)."""
+    if es.frame is None:
+        return kernel(es.etype)(model.nodes[conn], prop)
+    Ke, Me = kernel(es.etype)(model.nodes[conn] @ es.frame, prop)
+    return to_global(Ke, es.frame), to_global(Me, es.frame)
 
 
 def _chunk_matrices(model, name: str, prop=None):
@@ -41,7 +51,7 @@ def _chunk_matrices(model, name: str, prop=None):
     for a in range(0, conn.shape[0], CHUNK_CELLS):
         b = min(a + CHUNK_CELLS, conn.shape[0])
         part = prop.cells(a, b) if hasattr(prop, "cells") else prop  # per-cell data (EmbeddedBeamProperty)
-        yield (a, b, *kernel(es.etype)(model.nodes[conn[a:b]], part))
+        yield (a, b, *_kernel(model, es, conn[a:b], part))
 
 
 def _node_pairs(conn: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -341,9 +341,9 @@ def _solve_pencil(Kr, Mr, n_modes, f_max, free, keep_factor, axes):
     return np.concatenate(lams), np.hstack(vecs), np.concatenate(rigids), shifted
 
 
-def _describe_rigid(red, vec):
-    """The full DOFs that move most in the given reduced modes, as 'node 3 uy' text."""
-    full = np.abs(red.expand(vec)).max(axis=1)
+def _describe_rigid(full_vectors):
+    """The full DOFs that move most in the given (full-length) modes, as 'node 3 uy' text."""
+    full = np.abs(full_vectors).max(axis=1)
     top = np.argsort(full)[::-1][:6]
     top = top[full[top] > 1e-3 * full[top[0]]]
     return ", ".join(f"node {d // NDOF} {DOF_NAMES[d % NDOF]}" for d in top)
@@ -386,10 +386,18 @@ def solve_modes(model, n_modes: int | None = None, f_max: float | None = None, K
         raise ModelError("the mass matrix has negative diagonal terms: check densities and masses")
     axes = np.where(red.independent % NDOF < 3, red.independent % NDOF, -1)
     lam, vec, rigid, shifted = solve_pencil(Kr, Mr, n_modes, f_max, model.free, keep_factor, axes)
-    if rigid.any() and not model.free:
+    return select_modes(lam, vec, rigid, red, red.expand, n_modes, f_max, model.free, shifted)
+
+
+def select_modes(lam, vec, rigid, red, expand, n_modes=None, f_max=None, free: bool = False, shifted=None) -> Modes:
+    """The :class:`Modes` of eigenpairs (lambda, vectors, rigid mask) of a model's pencil, whose vectors
+    ``expand`` makes full-length (``red``: the model's constraint reduction): elastic ones sorted, the
+    first ``n_modes`` and/or those up to ``f_max``; a zero-frequency mode of a model not ``free`` and a
+    negative eigenvalue are errors."""
+    if rigid.any() and not free:
         raise ModelError(
             f"the model has {int(rigid.sum())} zero-frequency (rigid-body or mechanism) mode(s) but "
-            f"is not declared free; the DOFs moving most: {_describe_rigid(red, vec[:, rigid])}. "
+            f"is not declared free; the DOFs moving most: {_describe_rigid(expand(vec[:, rigid]))}. "
             "Add supports (fixed DOFs, springs) there, or set model.free = True"
         )
     lam_e, vec_e = lam[~rigid], vec[:, ~rigid]
@@ -403,4 +411,4 @@ def solve_modes(model, n_modes: int | None = None, f_max: float | None = None, K
     keep = order[f <= f_max] if f_max is not None else order
     if n_modes is not None:
         keep = keep[:n_modes]
-    return Modes(np.sqrt(lam_e[keep]) / (2.0 * np.pi), red.expand(vec_e[:, keep]), red.expand(vec[:, rigid]), red, shifted)
+    return Modes(np.sqrt(lam_e[keep]) / (2.0 * np.pi), expand(vec_e[:, keep]), expand(vec[:, rigid]), red, shifted)

@@ -24,13 +24,17 @@ class ElementSet:
     ``etype`` is one of quad4, tri3, beam2, spring (1 node: to ground, 2 nodes: node to node),
     edge_spring, edge_joint (springs between two coincident edges: a1, a2, b1, b2), mass,
     embedded_beam2 (a beam between points of two host shell cells: their 4 + 4 nodes). ``conn`` holds
-    node indices, shape (n_cells, nodes_per_cell).
+    node indices, shape (n_cells, nodes_per_cell). ``frame``: None (the property's directions are global
+    axes), or a rotation R (3, 3) whose columns are the set's own axes in global ones: its element
+    matrices are formed on the nodes in those axes, with the property's directions in them, and turned
+    to global DOFs (:func:`.frames.to_global`): a part described in its own frame (a card in a housing).
     """
 
     name: str
     etype: str
     conn: np.ndarray
     prop: object
+    frame: np.ndarray | None = None
 
     def __post_init__(self):
         self.conn = np.atleast_2d(np.asarray(self.conn, dtype=np.int64))
@@ -85,11 +89,12 @@ class Model:
     def n_dof(self) -> int:
         return NDOF * self.n_nodes
 
-    def add(self, name: str, etype: str, conn, prop) -> ElementSet:
-        """Add an element set; names are unique (a parameter addresses a set by name)."""
+    def add(self, name: str, etype: str, conn, prop, frame=None) -> ElementSet:
+        """Add an element set (``frame``: see :class:`ElementSet`); names are unique (a parameter
+        addresses a set by name)."""
         if name in self.sets:
             raise ModelError(f"element set '{name}' already exists")
-        es = ElementSet(name, etype, conn, prop)
+        es = ElementSet(name, etype, conn, prop, frame)
         if es.conn.size and (es.conn.min() < 0 or es.conn.max() >= self.n_nodes):
             raise ModelError(f"element set '{name}' refers to a node outside 0..{self.n_nodes - 1}")
         self.sets[name] = es
@@ -139,5 +144,5 @@ class Model:
         """A shallow copy whose set ``name`` has its property fields changed (for re-analysis)."""
         new = replace(self, sets=dict(self.sets))
         es = self.sets[name]
-        new.sets[name] = ElementSet(es.name, es.etype, es.conn, replace(es.prop, **changes))
+        new.sets[name] = replace(es, prop=replace(es.prop, **changes))
         return new

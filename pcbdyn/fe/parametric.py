@@ -26,13 +26,14 @@ from .model import Model, ModelError
 
 @dataclass
 class SetMaker:
-    """How to make one element set: its type, connectivity, the quantities it depends on and
-    ``make(q) -> property``."""
+    """How to make one element set: its type, connectivity, the quantities it depends on,
+    ``make(q) -> property`` and its ``frame`` (:class:`.model.ElementSet`)."""
 
     etype: str
     conn: np.ndarray
     deps: tuple
     make: object
+    frame: object = None
 
 
 @dataclass
@@ -81,7 +82,7 @@ class ParametricModel:
     def assemble_from(cls, model: Model, quantities: dict, makers: dict, **fields) -> "ParametricModel":
         """``model`` (nodes and constraints) with every maker's set added at ``quantities``."""
         for name, mk in makers.items():
-            model.add(name, mk.etype, mk.conn, mk.make(quantities))
+            model.add(name, mk.etype, mk.conn, mk.make(quantities), mk.frame)
         return cls(model, quantities, makers, **fields)
 
     def bind(self, specs) -> None:
@@ -113,7 +114,7 @@ class ParametricModel:
                       list(self.model.mpcs), self.model.free)
         for name, prop in self.properties(values).items():
             es = model.sets[name]
-            model.sets[name] = type(es)(es.name, es.etype, es.conn, prop)
+            model.sets[name] = replace(es, prop=prop)
         return replace(self, model=model, quantities={**self.quantities, **values})
 
     def with_parameters(self, values: dict):

@@ -1,6 +1,7 @@
 """The bridge from structures (boards, boxes) and their measured data to the plain-matrix updating driver:
-update, localisation, studies, library calibration and wedge-lock fitting build their equations here,
-and diagnosis takes its models from here."""
+update, localisation, studies, library calibration and wedge-lock fitting build their equations here
+(update, calibrate and wedgelock fit through :func:`pcbdyn.problems.fit.fit`), and diagnosis takes its
+models from here."""
 
 from .load import load_structure
 from .models import StructureModels

@@ -32,8 +32,9 @@ from ..updating.solvers import covariance
 from ..updating.success import add_noise
 from ..updating.weighting import NOISE_REDRAWS
 from .error_budget import measured_mesh_steps, noise_sigma
+from .fit import fit
 from .problem import UpdateProblem
-from .run import correlation_state, run
+from .run import correlation_state
 
 #: a family parameter is bounded to [value / FAMILY_RANGE, value * FAMILY_RANGE]
 FAMILY_RANGE = 3.0
@@ -62,11 +63,11 @@ class BoardTests:
 class Calibration:
     """A calibration's problem, fit and result: ``families`` (the family parameter names, first in
     ``problem.names``), ``start`` {family: (value [m], library file it came from)}, ``result``
-    (:class:`~pcbdyn.updating.iteration.UpdateResult`), ``before``/``after`` correlation states,
+    (:class:`~pcbdyn.updating.driver.UpdateResult`), ``before``/``after`` correlation states,
     ``std`` [SI] of every parameter and ``std_mesh``, the part of it the mesh makes (a systematic error,
     common to every run on meshes alike), ``at_bound`` and ``undetermined`` parameter names, ``mesh_steps``
     (per test configuration, the relative change h -> h/2 of each measured mode's model frequency),
-    and ``noise`` (how the standard deviations were found)."""
+    ``noise`` (how the standard deviations were found) and ``fit`` (:class:`~.fit.Fit`: status, verdict)."""
 
     problem: UpdateProblem
     families: list
@@ -83,6 +84,7 @@ class Calibration:
     undetermined: list = field(default_factory=list)
     mesh_steps: list = field(default_factory=list)
     noise: str = ""
+    fit: object = None
 
     def value(self, name) -> float:
         return float(self.result.p[self.problem.names.index(name)])
@@ -241,12 +243,13 @@ def check_pairing(cal: Calibration, check) -> None:
 
 
 def calibrate(cal: Calibration, method: str = "freq", solver: str = "bounded", noise=(None, None),
-              mesh_error: bool = True, seed: int = 0, **run_options) -> Calibration:
-    """Fit ``cal`` with ``method`` and ``solver`` (``run_options`` go to :func:`.run.run`) and give
-    every parameter its standard deviation (module docstring; ``noise`` = (frequency %, shape %),
-    uniform bounds, None where not stated). With ``mesh_error`` what the model's mesh does to each
-    paired mode (:mod:`.error_budget`) joins the covariance as a systematic error. Returns ``cal``
-    filled in."""
+              mesh_error: bool = True, seed: int = 0, **fit_options) -> Calibration:
+    """Fit ``cal`` with ``method`` and ``solver`` through :func:`.fit.fit` (``fit_options``: max_iter,
+    tol_freq_pct, tol_param_pct, progress; the shapes stay out of a frequency calibration and the data
+    keep the mesh's error, which the calibrated value absorbs, module docstring) and give every parameter
+    its standard deviation (``noise`` = (frequency %, shape %), uniform bounds, None where not stated).
+    With ``mesh_error`` what the model's mesh does to each paired mode (:mod:`.error_budget`) joins the
+    covariance as a systematic error. Returns ``cal`` filled in, its :class:`~.fit.Fit` as ``cal.fit``."""
     if method not in METHODS:
         raise CalibrationError(f"--method {method}: a calibration uses one of {', '.join(METHODS)}")
     cal.method, cal.solver = method, solver
@@ -256,11 +259,13 @@ def calibrate(cal: Calibration, method: str = "freq", solver: str = "bounded", n
                 it.structure.check_points(m.measured_points(), path)
             elif method != "freq":
                 raise CalibrationError(f"{path.name}: --method {method} needs mode shapes (a UFF test with dataset 55)")
-    check, fit = configurations(cal.problem, cal.items, method)
+    check, fitted = configurations(cal.problem, cal.items, method)
     check_pairing(cal, check)
-    cal.result, cal.before, cal.after = run(cal.problem, fit, solver, check=check, **run_options)
+    tests = [(k, c, m) for k, it in enumerate(cal.items) for c, m in it.tests]
+    cal.fit = fit(cal.problem, tests, method=method, noise=noise, shapes="never", solver=solver, **fit_options)
+    cal.result, cal.before, cal.after = cal.fit.result, cal.fit.before, cal.fit.after
     p = cal.result.p
-    cov, cal.noise, undetermined = posterior_covariance(cal, fit, p, noise, seed)
+    cov, cal.noise, undetermined = posterior_covariance(cal, fitted, p, noise, seed)
     g = np.zeros(p.size)
     if mesh_error:
         cal.mesh_steps = measured_mesh_steps(cal.problem, cal.items, cal.after, p)

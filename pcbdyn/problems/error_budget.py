@@ -38,11 +38,12 @@ def noise_sigma(bound_pct) -> float | np.ndarray:
 
 
 def richardson(f_coarse, f_fine) -> tuple:
-    """(converged frequency f0, the coarse mesh's error |f(h) - f0|, what is left uncertain once
-    corrected: a third of the step) from the frequencies on a mesh h and one twice as fine."""
+    """(converged frequency f0, the coarse mesh's error f(h) - f0 (positive where it is too stiff), what
+    is left uncertain once corrected: a third of the step) from the frequencies on a mesh h and one twice
+    as fine."""
     f_coarse, f_fine = np.asarray(f_coarse, float), np.asarray(f_fine, float)
     step = f_fine - f_coarse
-    return f_fine + step / 3.0, 4.0 / 3.0 * np.abs(step), np.abs(step) / 3.0
+    return f_fine + step / 3.0, -4.0 / 3.0 * step, np.abs(step) / 3.0
 
 
 def mesh_step(problem, config, structure: int, p, n_modes: int) -> np.ndarray:
@@ -59,7 +60,7 @@ def mesh_step(problem, config, structure: int, p, n_modes: int) -> np.ndarray:
     mf = solve_modes(fine.model, n_modes=n_modes + 4)
     U = np.asarray(model_probe(fine.model, coarse.model.nodes, (0.0, 0.0, 1.0), tol=0.02).P @ mf.shapes)
     k = mac(mc.shapes[2::6], U).argmax(axis=1)
-    return richardson(mc.frequencies, mf.frequencies[k])[1] / mc.frequencies
+    return np.abs(richardson(mc.frequencies, mf.frequencies[k])[1]) / mc.frequencies
 
 
 def measured_mesh_steps(problem, items, states, p) -> list:
@@ -77,3 +78,41 @@ def measured_mesh_steps(problem, items, states, p) -> list:
                 u[q["test_mode"] - 1] = step[q["model_mode"] - 1]
             out.append(u)
     return out
+
+
+def model_errors(problem, tests, p, states) -> tuple:
+    """What the mesh does to each measured mode at parameter values ``p``, per test configuration of
+    ``tests`` [(structure index, configuration, Modes)] whose correlation states ``states`` pair them:
+    (frequency errors [%], signed: :func:`richardson`'s error at h relative to f(h/2); shape errors: None without shapes, else (relative size: the rms of the change of
+    the model's shape at the test points from h/2 to h, relative to its rms, times 4/3, per measured mode;
+    the change itself, times 4/3, and the model's shape at h, both (n_meas, n_modes))). Zero for an
+    unpaired mode. The two meshes' modes pair by MAC at the test points (on the model's nodes, out of
+    plane, without shapes)."""
+    freq, shape = [], []
+    for (k, config, m), state in zip(tests, states):
+        s = problem.structures[k]
+        coarse = problem.system(config, k).at(p)
+        fine = s.build(config, (problem.mesh_size or s.mesh_size) / 2.0)
+        fine = fine.with_parameters(parameter_values(fine, problem.names, p))
+        n = max([q["model_mode"] for q in state["pairs"]], default=0)
+        e_f, e_s = np.zeros(m.frequencies.size), np.zeros(m.frequencies.size)
+        change = None if m.shapes is None else np.zeros(m.shapes.shape)
+        model = None if m.shapes is None else np.zeros(m.shapes.shape)
+        if n:
+            mc = solve_modes(coarse.model, n_modes=n)
+            mf = solve_modes(fine.model, n_modes=n + 4)
+            at = (m.xyz, m.directions) if m.shapes is not None else (coarse.model.nodes, (0.0, 0.0, 1.0))
+            Uc = np.asarray(model_probe(coarse.model, *at, tol=0.02).P @ mc.shapes)
+            Uf = np.asarray(model_probe(fine.model, *at, tol=0.02).P @ mf.shapes)
+            partner = mac(Uc, Uf).argmax(axis=1)
+            for q in state["pairs"]:
+                j, i = q["model_mode"] - 1, q["test_mode"] - 1
+                uc, uf = Uc[:, j], Uf[:, partner[j]]
+                e_f[i] = 100.0 * richardson(mc.frequencies[j], mf.frequencies[partner[j]])[1] / mf.frequencies[partner[j]]
+                diff = 4.0 / 3.0 * (uc - (uf @ uc) / (uf @ uf) * uf)
+                e_s[i] = np.linalg.norm(diff) / np.linalg.norm(uc)
+                if change is not None:
+                    change[:, i], model[:, i] = diff, uc
+        freq.append(e_f)
+        shape.append(None if change is None else (e_s, change, model))
+    return freq, shape

@@ -93,8 +93,9 @@ def correlate_extreme(board, kind: str, tests, mesh_size=None, min_mac: float = 
 def mesh_errors(coarse: Extreme, fine: Extreme) -> list:
     """Per configuration {test mode: the model's discretisation error [%]} of the modes paired on both
     meshes, ``fine`` on a mesh twice as fine as ``coarse``: the coarse mesh's error
-    (:func:`.error_budget.richardson`) relative to its frequency."""
+    (:func:`.error_budget.richardson`) relative to the finer frequency; positive where the model's mesh is
+    too stiff."""
     out = []
     for fc, ff in zip(coarse.f_model(), fine.f_model()):
-        out.append({t: 100.0 * float(richardson(fc[t], ff[t])[1]) / fc[t] for t in fc if t in ff})
+        out.append({t: 100.0 * float(richardson(fc[t], ff[t])[1]) / ff[t] for t in fc if t in ff})
     return out

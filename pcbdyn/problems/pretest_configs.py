@@ -21,6 +21,7 @@ from ..inputs import entry_name, new_entry_name
 from ..updating import design
 from ..updating.equations import frequency_equations
 from ..updating.pbc import condition_number
+from .error_budget import noise_sigma
 from .pretest import PretestModel, configuration_model
 from .pretest_points import Candidates, is_box
 
@@ -73,7 +74,7 @@ def design_configurations(model: PretestModel, cand: Candidates, masses, k: int,
     if not model.names:
         raise StructureError(f"{model.structure.path.name}: no parameters to design configurations for; name "
                              "them with --parameters or declare [[parameters]]")
-    sigma = frequency_pct / 100.0 / np.sqrt(3.0)
+    sigma = noise_sigma(frequency_pct)
     _, _, dKs, dMs = model.matrices()
     base = frequency_block(model.lam, model.phi, model, dKs, dMs, sigma)
     where = places(cand, max_places)

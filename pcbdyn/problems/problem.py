@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..correlation.pairing import FREQ_LIMIT
 from ..updating.frf_lines import choose_frf_frequencies, model_receptance
 from ..updating.iteration import Configuration
 from .system import ConfigSystem, DynamicReduced, ProblemError, ShapePairing
@@ -89,17 +90,26 @@ class UpdateProblem:
         return self.systems[key]
 
     def configuration(self, config, measured, method: str = "freq", n_modes=None, min_mac: float = 0.5,
-                      structure: int = 0, **options) -> Configuration:
+                      structure: int = 0, limit: float = FREQ_LIMIT, **options) -> Configuration:
         """A driver Configuration of ``config`` with its measured modes (:class:`pcbdyn.testdata.Modes`).
 
-        Shapes give P and MAC pairing; frequencies only pair by the test's mode numbers. ``n_modes``
-        analytical modes are solved per iteration (default: rigid-body modes + the highest measured
-        mode number + 4). ``options`` go to Configuration (matching, sigma, ...)."""
+        Shapes give P and MAC pairing (pairs more than ``limit`` apart in frequency left out); frequencies
+        only pair by the test's mode numbers. ``n_modes`` analytical modes are solved per iteration
+        (default: rigid-body modes + the highest measured mode number + 4). ``options`` go to
+        Configuration (matching, sigma, ...).
+
+        On a system (a box with cards), frequency rows default to units of their own frequency (eq. 4.28
+        with the same percentage of noise on every mode, as library calibration weights them): most of a
+        system's modes do not depend on a given card's or plate's parameters, and rows of unit length
+        (eq. 4.42) would blow up the residuals of the modes a parameter cannot reach (a test of the
+        example with the back plate's E and a shelf's guides off drove both to their bounds)."""
+        if method == "freq" and "sigma" not in options and getattr(self.structures[structure], "cards", None):
+            options["sigma"] = measured.frequencies
         sysm = self.system(config, structure)
         P = None if measured.shapes is None else sysm.measurement_matrix(measured.xyz, measured.directions)
         n = n_modes or sysm.n_rigid + int(max(measured.numbers.max(), measured.frequencies.size)) + 4
         return Configuration(model=sysm.model, f_x=measured.frequencies, phi_x=measured.shapes, P=P, method=method,
-                             n_modes=n, name=sysm.label, pairing=sysm.pairing(measured, min_mac),
+                             n_modes=n, name=sysm.label, pairing=sysm.pairing(measured, min_mac, limit),
                              n_rigid=sysm.n_rigid, **options)
 
     def mode_configurations(self, config, measured, method: str = "qms", min_mac: float = 0.5, structure: int = 0,

@@ -8,7 +8,8 @@ import warnings
 
 import numpy as np
 
-from ..updating.iteration import build_equations, update
+from ..updating.driver import update
+from ..updating.iteration import paired_states
 from ..updating.solvers import RankDeficiencyWarning
 
 #: the frequency criterion (thesis eq. 7.2, max |df| in %) an update stops at unless told otherwise: the
@@ -19,9 +20,10 @@ TOL_FREQ_PCT = 0.1
 def correlation_state(configs, p) -> list:
     """Per configuration at ``p``: the pairs (as in ``pcbdyn correlate``: test_mode, model_mode
     (1-based, elastic modes), f_test_hz, f_model_hz, df_pct, mac), the max |df| in percent (None for
-    a configuration none of whose modes pairs) and the pairing's warnings (model modes the test grid
+    a configuration none of whose modes pairs; also when none of any configuration's pairs: a test of
+    another structure is reported, not refused) and the pairing's warnings (model modes the test grid
     cannot tell apart, pairs beyond the frequency limit: reported, not used)."""
-    _, _, states = build_equations(configs, p)
+    states = paired_states(configs, p)
     out = []
     for cfg, st in zip(configs, states):
         pairs = []
@@ -42,7 +44,7 @@ def run(problem, configs, solver: str = "ls", check=None, **kwargs):
     (UpdateResult, before, after), before/after from :func:`correlation_state` on ``check`` (default
     ``configs``; give the full-model configurations of :meth:`~.problem.UpdateProblem.configuration`
     when updating on :meth:`~.problem.UpdateProblem.mode_configurations`). ``kwargs`` go to
-    :func:`pcbdyn.updating.iteration.update` (``progress``, ``max_iter``, ``tol_freq_pct``: default
+    :func:`pcbdyn.updating.driver.update` (``progress``, ``max_iter``, ``tol_freq_pct``: default
     :data:`TOL_FREQ_PCT`, as the command line's, ...). The solvers' warnings
     are not printed: :func:`outcome` says what they meant with the parameters named."""
     check = configs if check is None else check
@@ -61,35 +63,47 @@ def _combination(v, names) -> str:
     return " and ".join(f"{names[i]} ({'+' if v[i] * v[big[0]] > 0 else '-'})" for i in big)
 
 
+def undetermined_directions(vectors, names) -> list:
+    """Each parameter direction of ``vectors`` in words: its main parameters with the sign each moves with
+    ("k_top (+) and k_bottom (-)": one up and the other down leaves the data as they are)."""
+    return [f"{_combination(np.asarray(v, float), names)}" + (" separately" if len(names) > 1 else "")
+            for v in vectors]
+
+
+def worse_configurations(before, after) -> list:
+    """[(configuration, max |df| before, after)] of the configurations whose error grew."""
+    return [(b["configuration"], b["max_freq_error_pct"], a["max_freq_error_pct"]) for b, a in zip(before, after)
+            if None not in (b["max_freq_error_pct"], a["max_freq_error_pct"])
+            and a["max_freq_error_pct"] > b["max_freq_error_pct"] * (1 + 1e-9)]
+
+
 def outcome(problem, res, before, after) -> dict:
-    """What an update did, in the user's terms: ``status`` ("converged", "stopped on bounds", "error grew",
-    "rank-deficient", "diverged" or "not converged": the first that applies of error grew, stopped on
-    bounds, rank-deficient, diverged, not converged, converged), and ``details``: parameters at their
-    bounds, configurations whose error grew (before -> after), parameter combinations the equations
+    """What an update did, in the user's terms: ``status`` ("error grew", "on a bound", "not determined",
+    "stalled", "not converged" or "converged": the first that applies), and ``details``: parameters at
+    their bounds, configurations whose error grew (before -> after), parameter combinations the equations
     did not determine at the last solve, configurations set aside because no mode paired; ``warnings``:
-    the pairing's before and after (:func:`pairing_warnings`)."""
+    the pairing's before and after (:func:`pairing_warnings`). The fits of :func:`.fit.fit` judge more
+    (the chi^2 verdict, the directions in units of the noise)."""
     lo, hi = problem.bounds
     bounds = {n: "lower" if np.isclose(v, a, rtol=1e-6) else "upper" for n, v, a, b in
               zip(problem.names, res.p, lo, hi) if np.isclose(v, a, rtol=1e-6) or np.isclose(v, b, rtol=1e-6)}
-    worse = [(b["configuration"], b["max_freq_error_pct"], a["max_freq_error_pct"]) for b, a in zip(before, after)
-             if None not in (b["max_freq_error_pct"], a["max_freq_error_pct"])
-             and a["max_freq_error_pct"] > b["max_freq_error_pct"] * (1 + 1e-9)]
+    worse = worse_configurations(before, after)
     sol = res.solution
-    undetermined = [] if sol is None or not sol.rank_deficient else [
-        _combination(v, problem.names) for v in sol.null_space.T[:3]]
+    undetermined = [] if sol is None or not sol.rank_deficient else undetermined_directions(
+        sol.null_space.T[:3], problem.names)
     set_aside = sorted({n for h in res.history for n in h.get("set_aside", [])})
     details = [f"{n} stopped at its {side} bound" for n, side in bounds.items()]
     details += [f"configuration {c}: max |df| grew from {b:.2f} % to {a:.2f} %" for c, b, a in worse]
-    details += [f"the data do not determine {c} separately (rank-deficient equations)" for c in undetermined]
+    details += [f"the data do not determine {c} (rank-deficient equations)" for c in undetermined]
     details += [f"configuration {c}: no mode paired at some iteration; set aside there" for c in set_aside]
     if worse:
         status = "error grew"
     elif bounds:
-        status = "stopped on bounds"
+        status = "on a bound"
     elif undetermined:
-        status = "rank-deficient"
-    elif res.diverged:
-        status = "diverged"
+        status = "not determined"
+    elif res.stalled:
+        status = "stalled"
     else:
         status = "converged" if res.converged else "not converged"
     return {"status": status, "details": details, "at_bounds": bounds, "worse": [c for c, _, _ in worse],

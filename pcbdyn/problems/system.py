@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ..correlation.pairing import pair_modes
+from ..correlation.pairing import FREQ_LIMIT, pair_modes
 from ..domain import StructureError
 from ..fe.constraints import build_reduction
 from ..fe.parametric_matrices import ParametricMatrices
@@ -89,22 +89,23 @@ class ConfigSystem:
         return j, (f"excitation at {where} mm is not on a node along an axis: the nearest-weight DOF is excited "
                    "instead (biased); put the excitation on a mesh node")
 
-    def pairing(self, measured, min_mac: float = 0.5):
+    def pairing(self, measured, min_mac: float = 0.5, limit: float = FREQ_LIMIT):
         """The driver's pairing callable for the measured modes ``measured`` (:class:`pcbdyn.testdata.Modes`):
-        by MAC (:func:`pcbdyn.correlation.pairing.pair_modes`) when shapes are measured, else by the
-        test's mode numbers; rigid-body modes never pair."""
-        return ShapePairing(min_mac, self.n_rigid, None if measured.shapes is not None else measured.numbers)
+        by MAC (:func:`pcbdyn.correlation.pairing.pair_modes`) when shapes are measured, pairs more than
+        ``limit`` apart in frequency left out, else by the test's mode numbers; rigid-body modes never pair."""
+        return ShapePairing(min_mac, self.n_rigid, None if measured.shapes is not None else measured.numbers, limit)
 
 
 class ShapePairing:
     """A pairing callable (f_a, phi_a, f_x, phi_x) -> analytical index per measured mode (-1: unpaired):
     by MAC, each model mode used once (:func:`pcbdyn.correlation.pairing.pair_modes`), past the first
-    ``n_rigid`` (rigid-body) analytical modes, a pair beyond the frequency limit left out; with ``numbers``
-    (1-based elastic mode numbers, for frequencies without shapes) by those numbers. ``last``: the
+    ``n_rigid`` (rigid-body) analytical modes, a pair beyond the frequency ``limit`` (relative; default
+    :data:`pcbdyn.correlation.pairing.FREQ_LIMIT`) left out; with ``numbers`` (1-based elastic mode numbers,
+    for frequencies without shapes) by those numbers. ``last``: the
     :class:`~pcbdyn.correlation.pairing.Pairing` of the last call, for its warnings."""
 
-    def __init__(self, min_mac: float, n_rigid: int = 0, numbers=None):
-        self.min_mac, self.n_rigid, self.numbers = min_mac, n_rigid, numbers
+    def __init__(self, min_mac: float, n_rigid: int = 0, numbers=None, limit: float = FREQ_LIMIT):
+        self.min_mac, self.n_rigid, self.numbers, self.limit = min_mac, n_rigid, numbers, limit
         self.last = None
 
     def __call__(self, f_a, phi_a, f_x, phi_x):
@@ -116,7 +117,7 @@ class ShapePairing:
             out[ok] = k[ok]
             return out
         self.last = pair_modes(np.asarray(phi_x), np.asarray(phi_a)[:, n_rigid:], f_x, np.asarray(f_a)[n_rigid:],
-                               min_mac=self.min_mac)
+                               min_mac=self.min_mac, limit=self.limit)
         for pr in self.last.pairs:
             if pr.used:
                 out[pr.test] = pr.model + n_rigid

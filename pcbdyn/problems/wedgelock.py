@@ -6,8 +6,9 @@ Step 1 correlates the board with every guide hinged and clamped (:mod:`.extremes
 when it matches every paired test mode within the tolerance: by default what the test noise (a uniform
 bound, eq. 5.72) and the model's mesh error (4/3 of the frequency change of a mesh twice as fine) explain,
 or a percentage the user gives. Otherwise step 2 (:mod:`.spring_fit`): the guides become rotational
-springs, one stiffness shared by all guides (or one per guide), started from the best of a scan between
-the extremes on a log scale, bounded and iterated with re-pairing. One stiffness per guide is fitted when
+springs, one stiffness shared by all guides (or one per guide), fitted by :func:`.fit.fit` (scanned
+between the extremes on a log scale, jointly for the guides, with the shapes in the objective where the
+frequencies cannot tell the guides apart), bounded and iterated with re-pairing. One stiffness per guide is fitted when
 asked, or when the shared one leaves more than the noise and one per guide explains significantly more.
 The springs are kept only when they explain the test significantly better than the clamped edges (F
 test, :func:`.spring_fit.significance`); otherwise what is left is not the guides' doing, and the thesis'
@@ -21,16 +22,17 @@ import numpy as np
 from scipy.stats import chi2 as chi2_dist
 
 from ..testdata import TestDataError
+from ..updating.driver import evaluate
+from ..updating.scan import grid
 from . import guides
 from .error_budget import noise_sigma
 from .extremes import Extreme, correlate_extreme, mesh_errors
+from .fit import DEFAULT_NOISE
 from .run import pairing_warnings
 from .spring_fit import ALPHA, SpringFit, SpringModel, chi2, significance
 
 #: frequency noise [%] (uniform bound, eq. 5.72) assumed when the test states none
-DEFAULT_NOISE_PCT = 0.2
-#: stiffnesses per decade of the scan between the extremes
-SCAN_PER_DECADE = 2
+DEFAULT_NOISE_PCT = DEFAULT_NOISE[0]
 
 
 @dataclass(kw_only=True)
@@ -109,14 +111,18 @@ class WedgeLockResult:
             "tolerance_pct": per_mode(self.tolerance_pct), "sigma_pct": per_mode(self.sigma_pct),
             "between_extremes": per_mode(self.positions()),
             "clamped_within_tolerance": self.clamped_ok, "decision": self.decision, "reason": self.reason,
-            "notes": self.notes, "warnings": self.warnings(), "k_rot": self.k_rot(), "per_guide": fit is not None and fit is self.per_guide,
+            "notes": self.notes, "warnings": self.warnings(), "k_rot": self.k_rot(),
+            "per_guide": fit is not None and fit is self.per_guide,
             "before": summary(before), "after": summary(after), "significance": self.tests,
+            "start": {} if fit is None else fit.by_fixture(fit.problem.p0),
             "history": [] if fit is None else [
                 {"iteration": h["iteration"], "k_rot": fit.by_fixture(h["p"]),
                  "max_freq_error_pct": h["max_freq_error_pct"], "residue_pct": 100.0 * h["sigma"]}
                 for h in fit.result.history],
             "fits": {name: {"k_rot": f.k_rot(), "chi2": f.chi2, "modes": f.n, "iterations": f.result.iterations,
                             "converged": bool(f.result.converged), "reason": f.result.reason, "notes": f.notes,
+                            "status": f.fit.status, "verdict": f.fit.verdict, "starts": f.fit.summary()["starts"],
+                            "shapes_in_objective": f.fit.shapes,
                             "chosen": f is fit, "max_freq_error_pct": f.max_freq_error_pct}
                      for name, f in (("shared", self.shared), ("per_guide", self.per_guide)) if f is not None},
         }
@@ -146,7 +152,7 @@ def _noise_and_tolerance(tests, mesh, noise, tol_pct) -> tuple:
     for (_, test), m in zip(tests, mesh):
         modes = range(1, test.n_modes + 1)
         sigma.append({t: float(np.hypot(100.0 * noise_sigma(noise), m.get(t, 0.0))) for t in modes})
-        tol.append({t: float(tol_pct if tol_pct is not None else noise + m.get(t, 0.0)) for t in modes})
+        tol.append({t: float(tol_pct if tol_pct is not None else noise + abs(m.get(t, 0.0))) for t in modes})
     return sigma, tol
 
 
@@ -160,11 +166,14 @@ def _too_few(n: int, need: int, what: str, clamped: Extreme) -> TestDataError:
 
 def fit_wedge_locks(board, tests, per_guide: bool | None = None, tol_pct: float | None = None,
                     noise_pct: float | None = None, mesh_size: float | None = None, min_mac: float = 0.5,
+                    shape_noise_pct: float | None = None,
                     probe_tol: float | None = None, max_iter: int = 20, progress=None) -> WedgeLockResult:
     """The two steps on ``board`` (with wedge_lock fixtures) against ``tests`` [(configuration or None,
     :class:`pcbdyn.testdata.Modes`)]. ``per_guide``: True fits one stiffness per guide, False one shared,
     None decides from the data. ``tol_pct``: the tolerance that accepts clamped (default noise + mesh
-    error); ``noise_pct``: the test's frequency noise (uniform bound, %; default :data:`DEFAULT_NOISE_PCT`).
+    error); ``noise_pct``: the test's frequency noise (uniform bound, %; default :data:`DEFAULT_NOISE_PCT`);
+    ``shape_noise_pct``: its shape noise (uniform bound, %; default :data:`.fit.DEFAULT_NOISE`'s), which
+    weighs the shapes when they join the objective.
     A TestDataError when no test mode pairs with either extreme or when too few pair to fit."""
     say = progress or (lambda msg: None)
     names = [f.name for f in guides.wedge_locks(board)]
@@ -202,39 +211,34 @@ def fit_wedge_locks(board, tests, per_guide: bool | None = None, tol_pct: float 
     if n_paired < 2 or (per_guide and n_paired < len(names) + 1):
         need = len(names) + 1 if per_guide else 2
         raise _too_few(n_paired, need, "one stiffness per guide" if per_guide else "a stiffness", clamped)
-    _step2(result, board, tests, per_guide, h, min_mac, max_iter, say)
+    _step2(result, board, tests, per_guide, (noise_pct, shape_noise_pct), h, min_mac, max_iter, say)
     return result
 
 
-def _step2(result: WedgeLockResult, board, tests, per_guide, h, min_mac, max_iter, say) -> None:
+def _step2(result: WedgeLockResult, board, tests, per_guide, noise, h, min_mac, max_iter, say) -> None:
     """Scan, shared fit, per-guide fit when asked or called for, and the springs-or-clamped test."""
     names, sigma = result.guides, result.sigma_pct
     bounds = guides.stiffness_range(board)
-    n_scan = int(round(np.log10(bounds[1] / bounds[0]) * SCAN_PER_DECADE)) + 1
-    ks = np.geomspace(bounds[0], bounds[1], n_scan)
-    model = SpringModel(board, tests, guides.spring_groups(board, False), bounds, sigma, h, min_mac)
-    say(f"step 2: scanning {n_scan} stiffnesses {bounds[0]:.3g}-{bounds[1]:.3g} N*m/rad/m")
-    states = model.scan(ks)
-    score = [(-model.chi2(s)[1], model.chi2(s)[0]) if s is not None else (1, np.inf) for s in states]
-    start = float(ks[min(range(len(ks)), key=lambda i: score[i])])
-    result.scan = {"k": ks.tolist(), "states": states}
-    say(f"fitting one stiffness for {len(names)} guide(s) from {start:.4g} N*m/rad/m")
-    result.shared = result.chosen = model.fit([start], max_iter)
+    ks = grid([(0, *bounds)])[0]
+    model = SpringModel(board, tests, guides.spring_groups(board, False), bounds, sigma, noise, result.mesh_pct, h,
+                        min_mac)
+    say(f"step 2: the frequencies at {ks.size} stiffnesses {bounds[0]:.3g}-{bounds[1]:.3g} N*m/rad/m")
+    result.scan = {"k": ks.tolist(), "states": model.scan(ks)}
+    say(f"fitting one stiffness for {len(names)} guide(s)")
+    result.shared = result.chosen = model.fit([float(np.sqrt(bounds[0] * bounds[1]))], max_iter, say)
     shared = result.shared
     if shared.n < 2:
         raise _too_few(shared.n, 2, "a stiffness", result.clamped)
-    misfit = float(chi2_dist.sf(shared.chi2, shared.n - 1)) < ALPHA
+    misfit = float(chi2_dist.sf(shared.chi2, shared.n - 1)) < ALPHA or shared.fit.verdict["fits"] is False
     if len(names) > 1 and (per_guide or (per_guide is None and misfit and shared.n >= len(names) + 1)):
         say(f"fitting one stiffness per guide from {shared.values['k_rot']:.4g} N*m/rad/m")
-        pg_model = SpringModel(board, tests, guides.spring_groups(board, True), bounds, sigma, h, min_mac)
-        result.per_guide = pg_model.fit(np.full(len(names), shared.values["k_rot"]), max_iter)
+        pg_model = SpringModel(board, tests, guides.spring_groups(board, True), bounds, sigma, noise,
+                               result.mesh_pct, h, min_mac)
+        result.per_guide = pg_model.fit(np.full(len(names), shared.values["k_rot"]), max_iter, say)
         pg = result.per_guide
         if pg.n < len(names) + 1:
             raise _too_few(pg.n, len(names) + 1, "one stiffness per guide", result.clamped)
-        common = _common(shared.after, pg.after)
-        result.tests["per_guide_vs_shared"] = significance(
-            model.chi2(shared.after, common)[0], model.chi2(pg.after, common)[0], sum(map(len, common)),
-            len(names) - 1, len(names))
+        result.tests["per_guide_vs_shared"] = _per_guide_vs_shared(model, shared, pg, len(names))
         if per_guide or result.tests["per_guide_vs_shared"]["significant"]:
             result.chosen = pg
     fit = result.chosen
@@ -257,6 +261,20 @@ def _step2(result: WedgeLockResult, board, tests, per_guide, h, min_mac, max_ite
                          f"{result.clamped.max_abs_freq_error_pct:.2f} %), but springs do not explain the test "
                          f"significantly better ({what}): the rest of the error is not the guides' (as the thesis "
                          "concludes for its card, section 7.4.2); look elsewhere in the model (pcbdyn diagnose)")
+
+
+def _per_guide_vs_shared(model, shared, pg, n_guides: int) -> dict:
+    """The F test of one stiffness per guide against one shared (:func:`.spring_fit.significance`): on the
+    per-guide fit's own objective when the shapes joined it (the shared stiffness on every guide is that
+    model too; the frequencies of a nearly symmetric card barely tell the two apart), else on the frequencies
+    of the modes paired in both."""
+    if pg.fit.shapes:
+        chi2_shared = evaluate(pg.fit.configs, np.full(n_guides, shared.values["k_rot"]))[1]
+        v = pg.fit.verdict
+        return significance(chi2_shared, v["chi2"], v["dof"] + n_guides, n_guides - 1, n_guides)
+    common = _common(shared.after, pg.after)
+    return significance(model.chi2(shared.after, common)[0], model.chi2(pg.after, common)[0],
+                        sum(map(len, common)), n_guides - 1, n_guides)
 
 
 def _common(a, b) -> list:

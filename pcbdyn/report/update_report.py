@@ -96,8 +96,11 @@ def _summary(states) -> dict:
             "pairs": [q for s in states for q in s["pairs"]]}
 
 
-def update_json(problem, res, rows, before, after, what: dict, method: str, solver: str, dst) -> dict:
-    """The JSON of ``pcbdyn update`` (values in SI; ``unit`` is the SI unit of each parameter)."""
+def update_json(problem, res, rows, before, after, what: dict, method: str, solver: str, dst, fitted=None) -> dict:
+    """The JSON of ``pcbdyn update`` (values in SI; ``unit`` is the SI unit of each parameter; the fit's
+    verdict, noise, starts and shapes from :meth:`pcbdyn.problems.fit.Fit.summary` for the modal methods;
+    ``updated_board`` None when none was written)."""
+    extra = {} if fitted is None else {k: v for k, v in fitted.summary().items() if k not in ("status", "details")}
     return {
         "parameters": {r["name"]: {"initial": float(v0), "updated": float(v), "unit": SI_UNITS.get(r["unit"], r["unit"]),
                                    "display_unit": r["unit"], "change_pct": r["change_pct"], "bound_hit": r["bound_hit"]}
@@ -108,7 +111,7 @@ def update_json(problem, res, rows, before, after, what: dict, method: str, solv
         "history": [{"iteration": h["iteration"], "p": np.asarray(h["p"]).tolist(),
                      "max_freq_error_pct": h["max_freq_error_pct"], "condition_stacked": _finite(h["condition_stacked"]),
                      "rank": h.get("rank"), "set_aside": h.get("set_aside", [])} for h in res.history],
-        "updated_board": str(dst),
+        "updated_board": None if dst is None else str(dst), **extra,
     }
 
 

@@ -52,8 +52,8 @@ def format_summary(d: dict) -> str:
     for name, f in d.get("fits", {}).items():
         ks = ", ".join(f"{g} {v['value']:.4g} (x/ {v['factor_1sigma']:.3g})" for g, v in f["k_rot"].items())
         state = "kept" if f["chosen"] and d["decision"] == "springs" else "not kept"
-        lines.append(f"step 2, {name.replace('_', ' ')} stiffness ({state}): {ks} {UNIT}; max |df| "
-                     f"{f['max_freq_error_pct']:.2f} %, chi^2 {f['chi2']:.3g} over {f['modes']} modes; {f['reason']}")
+        lines.append(f"step 2, {name.replace('_', ' ')} stiffness ({state}): {ks} {UNIT}; {f['status']}; max |df| "
+                     f"{f['max_freq_error_pct']:.2f} %, chi^2 {f['chi2']:.3g} over {f['modes']} modes")
         lines += [f"  {n}" for n in f["notes"]]
     lines += [f"note: {n}" for n in d["notes"]]
     return "\n".join(lines)
@@ -65,8 +65,8 @@ def format_before_after(d: dict, before, after) -> str:
     if not d["history"]:
         title = "clamped guides (no spring fit needed)"
     else:
-        first, last = d["history"][0]["k_rot"], d["history"][-1]["k_rot"]
-        moves = ", ".join(f"{g} {first[g]:.4g} -> {last[g]:.4g}" for g in d["guides"])
+        first, last = d["start"], next(f for f in d["fits"].values() if f["chosen"])["k_rot"]
+        moves = ", ".join(f"{g} {first[g]:.4g} -> {last[g]['value']:.4g}" for g in d["guides"])
         title = f"step 2, springs: {moves} {UNIT}"
     return title + "\n" + format_correlation(before, after)
 

@@ -17,7 +17,8 @@ from .equations import (
     qms_equations,
 )
 from .gauss_newton import GaussNewton, gauss_newton
-from .iteration import Configuration, UpdateResult, build_equations, mac_pairing, update
+from .driver import UpdateResult, update
+from .iteration import Configuration, build_equations, mac_pairing
 from .pbc import condition_number, condition_numbers, stack, svd_reduce
 from .sensitivity import (
     bilinear_forms,

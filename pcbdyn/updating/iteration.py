@@ -1,16 +1,15 @@
-"""Iterative sensitivity-based updating on plain callables (thesis section 4.9, 7.3.1, chapter 6).
+"""Updating configurations on plain callables and their equations (thesis section 4.9, 7.3.1, chapter 6).
 
-A configuration is a model callable ``p -> (K, M, dKs, dMs)`` plus its measured data. Every
-iteration re-solves each configuration, re-pairs its modes (by MAC when shapes are measured,
-through a ``pairing`` callable), builds its weighted equations, stacks all configurations
-(PBC, eq. 6.4), solves for relative changes x = dp/p and updates p <- p (1 + beta x)
-(eqs. 4.49-4.52). It stops on the criteria of eqs. 7.2-7.4, and on divergence, keeping the best
-iterate.
+A configuration is a model callable ``p -> (K, M, dKs, dMs)`` plus its measured data. At every
+parameter state each configuration is re-solved, its modes re-paired (by MAC when shapes are measured,
+through a ``pairing`` callable), its weighted equations built and all configurations stacked (PBC,
+eq. 6.4); :mod:`.driver` iterates them. :func:`objective_rows` is what a fit minimises: the frequency
+errors (and, for the "modal" method, the shape errors of :mod:`.shapes`) in units of their noise.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
@@ -18,12 +17,13 @@ import numpy as np
 from . import equations as eq
 from . import matching
 from .errors import UpdatingError
-from .pbc import condition_number, stack
+from .pbc import stack
 from .sensitivity import frequencies_hz, solve_modes
-from .solvers import SOLVERS, Solution, bayes_alpha, frequency_residue, line_search
+from .shapes import shape_derivatives, shape_residual, shape_rows, shape_sigma
+from .solvers import frequency_residue
 from .weighting import std_row_weights, unit_row_weights, weight_rows
 
-METHODS = ("freq", "freq-rel", "fbm", "qms", "frf-in", "frf-out", "frf-direct")
+METHODS = ("freq", "freq-rel", "modal", "fbm", "qms", "frf-in", "frf-out", "frf-direct")
 
 
 @dataclass
@@ -36,12 +36,15 @@ class Configuration:
     P: (n_meas, n_dof) maps model DOFs to measured DOFs (None: every DOF measured).
     frf_omegas, H_x, excitation: updating frequencies [rad/s], measured receptances
         (n_meas, n_freq) and the excited model DOF for the FRF methods.
-    method: one of METHODS. matching: "expand" (dynamic expansion of the data) or "reduce"
-        (Guyan reduction of the model) when P is not None. damping: treatment of unknown damping
+    method: one of METHODS ("modal": frequencies and MAC-paired shapes in units of their noise,
+        :mod:`.shapes`; needs ``sigma`` and ``shape_noise``). matching: "expand" (dynamic expansion of
+        the data) or "reduce" (Guyan reduction of the model) when P is not None. damping: treatment of unknown damping
         in the data (appendix A): any of equations.DAMPING_TREATMENTS for "frf-in",
         "undamped"/"proportional" for "frf-out".
-    sigma: standard deviations of the equations' rows (chi-squares weights, eq. 4.28);
-        None gives unit-length rows (eq. 4.42).
+    sigma: standard deviations of the equations' rows (chi-squares weights, eq. 4.28; for the
+        frequency methods one per measured frequency [Hz]); None gives unit-length rows (eq. 4.42).
+    shape_noise: "modal": the standard deviation of a measured shape component as a fraction of its
+        size (uniform bound / sqrt 3, eq. 5.73), one for all modes or one per measured mode.
     n_modes: analytical modes computed for pairing (default max(2 m, m + 4) for m measured
         modes; count the rigid-body modes of a free model in).
     pairing: callable (f_a, phi_a_measured, f_x, phi_x) -> analytical mode index per measured mode,
@@ -66,6 +69,7 @@ class Configuration:
     name: str = ""
     pairing: Callable | None = None
     n_rigid: int = 0
+    shape_noise: float | None = None
 
     @property
     def frf_hz(self) -> np.ndarray | None:
@@ -76,6 +80,8 @@ class Configuration:
             raise ValueError(f"method={self.method!r}; choose one of {METHODS}")
         if self.method.startswith("freq") and self.f_x is None:
             raise ValueError(f"configuration {self.name!r}: method {self.method!r} needs f_x (measured frequencies)")
+        if self.method == "modal" and (self.phi_x is None or self.sigma is None or self.shape_noise is None):
+            raise ValueError(f"configuration {self.name!r}: method 'modal' needs phi_x, sigma and shape_noise")
         if self.method in ("fbm", "qms") and (self.phi_x is None or self.f_x is None):
             raise ValueError(f"configuration {self.name!r}: method {self.method!r} needs f_x and phi_x")
         if self.method.startswith("frf") and (self.H_x is None or self.frf_omegas is None or self.excitation is None):
@@ -109,47 +115,103 @@ def mac_pairing(f_a, phi_a, f_x, phi_x) -> np.ndarray:
     return pairs
 
 
-@dataclass
-class UpdateResult:
-    """Outcome of :func:`update`: final (best) parameters and the full history."""
-
-    p: np.ndarray
-    converged: bool
-    diverged: bool
-    reason: str
-    iterations: int
-    best_iteration: int
-    history: list = field(default_factory=list)
-    solution: Solution | None = None
-
-
 def _state(cfg: Configuration, p, pairing):
     """Model matrices, paired modes and residue of one configuration at p."""
     K, M, dKs, dMs = cfg.model(p)
     out = {"K": K, "M": M, "dKs": dKs, "dMs": dMs}
     if cfg.f_x is not None:
-        f_x = np.asarray(cfg.f_x, float)
-        n_modes = cfg.n_modes or min(K.shape[0], max(2 * f_x.size, f_x.size + 4))
-        lam, Phi = solve_modes(K, M, n_modes)
-        f_a = frequencies_hz(lam)
-        phi_am = Phi if cfg.P is None else np.asarray(cfg.P @ Phi)
-        pairs = np.asarray((cfg.pairing or pairing or mac_pairing)(f_a, phi_am, f_x, cfg.phi_x), int)
-        used = np.flatnonzero(pairs >= 0)
-        if used.size == 0:  # set aside at this state: nothing of it pairs
-            out.update(set_aside=True, pairs=pairs, used=used)
-            return out
-        ia = pairs[used]
-        out.update(lam=lam[ia], Phi=Phi[:, ia], f_a=f_a[ia], pairs=pairs, used=used,
-                   sigma=frequency_residue(f_a[ia], f_x[used]),
-                   max_err_pct=float(np.max(np.abs(1 - f_a[ia] / f_x[used])) * 100))
-        if cfg.phi_x is not None:
-            out["mac"] = np.diag(mac_matrix(phi_am[:, ia], np.asarray(cfg.phi_x)[:, used]))
+        n_modes = cfg.n_modes or min(K.shape[0], max(2 * np.size(cfg.f_x), np.size(cfg.f_x) + 4))
+        out.update(paired_state(cfg, *solve_modes(K, M, n_modes), pairing))
     return out
+
+
+def paired_states(configs, p, pairing=None) -> list:
+    """Each configuration's state at ``p`` (:func:`paired_state` of its solved modes; "set_aside" where
+    nothing pairs), without its equations."""
+    return [_state(c, np.asarray(p, float), pairing) for c in configs]
+
+
+def paired_state(cfg: Configuration, lam, Phi, pairing=None) -> dict:
+    """The measured modes of ``cfg`` paired among the computed eigenpairs (lam, Phi): "pairs" (analytical
+    index per measured mode, -1 unpaired), "used" (the paired measured modes), their partners' "lam",
+    "Phi", "f_a", "phi_am" (read at the measured DOFs), "mac", the frequency residue "sigma" and
+    "max_err_pct"; all computed modes as "lam_all", "Phi_all" with the partners' "index"; "set_aside"
+    when nothing pairs."""
+    f_x = np.asarray(cfg.f_x, float)
+    f_a = frequencies_hz(lam)
+    phi_am = Phi if cfg.P is None else np.asarray(cfg.P @ Phi)
+    pairs = np.asarray((cfg.pairing or pairing or mac_pairing)(f_a, phi_am, f_x, cfg.phi_x), int)
+    used = np.flatnonzero(pairs >= 0)
+    if used.size == 0:  # set aside at this state: nothing of it pairs
+        return {"set_aside": True, "pairs": pairs, "used": used}
+    ia = pairs[used]
+    out = {"lam": lam[ia], "Phi": Phi[:, ia], "f_a": f_a[ia], "pairs": pairs, "used": used, "index": ia,
+           "lam_all": lam, "Phi_all": Phi, "phi_am": phi_am[:, ia], "sigma": frequency_residue(f_a[ia], f_x[used]),
+           "max_err_pct": float(np.max(np.abs(1 - f_a[ia] / f_x[used])) * 100)}
+    if cfg.phi_x is not None:
+        out["mac"] = np.diag(mac_matrix(phi_am[:, ia], np.asarray(cfg.phi_x)[:, used]))
+    return out
+
+
+def _frequency_sigma(cfg, st) -> np.ndarray:
+    """The standard deviation [Hz] of each paired measured frequency: ``cfg.sigma`` when it is one per
+    measured frequency, else the frequency itself (relative errors)."""
+    f_x = np.asarray(cfg.f_x, float)
+    sig = np.asarray(cfg.sigma, float) if cfg.sigma is not None and np.size(cfg.sigma) == f_x.size else f_x
+    return sig[st["used"]]
+
+
+def objective_rows(cfg: Configuration, st) -> np.ndarray | None:
+    """What a fit of ``cfg`` minimises the squares of at its state ``st``: the paired frequencies' errors
+    f_x - f_a in units of their sigma (relative errors without one: the frequency residue of eq. 7.4)
+    and, for "modal", every paired shape's residual in units of its noise (:mod:`.shapes`). None for a
+    configuration without measured frequencies (the FRF methods: their ||b||)."""
+    if cfg.f_x is None:
+        return None
+    if st.get("set_aside"):
+        return np.zeros(0)
+    used = st["used"]
+    rows = [(np.asarray(cfg.f_x, float)[used] - st["f_a"]) / _frequency_sigma(cfg, st)]
+    if cfg.method == "modal":
+        for a, k in enumerate(used):
+            d = np.asarray(cfg.phi_x, float)[:, k]
+            rows.append(shape_residual(d, st["phi_am"][:, a], shape_sigma(d, _shape_noise(cfg, k))))
+    return np.concatenate(rows)
+
+
+def _shape_noise(cfg: Configuration, k: int) -> float:
+    return float(cfg.shape_noise if np.ndim(cfg.shape_noise) == 0 else cfg.shape_noise[k])
+
+
+def unpaired(cfg: Configuration, st) -> int:
+    """How many measured modes of ``cfg`` found no partner at the state ``st``."""
+    return 0 if cfg.f_x is None else int(np.size(cfg.f_x) - np.size(st["used"]))
+
+
+def _modal_block(cfg: Configuration, st, p) -> eq.Block:
+    """The "modal" rows in units of their noise: the frequency equations (eqs. 3.2-3.3) over their sigma,
+    then per paired mode its shape rows (:func:`.shapes.shape_rows`)."""
+    K, M, dKs, dMs = st["K"], st["M"], st["dKs"], st["dMs"]
+    used, sig = st["used"], _frequency_sigma(cfg, st)
+    A_f, b_f = eq.frequency_equations(st["lam"], st["Phi"], np.asarray(cfg.f_x, float)[used], dKs, dMs, p)
+    lam = st["lam_all"]
+    shift = 0.0 if cfg.n_rigid == 0 else 0.1 * float(lam[min(cfg.n_rigid, lam.size - 1)])
+    dphi = shape_derivatives(K, M, lam, st["Phi_all"], st["index"], dKs, dMs, shift)
+    A, b = [A_f / sig[:, None]], [b_f / sig]
+    for a, k in enumerate(used):
+        d = np.asarray(cfg.phi_x, float)[:, k]
+        du = dphi[:, :, a].T if cfg.P is None else np.asarray(cfg.P @ dphi[:, :, a].T)
+        A_s, b_s = shape_rows(d, st["phi_am"][:, a], du, shape_sigma(d, _shape_noise(cfg, k)), p)
+        A.append(A_s)
+        b.append(b_s)
+    return eq.Block(np.vstack(A), np.concatenate(b))
 
 
 def _block(cfg: Configuration, st, p) -> eq.Block:
     K, M, dKs, dMs = st["K"], st["M"], st["dKs"], st["dMs"]
     used = st.get("used")
+    if cfg.method == "modal":
+        return _modal_block(cfg, st, p)
     if cfg.method in ("freq", "freq-rel"):
         f_x = np.asarray(cfg.f_x, float)[used]
         return eq.frequency_equations(st["lam"], st["Phi"], f_x, dKs, dMs, p, relative_rows=cfg.method == "freq-rel")
@@ -216,7 +278,7 @@ def _condensed_frf_equations(cfg, K, M, dKs, dMs, p) -> eq.Block:
 def _weighted(cfg, blk, st):
     """``blk`` with unit-length rows (eq. 4.42) or rows in units of ``cfg.sigma`` (eq. 4.28); a sigma per
     measured frequency keeps the rows of the modes paired in this state ``st``."""
-    if cfg.sigma is None and cfg.method == "frf-in" and _condensed(cfg):
+    if (cfg.sigma is None and cfg.method == "frf-in" and _condensed(cfg)) or cfg.method == "modal":
         return blk  # weighted by its noise already
     sigma = cfg.sigma
     if sigma is not None and cfg.method.startswith("freq") and np.size(sigma) == np.size(cfg.f_x):
@@ -237,7 +299,7 @@ def build_equations(configs, p, pairing: Callable | None = None, stack_reduce: b
     """
     configs = [configs] if isinstance(configs, Configuration) else list(configs)
     p = np.asarray(p, float)
-    states = [_state(c, p, pairing) for c in configs]
+    states = paired_states(configs, p, pairing)
     active = [(c, st) for c, st in zip(configs, states) if not st.get("set_aside")]
     if not active:
         raise UpdatingError("no measured mode of any configuration found an analytical partner; check that test and "
@@ -245,132 +307,3 @@ def build_equations(configs, p, pairing: Callable | None = None, stack_reduce: b
     blocks = [_block(c, st, p) for c, st in active]
     stacked = stack([_weighted(c, blk, st) for (c, st), blk in zip(active, blocks)], reduce=stack_reduce)
     return stacked, blocks, states
-
-
-def update(
-    configs, p0, *, solver: str = "ls", bounds=None, fixed=(), log_scale=(), pairing: Callable | None = None,
-    max_iter: int = 30, use_line_search: bool | None = None, stack_reduce: bool = False,
-    tol_freq_pct: float = 1.0, tol_param_pct: float = 0.5, tol_sigma_pct: float = 0.01,
-    patience: int = 3, solver_options: dict | None = None, progress: Callable | None = None,
-) -> UpdateResult:
-    """Iterate sensitivity-based updating until convergence (thesis eqs. 4.49-4.52, 7.2-7.6).
-
-    configs: one :class:`Configuration` or a list (PBC). p0: initial parameter values (non-zero).
-    solver: "ls", "tls", "bayes" (alpha 0.5 * 0.9^iter, eq. 4.40) or "bounded" (needs ``bounds``
-    = (lower, upper) arrays of parameter values). fixed: indices of parameters held.
-    log_scale: indices of parameters updated on a log scale, p <- p exp(x) instead of p (1 + x)
-    (same first-order equations, since dp/p = d ln p; keeps stiffnesses that span decades
-    positive).
-    pairing: callable (f_a, phi_a_measured, f_x, phi_x) -> analytical index per measured mode,
-    -1 for a mode left unpaired (dropped from that iteration's equations), for configurations that
-    do not carry their own (``Configuration.pairing``; default :func:`mac_pairing`). use_line_search: minimise the overall frequency residue along
-    the step (eq. 7.6; default on for "bayes"). Stops when one of: max frequency error <
-    ``tol_freq_pct`` (7.2), max parameter change < ``tol_param_pct`` (7.3), mean change of the
-    frequency residue over the last three iterations < ``tol_sigma_pct`` (7.4). Divergence: the
-    objective (frequency residue, or ||b|| without frequencies) above its best for ``patience``
-    iterations in a row, or a model that can no longer be solved (e.g. a parameter driven
-    negative); the best iterate is returned (also when ``max_iter`` runs out).
-    solver_options: keyword arguments of the "ls"/"tls" solver (rank, rtol, jump, t_b, ...), or
-    alpha0/factor of the Bayesian schedule. Each history entry holds p, the frequency residue,
-    max frequency error, ||b||, pairs, MAC of the pairs, condition numbers per configuration and
-    stacked, and the rank, message and step of the solve made from it; ``set_aside`` names the
-    configurations none of whose modes paired at that iteration. ``progress(entry)`` is called with
-    each history entry as it is made (long runs report per iteration).
-    """
-    configs = [configs] if isinstance(configs, Configuration) else list(configs)
-    if solver not in SOLVERS:
-        raise ValueError(f"solver={solver!r}; choose one of {sorted(SOLVERS)}")
-    p = np.asarray(p0, float).copy()
-    if np.any(p == 0):
-        raise ValueError("p0: relative design variables (eq. 4.41) need non-zero parameter values")
-    free = np.setdiff1d(np.arange(p.size), np.asarray(fixed, int))
-    is_log = np.zeros(p.size, bool)
-    is_log[np.asarray(log_scale, int)] = True
-
-    def stepped(q, dx):
-        return np.where(is_log, q * np.exp(dx), q * (1 + dx))
-
-    def rel_bound(v, q):
-        return np.where(is_log, np.log(v / q), v / q - 1)
-
-    if solver == "bounded":
-        if bounds is None:
-            raise ValueError("solver 'bounded' needs bounds=(lower, upper) parameter values")
-        lo, hi = (np.broadcast_to(np.asarray(v, float), p.shape) for v in bounds)
-    line = (solver == "bayes") if use_line_search is None else use_line_search
-    have_f = all(c.f_x is not None for c in configs)
-    opts = dict(solver_options or {})
-
-    history, best, best_obj, worse, last_sol = [], None, np.inf, 0, None
-    converged, diverged, reason = False, False, "maximum number of iterations reached"
-    for it in range(max_iter + 1):
-        try:
-            (A, b), blocks, states = build_equations(configs, p, pairing, stack_reduce)
-        except (np.linalg.LinAlgError, ValueError, ArithmeticError) as exc:
-            if it == 0:
-                raise
-            diverged, reason = True, f"diverged: the model could not be evaluated after step {it} ({exc})"
-            break
-        raw_norm = float(np.linalg.norm(np.concatenate([blk.b for blk in blocks])))
-        paired = [st for st in states if not st.get("set_aside")]
-        sigma = float(np.sqrt(np.mean([st["sigma"] ** 2 for st in paired]))) if have_f else None
-        obj = sigma if have_f else raw_norm
-        A = A[:, free]
-        entry = {
-            "iteration": it, "p": p.copy(), "sigma": sigma, "residual_norm": raw_norm,
-            "max_freq_error_pct": max(st["max_err_pct"] for st in paired) if have_f else None,
-            "pairs": [st.get("pairs") for st in states], "mac": [st.get("mac") for st in states],
-            "set_aside": [c.name for c, st in zip(configs, states) if st.get("set_aside")],
-            "condition_per_configuration": [condition_number(blk.A[:, free]) for blk in blocks],
-            "condition_stacked": condition_number(A),
-        }
-        history.append(entry)
-        if progress is not None:
-            progress(entry)
-        if obj < best_obj:
-            best, best_obj, worse = it, obj, 0
-        else:
-            worse += 1
-        if worse >= patience:
-            diverged, reason = True, f"diverged: objective above its best (iteration {best}) for {patience} iterations"
-            break
-        if have_f and entry["max_freq_error_pct"] < tol_freq_pct:
-            converged, reason = True, f"max frequency error {entry['max_freq_error_pct']:.3g} % < {tol_freq_pct} % (eq. 7.2)"
-            break
-        if it >= 1 and np.max(np.abs(history[-2]["proposed"])) * 100 < tol_param_pct:
-            converged, reason = True, f"max parameter change < {tol_param_pct} % (eq. 7.3)"
-            break
-        if have_f and it >= 3:
-            s = [h["sigma"] for h in history[-4:]]
-            if np.mean(np.abs(np.diff(s))) * 100 < tol_sigma_pct:
-                converged, reason = True, f"frequency residue changed < {tol_sigma_pct} % over three iterations (eq. 7.4)"
-                break
-        if it == max_iter:
-            break
-        if solver == "bayes":
-            sol = SOLVERS[solver](A, b, alpha=bayes_alpha(it, opts.get("alpha0", 0.5), opts.get("factor", 0.9)))
-        elif solver == "bounded":
-            sol = SOLVERS[solver](A, b, rel_bound(lo, p)[free], rel_bound(hi, p)[free])
-        else:
-            sol = SOLVERS[solver](A, b, **opts)
-        last_sol = sol
-        entry.update(rank=sol.rank, rank_deficient=sol.rank_deficient, message=sol.message)
-        x = np.zeros(p.size)
-        x[free] = sol.x
-        beta = 1.0
-        if line and have_f:
-            def residue(bt):
-                trial = stepped(p, bt * x)
-                try:
-                    states = [_state(c, trial, pairing) for c in configs]
-                    return float(np.sqrt(np.mean([st["sigma"] ** 2 for st in states if not st.get("set_aside")])))
-                except (np.linalg.LinAlgError, ValueError, ArithmeticError):
-                    return np.inf  # the trial model cannot be solved: not a candidate
-            beta, _ = line_search(residue)
-        entry.update(step=beta * x, proposed=x, beta=beta)
-        if beta == 0.0:
-            reason = f"stalled: the line search (eq. 7.6) found no decrease of the frequency residue at iteration {it}"
-            break
-        p = stepped(p, beta * x)
-    final = len(history) - 1 if converged else best
-    return UpdateResult(history[final]["p"], converged, diverged, reason, len(history) - 1, best, history, last_sol)

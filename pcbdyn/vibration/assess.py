@@ -92,8 +92,8 @@ class Assessment:
             "modes": [{"n": i + 1, "frequency_hz": float(f), "damping_ratio": float(z), "damping_source": s,
                        "effective_mass": m}
                       for i, (f, z, s, m) in enumerate(zip(be.frequencies, be.zeta, self.damping_source,
-                                                           self.effective_mass.as_dicts()))],
-            "effective_mass_fraction": self.effective_mass.share(self.axis),
+                                                           self._masses()))],
+            "effective_mass_fraction": None if self.effective_mass is None else self.effective_mass.share(self.axis),
             "z_peak_rms_m": self.z_peak_m,
             "parts": [p.to_dict() for p in self.parts],
             "octave_rule": self.octave,
@@ -102,6 +102,13 @@ class Assessment:
             "ok": all(p.ok for p in self.parts) and (self.octave is None or self.octave["ok"]),
             "notes": self.notes,
         }
+
+
+    def _masses(self) -> list:
+        """Each mode's effective masses (JSON), None per mode where they are not known."""
+        if self.effective_mass is None:
+            return [None] * len(self.excitation.frequencies)
+        return self.effective_mass.as_dicts()
 
 
 def _sine(be: BaseExcitation, sine: SineSweep, B: np.ndarray, parts, results) -> None:
@@ -136,9 +143,22 @@ def assess(board, bm, modes, K, M, psd: Psd, damping: Damping, *, axis: str = "z
     damage over ``duration`` [s] and of ``sine``, and the octave rule against ``chassis_hz``.
     ``parts``: the :func:`~.parts.judged_parts` to judge (default: all of the board's);
     ``probe_tol`` [m]: how far off the board a test point of a UFF damping file may lie."""
-    parts = judged_parts(board) if parts is None else parts
-    model = bm.model
     be, source, em, notes = board_excitation(board, bm, modes, K, M, damping, axis, probe_tol)
+    octave = None if chassis_hz is None else steinberg.octave_rule(float(be.frequencies[0]), chassis_hz)
+    return judge(board, bm.model, be, source, psd, damping, duration=duration, sine=sine, octave=octave, parts=parts,
+                 masses=em, notes=notes)
+
+
+def judge(board, model, be: BaseExcitation, source, psd: Psd, damping: Damping, *, duration: float | None = None,
+          sine: SineSweep | None = None, octave: dict | None = None, parts=None, direction=None,
+          masses: EffectiveMass | None = None, notes=()) -> Assessment:
+    """The :class:`Assessment` of a board whose response to the base excitation is ``be`` on its own
+    ``model`` (board frame: z normal to the board); ``direction``: the shaken axis in the board frame
+    (default the excitation's own axis); ``source``: where each mode's damping came from;
+    ``masses``: the modes' effective masses (None where the board is judged inside a larger structure)."""
+    parts = judged_parts(board) if parts is None else parts
+    axis = be.axis
+    notes = list(notes)
     grid = frequency_grid(psd.f[0], psd.f[-1], be.frequencies, be.zeta)
     C0, C2 = be.covariance(psd, grid), be.covariance(psd, grid, moment=2)
     nodes = shell_nodes(model)
@@ -151,7 +171,7 @@ def assess(board, bm, modes, K, M, psd: Psd, damping: Damping, *, axis: str = "z
     results = []
     accel_psd, z_psd = np.zeros((grid.size, len(parts))), np.zeros((grid.size, len(parts)))
     if parts:
-        read = part_readers(model, parts, axis)
+        read = part_readers(model, parts, axis, direction)
         Bz = be.columns(read["z"])
         Ba = be.columns(read["acceleration"], "acceleration")
         Ca = be.covariance(psd, grid, "acceleration")
@@ -174,6 +194,5 @@ def assess(board, bm, modes, K, M, psd: Psd, damping: Damping, *, axis: str = "z
         if sine is not None:
             _sine(be, sine, Bz, parts, results)
     order = np.argsort([r.margin for r in results], kind="stable")
-    octave = None if chassis_hz is None else steinberg.octave_rule(float(be.frequencies[0]), chassis_hz)
     return Assessment(psd, damping, axis, duration, be, source, [results[i] for i in order],
-                      node_z, grid, accel_psd[:, order], z_psd[:, order], em, octave, sine, notes)
+                      node_z, grid, accel_psd[:, order], z_psd[:, order], masses, octave, sine, notes)

@@ -72,6 +72,19 @@ class BaseExcitation:
         """Mean square of each output row of B, Re(b C b^T) (>= 0)."""
         return np.maximum(np.einsum("ik,kl,il->i", B, C, B).real, 0.0)
 
+    def seen_by(self, nodes, R) -> "BaseExcitation":
+        """The excitation as a part of the model sees it in its own axes: the six rows of each of
+        ``nodes`` (in their order) of ``basis`` and ``r``, turned by R^T (R: the part's axes as columns),
+        so that the part's own model reads them (a card in a housing)."""
+        dofs = (6 * np.asarray(nodes)[:, None] + np.arange(6)).ravel()
+
+        def turn(A):
+            A = A[dofs].reshape(len(nodes), 2, 3, -1)
+            return np.einsum("ji,nbjm->nbim", R, A).reshape(len(dofs), -1)
+
+        return BaseExcitation(self.axis, self.frequencies, self.zeta, self.gamma, turn(self.basis),
+                              turn(self.r[:, None])[:, 0], self.total_mass)
+
     def response_psd(self, B: np.ndarray, psd, freqs, quantity: str = "displacement") -> np.ndarray:
         """|B g(f)|^2 W(f) (n_f, n_out): the response PSD of each output."""
         return np.abs(self.transfer(freqs, quantity) @ B.T) ** 2 * psd.at(freqs)[:, None]

@@ -143,13 +143,15 @@ def _curvature_rows(model, parts) -> tuple:
     return tuple(out)
 
 
-def part_readers(model, parts, axis: str) -> dict:
+def part_readers(model, parts, axis: str, direction=None) -> dict:
     """What is read at the parts, as operators on the model's DOFs (n_parts, n_dof): "z", the
     displacement normal to the board at each centre; "acceleration", the motion along the shaken
-    ``axis`` there; "curvature_along" and "curvature_across", the curvatures along and across each
-    part's long side averaged over its footprint."""
+    ``axis`` there (or along ``direction``, a unit vector in the board frame: a card in a housing shaken
+    along the housing's axis); "curvature_along" and "curvature_across", the curvatures along and
+    across each part's long side averaged over its footprint."""
     centres = np.column_stack([np.array([p.at for p in parts]), np.zeros(len(parts))])
     along, across = _curvature_rows(model, parts)
+    direction = np.eye(3)["xyz".index(axis)] if direction is None else direction
     return {"z": model_probe(model, centres).P,
-            "acceleration": model_probe(model, centres, np.eye(3)["xyz".index(axis)]).P,
+            "acceleration": model_probe(model, centres, direction).P,
             "curvature_along": along, "curvature_across": across}

@@ -64,6 +64,16 @@ def test_json_contract(fitted):
     assert h[-1]["k_rot"]["bottom_guide"] == pytest.approx(d["k_rot"]["bottom_guide"]["value"])
 
 
+def test_printed_values_are_the_json_values(fitted):
+    """What the run prints for each guide (the fit's 'start -> end' line and the stiffness table) is the JSON's
+    value (issue 40: the summary printed 'guide_y0 4783 -> 2.936' while the JSON kept 4783)."""
+    _, res, d = fitted
+    for name in ("bottom_guide", "top_guide"):
+        k = d["k_rot"][name]["value"]
+        assert f"{name} {d['start'][name]:.4g} -> {k:.4g}" in res.output
+        assert f"{k:>20.5g}" in res.output
+
+
 def test_outputs_and_updated_board(fitted):
     """Tables, pictures and the board with the fitted stiffness in --out, its comments kept, giving back
     the fitted value."""

@@ -146,7 +146,7 @@ def test_update_command_writes_board_and_json(tmp_path):
     js = tmp_path / "u.json"
     r = CliRunner().invoke(main, ["update", str(path), "--frequencies", str(CARD / "measured_frequencies_table_7_2.csv"),
                                   "--params", "t_U1,t_U2,t_U3,t_U4,t_U5,t_U6", "--max-iter", "3", "--json", str(js),
-                                  "--out", str(tmp_path / "out")])
+                                  "--out", str(tmp_path / "out"), "--force", "--no-mesh-check"])
     assert r.exit_code == 0, r.output
     data = json.loads(js.read_text())
     assert data["updated_board"] == str(tmp_path / "out" / "board.updated.toml")
@@ -155,12 +155,13 @@ def test_update_command_writes_board_and_json(tmp_path):
         assert updated.component(f"U{i}").thickness == pytest.approx(data["parameters"][f"t_U{i}"]["updated"], rel=1e-12)
     assert (tmp_path / "out" / "iterations.png").exists()
     assert data["after"]["max_freq_error_pct"] <= data["before"]["max_freq_error_pct"]
-    assert data["status"] in ("converged", "not converged", "stopped on bounds", "rank-deficient", "error grew")
+    assert data["status"] in ("converged", "not converged", "on a bound", "not determined", "error grew", "cannot fit")
 
 
 def test_update_command_qms_from_uff(tmp_path):
     """End to end: simulated UFF tests of two configurations (noise-free shapes and frequencies) of a
-    card with two changed part thicknesses; `pcbdyn update --method qms` recovers them."""
+    card with two changed part thicknesses, on the model's own mesh (so no mesh check: there is no mesh error
+    to take out); `pcbdyn update --method qms` recovers them."""
     from click.testing import CliRunner
 
     from pcbdyn.cli import main
@@ -178,7 +179,7 @@ def test_update_command_qms_from_uff(tmp_path):
     path = card(tmp_path, "board.toml")
     js = tmp_path / "u.json"
     r = CliRunner().invoke(main, ["update", str(path), str(files[0]), f"c2={files[1]}", "--method", "qms",
-                                  "--solver", "ls", "--params", "t_U1,t_U4", "--json", str(js)])
+                                  "--solver", "ls", "--params", "t_U1,t_U4", "--json", str(js), "--no-mesh-check"])
     assert r.exit_code == 0, r.output
     data = json.loads(js.read_text())
     assert data["parameters"]["t_U1"]["unit"] == "m"
