@@ -38,9 +38,9 @@ class _Stiffener:
         self.section = section
 
     def generate(self, layout, path_spacing: float = 0.02) -> list:
-        """Lines across the whole plate in :data:`DIRECTIONS`, ``path_spacing`` [m] apart: a bar at any
-        angle and of any length starts from the line it lies nearest (its ends and direction are
-        fitted after, :mod:`.geometry_fit`)."""
+        """Lines across the whole plate in :data:`DIRECTIONS`, ``path_spacing`` [m] apart, and their
+        :data:`PIECES`: a bar at any angle and of any length starts from the line it lies nearest (its ends,
+        direction and section are fitted after, :mod:`.geometry_fit`)."""
         if not path_spacing > 0:
             raise ValueError(f"path_spacing must be > 0 m, got {path_spacing}")
         if not layout.planar:  # lines of a plate in one plane only
@@ -56,9 +56,10 @@ class _Stiffener:
             n = max(1, int(round(2.0 * half / path_spacing)))
             for s in -half + (np.arange(n) + 0.5) * (2.0 * half / n):
                 ends = _clipped(centre + s * across, d, lo, hi)
-                c = None if ends is None else self.candidate(layout, None, *ends)
-                if c is not None:
-                    out.append(c)
+                for a, b in [] if ends is None else PIECES:
+                    c = self.candidate(layout, None, ends[0] + a * (ends[1] - ends[0]), ends[0] + b * (ends[1] - ends[0]))
+                    if c is not None:
+                        out.append(c)
         return out
 
     def parallel(self, layout, candidate, offsets) -> list:
@@ -136,6 +137,9 @@ class _Stiffener:
 
 #: [rad] the directions of the lines searched first: rows, columns and the diagonals between them
 DIRECTIONS = np.radians([0.0, 90.0, 45.0, 135.0])
+#: the stretches of each line searched first (fractions of its length across the plate): the whole, and
+#: halves at either end and in the middle (a bar glued over part of the board is nearer one of them)
+PIECES = ((0.0, 1.0), (0.0, 0.5), (0.5, 1.0), (0.25, 0.75))
 
 
 def normal(path) -> np.ndarray:
