@@ -47,7 +47,8 @@ def atoms(case: dict, E_board: float) -> list:
     return out
 
 
-def _to_polyline(p, pts) -> float:
+def to_polyline(p, pts) -> float:
+    """Distance of point ``p`` to the polyline through ``pts`` (one point: to that point)."""
     pts = np.asarray(pts, float).reshape(-1, 2)
     if len(pts) == 1:
         return float(np.linalg.norm(p - pts[0]))
@@ -68,7 +69,7 @@ def distance(r: dict, geometry: dict) -> float:
     """[mm] how far reported effect ``r`` lies from an atom's geometry."""
     if "segment" in geometry:
         line = _reported_line(r)
-        return max(_to_polyline(np.asarray(p, float), line) for p in geometry["segment"])
+        return max(to_polyline(np.asarray(p, float), line) for p in geometry["segment"])
     if "rect" in geometry:
         x0, y0, x1, y1 = geometry["rect"]
         p = np.array([(x0 + x1) / 2, (y0 + y1) / 2])

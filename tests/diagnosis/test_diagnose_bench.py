@@ -22,6 +22,9 @@ import pytest
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import bench_cases as bc  # noqa: E402
 
+sys.path.insert(0, str(bc.ROOT / "benchmarks" / "discovery"))
+from score import to_polyline  # noqa: E402
+
 LOC_TOL_MM = max(15.0, 1e3 * bc.MODEL_MESH)
 MAG_TOL = 0.30
 AFTER_MAX_PCT = 0.5
@@ -47,17 +50,6 @@ def bench(tmp_path_factory):
 
 
 # ------------------------------------------------------------------------------------- geometry
-def _polyline_distance(p, pts) -> float:
-    """Distance of point ``p`` to the polyline through ``pts`` (one point: to that point)."""
-    pts = np.asarray(pts, float).reshape(-1, 2)
-    if len(pts) == 1:
-        return float(np.linalg.norm(p - pts[0]))
-    a, b = pts[:-1], pts[1:]
-    ab = b - a
-    t = np.clip(np.einsum("ij,ij->i", p - a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-300), 0.0, 1.0)
-    return float(np.linalg.norm(a + t[:, None] * ab - p, axis=1).min())
-
-
 def _inside(p, poly) -> bool:
     from matplotlib.path import Path as PolyPath
 
@@ -71,10 +63,10 @@ def location_error_mm(reported: dict, truth: dict) -> float:
     d = [float(np.linalg.norm(np.asarray(reported["at_mm"], float) - p))]
     for key in ("segment_mm", "path_mm"):
         if reported.get(key):
-            d.append(_polyline_distance(p, reported[key]))
+            d.append(to_polyline(p, reported[key]))
     if reported.get("polygon_mm"):
         poly = np.asarray(reported["polygon_mm"], float)
-        d.append(0.0 if _inside(p, poly) else _polyline_distance(p, np.vstack([poly, poly[:1]])))
+        d.append(0.0 if _inside(p, poly) else to_polyline(p, np.vstack([poly, poly[:1]])))
     return min(d)
 
 
