@@ -22,7 +22,8 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
 sys.path.insert(0, str(HERE))
 
-from make import EXTRA_MODES, ZETA, cache_dir  # noqa: E402
+from make import ZETA, cache_dir  # noqa: E402
+from seen import EXTRA_MODES  # noqa: E402
 
 EXAMPLE = ROOT / "examples" / "ribbed_box" / "box.toml"
 #: the handed box's declared values (the example's, i.e. the truth's, in brackets)

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from cases import Case
-from make import EXTRA_MODES, MIN_BENDING, bending_share
+from seen import EXTRA_MODES, MIN_BENDING, bending_share
 from toml_text import board_text
 
 DETECTABLE_CHI2 = 50.0

@@ -23,15 +23,11 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
 from cases import Case, draw  # noqa: E402
+from seen import EXTRA_MODES, MIN_BENDING, bending_share  # noqa: E402
 from toml_text import board_text  # noqa: E402
 
 #: the truth is meshed this many times finer than the model
 TRUTH_REFINEMENT = 2.0
-#: modes solved beyond those tested, so that in-plane modes (a board on soft standoffs sliding on them)
-#: can be left out: a test in z does not see them
-EXTRA_MODES = 6
-#: the least share of a mode's translations out of the plane for a z test to measure it
-MIN_BENDING = 0.3
 #: damping of the simulated test's modes (written to the UFF; diagnose does not use it)
 ZETA = 0.01
 
@@ -43,7 +39,7 @@ def cache_dir() -> Path:
 def code_key() -> str:
     """A digest of the generator's own code: a cached case made by other code is made again."""
     h = hashlib.sha1()
-    for name in ("cases.py", "toml_text.py", "make.py", "opensees_truth.py", "detectability.py"):
+    for name in ("cases.py", "toml_text.py", "make.py", "opensees_truth.py", "detectability.py", "seen.py"):
         h.update((HERE / name).read_bytes())
     return h.hexdigest()[:12]
 
@@ -114,11 +110,6 @@ def _solve_and_write(case: Case, folder: Path) -> list:
     write_uff(folder / "test.uff", noisy_test(case, f, z))
     np.save(folder / "shapes_z.npy", z)
     return [float(v) for v in f]
-
-
-def bending_share(u) -> np.ndarray:
-    """Per mode, the share of the translations ``u`` (n_nodes, 3, n_modes) along z."""
-    return np.linalg.norm(u[:, 2], axis=0) / np.linalg.norm(u.reshape(-1, u.shape[-1]), axis=0)
 
 
 def seeds(text: str) -> list:
