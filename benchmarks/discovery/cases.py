@@ -192,8 +192,8 @@ def _hold(rng, case: Case, board):
                    "N*m/rad/m", k, log=True)
     if hold == "edges":
         pair = edge_pair(str(rng.choice(["clamped_edge", "hinged_edge"])))
-        if rng.random() < 0.5:
-            pair = pair[:1]
+        if rng.random() < 0.5:  # one edge: clamped (hinged alone, the board would turn about it)
+            pair = [("clamped_edge", e, seg) for _, e, seg in pair[:1]]
         for j, (typ, e, seg) in enumerate(pair):
             case.fixtures.append({"name": f"edge{j + 1}", "type": typ, "edge": e})
             held.append((e, seg, typ))

@@ -46,9 +46,15 @@ def _tag() -> str:
 
 
 def run_case(seed: int, options: dict, shared=None) -> dict:
-    """Make case ``seed`` and diagnose it (or reuse the result kept under the tag)."""
-    folder = make(seed, options["cache"])
-    out = folder / f"result-{options['tag']}.json"
+    """Make case ``seed`` and diagnose it (or reuse the result kept under the tag and the truth's key);
+    a case that cannot be made is a result with ``exit`` None and the reason."""
+    try:
+        folder = make(seed, options["cache"])
+    except Exception as exc:  # the generator's own failure: reported per case, the split goes on
+        return {"seed": seed, "wall_s": 0.0, "exit": None, "stderr_tail": f"{type(exc).__name__}: {exc}",
+                "diagnosis": None}
+    key = json.loads((folder / "truth.json").read_text())["key"]
+    out = folder / f"result-{options['tag']}-{key}.json"
     if out.exists() and not options["again"]:
         return json.loads(out.read_text())
     js = folder / f"diagnose-{options['tag']}.json"
@@ -117,6 +123,9 @@ def main(argv=None):
     t0 = time.perf_counter()
     for (seed, _), result in run_jobs(run_case, [(s, options) for s in todo], None, workers=a.jobs,
                                       scheduler=a.scheduler):
+        if result["exit"] is None:
+            print(f"s{seed:04d} not made: {result['stderr_tail']}", flush=True)
+            continue
         truth = json.loads((options["cache"] / f"s{seed:04d}" / "truth.json").read_text())
         v = judge(truth, result["diagnosis"], DETECTABLE_CHI2)
         rows.append((truth, result, v))
