@@ -160,15 +160,25 @@ def _generate(gmsh, size: float, algorithm: int, recombine) -> None:
 
 
 def folded_surfaces(gmsh) -> set:
-    """The surfaces whose elements do not all turn the same way in the xy plane (a folded element)."""
+    """The surfaces whose elements do not all turn the same way about the surface's normal (a folded
+    element); a surface in 3-D (a housing's plate) is judged in its own plane."""
     xyz, index = mesh_nodes(gmsh)
     out = set()
     for _, t in gmsh.model.getEntities(2):
-        for conn in surface_cells(gmsh, t, index):
-            area = _signed_area(xyz, conn)
-            if area.size and area.min() < 0 < area.max():
-                out.add(t)
+        cells = surface_cells(gmsh, t, index)
+        if not cells:
+            continue
+        normals = np.concatenate([_cell_normals(xyz, conn) for conn in cells])
+        turn = normals @ normals.sum(axis=0)
+        if turn.size and turn.min() < 0 < turn.max():
+            out.add(t)
     return out
+
+
+def _cell_normals(xyz, conn) -> np.ndarray:
+    """Each cell's area vector (n, 3): half the sum of its edges' cross products (Newell)."""
+    p = xyz[conn]
+    return 0.5 * np.cross(p, np.roll(p, -1, axis=1)).sum(axis=1)
 
 
 def mesh_nodes(gmsh) -> tuple:

@@ -36,18 +36,21 @@ def parts_table(a) -> pd.DataFrame:
 
 
 def modes_table(a) -> pd.DataFrame:
-    """One row per mode: frequency, damping, effective masses in percent (:func:`.modes.mass_columns`)."""
+    """One row per mode: frequency, damping, effective masses in percent (:func:`.modes.mass_columns`;
+    none for a card judged inside its housing, whose modes are the system's)."""
     from .modes import mass_columns
 
     be = a.excitation
+    masses = {} if a.effective_mass is None else mass_columns(a.effective_mass)
     return pd.DataFrame({"mode": np.arange(1, be.frequencies.size + 1), "frequency [Hz]": be.frequencies,
-                         "damping ratio": be.zeta, "Q": 0.5 / be.zeta, **mass_columns(a.effective_mass),
-                         "damping from": a.damping_source})
+                         "damping ratio": be.zeta, "Q": 0.5 / be.zeta, **masses, "damping from": a.damping_source})
 
 
 def modes_line(a) -> str:
     """How many modes the response sums, to where, and the share of the mass moved along the axis they carry."""
     be = a.excitation
+    if a.effective_mass is None:
+        return f"modes: {be.frequencies.size} of the system, up to {be.frequencies[-1]:.0f} Hz (static residual added)"
     return (f"modes: {be.frequencies.size} up to {be.frequencies[-1]:.0f} Hz, {100 * a.effective_mass.share(a.axis):.2f} "
             f"% of the mass moved along {a.axis} (static residual added for the rest)")
 
