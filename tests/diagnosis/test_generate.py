@@ -90,16 +90,23 @@ def test_each_part_footprint_is_a_region_candidate(board):
     assert [c for c in patches if "@patch2x+[" in c.name]  # and shifted by half of it
 
 
-def test_stiffener_paths_follow_rows_and_columns(board):
+def test_stiffener_paths_follow_rows_columns_and_diagonals_with_their_pieces(board):
     bm, layout, cands = board
     paths = of(cands, "stiffener")
-    assert len(paths) == 4 + 5
-    for c in paths:
-        p = c.geometry["path"]
-        axis = 1 if "@y=" in c.name else 0
-        assert np.ptp(p[:, axis]) < 0.8 * 0.008 * 2  # within about one element of the line
-        span = (W, H)[1 - axis]
-        assert np.ptp(p[:, 1 - axis]) > span - 0.008
+    ends = [np.asarray(c.geometry["path"])[[0, -1]] for c in paths]
+    d = [e[1] - e[0] for e in ends]
+    rows = [e for e, v in zip(ends, d) if abs(v[1]) < 1e-9]
+    cols = [e for e, v in zip(ends, d) if abs(v[0]) < 1e-9]
+    whole_rows = [e for e in rows if np.ptp(e[:, 0]) > W - 0.008]
+    whole_cols = [e for e in cols if np.ptp(e[:, 1]) > H - 0.008]
+    assert len(whole_rows) == 4 and len(whole_cols) == 5  # 20 mm apart across 80 mm and 100 mm
+    assert np.allclose(sorted(e[0, 1] for e in whole_rows), [0.01, 0.03, 0.05, 0.07], atol=0.8 * 0.008)
+    # each line also in halves at either end and in the middle
+    assert len(rows) == 4 * len(whole_rows) and len(cols) == 4 * len(whole_cols)
+    for e in rows:
+        assert np.ptp(e[:, 0]) == pytest.approx(W, abs=0.008) or np.ptp(e[:, 0]) == pytest.approx(W / 2, abs=0.008)
+    slanted = [v for v in d if abs(v[0]) > 1e-9 and abs(v[1]) > 1e-9]
+    assert slanted and all(abs(abs(v[1] / v[0]) - 1.0) < 0.25 for v in slanted)  # diagonals at about 45 deg
 
 
 def test_columns_of_the_board_candidates_are_finite_and_the_prime_suspect_matters(board):
