@@ -31,7 +31,6 @@ import numpy as np
 from scipy.stats import chi2 as chi2_dist
 
 from .fitting import RANK_STEPS, UPPER, Fit, estimate  # noqa: F401  (re-exported)
-from .catalogue import kind
 from .scan import Runner, rank, worth_full
 
 #: probability that noise alone makes one of the candidates look like an effect (family-wise)
@@ -293,19 +292,12 @@ def _companions(candidates, chosen) -> np.ndarray:
 
 
 def _shortlist(gain, kinds, per_kind: int) -> np.ndarray:
-    """The ``per_kind`` best finite-gain columns of every kind, :data:`SCREENED` times as many of the
-    kinds a reanalysis follows (their trials are screened by quick fits, :func:`.scan.rank`: a stiff
-    spring's or a heavy mass's linear score saturates, and its best place need not rank first)."""
+    """The ``per_kind`` best finite-gain columns of every kind."""
     out = []
     for k in np.unique(kinds):
         idx = np.flatnonzero((kinds == k) & np.isfinite(gain))
-        n = per_kind * (SCREENED if getattr(kind(str(k)), "reanalysed", True) else 1)
-        out.append(idx[np.argsort(-gain[idx])[:n]])
+        out.append(idx[np.argsort(-gain[idx])[:per_kind]])
     return np.concatenate(out) if out else np.zeros(0, dtype=np.int64)
-
-
-#: how many times more of a kind the reanalysis follows go to its quick fits than of one it does not
-SCREENED = 4
 
 
 def _prune(res, candidates, idx, fit, steps, bounds, pen, n_params, runner: Runner | None = None):
