@@ -32,6 +32,7 @@ from scipy.stats import chi2 as chi2_dist
 
 from .fitting import RANK_STEPS, UPPER, Fit, estimate  # noqa: F401  (re-exported)
 from .scan import Runner, rank, worth_full
+from .stiffener import normal
 
 #: probability that noise alone makes one of the candidates look like an effect (family-wise)
 ALPHA = 0.01
@@ -95,7 +96,9 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
         gain = np.where(ok, value**2 * norm2 / scale**2, -np.inf)
         gain[value < lower] = -np.inf  # an effect of unphysical sign cannot be the answer
         gain[sel.chosen] = -np.inf
-        order = np.union1d(_shortlist(gain, kinds, shortlist), _companions(candidates, sel.chosen))
+        short = _shortlist(gain, kinds, shortlist)
+        order = np.setdiff1d(np.union1d(np.union1d(short, _companions(candidates, sel.chosen)),
+                                        _whole_lines(candidates, short)), sel.chosen)
         if not order.size:
             break
         trials = [([candidates[i] for i in sel.chosen + [j]], np.r_[sel.values, max(value[j], 0.0)]) for j in order]
@@ -289,6 +292,27 @@ def _companions(candidates, chosen) -> np.ndarray:
     taken = {tuple(candidates[i].nodes.tolist()) for i in chosen}
     return np.array([j for j, c in enumerate(candidates) if j not in chosen and tuple(c.nodes.tolist()) in taken
                      and c.nodes.size == 1], dtype=np.int64)
+
+
+def _whole_lines(candidates, idx) -> np.ndarray:
+    """For each stiffener among ``idx``, the longest stiffener candidate on its line: always tried
+    beside it, since a piece can score best on its own where a bar spans the plate (a bar across the
+    card was found as a middle piece whose ends, fitted after, stopped 33 mm short of either edge)."""
+    ribs = [j for j, c in enumerate(candidates) if c.kind == "stiffener"]
+    if not ribs or not any(candidates[i].kind == "stiffener" for i in idx):
+        return np.zeros(0, dtype=np.int64)
+    paths = [np.asarray(candidates[j].geometry["path"], float)[[0, -1]] for j in ribs]
+    n = np.array([normal(q) for q in paths])
+    offset = np.einsum("ij,ij->i", n, np.array([q[0] for q in paths]))
+    length = np.array([np.linalg.norm(q[1] - q[0]) for q in paths])
+    where = {j: k for k, j in enumerate(ribs)}
+    out = []
+    for i in idx:
+        if i in where:
+            k = where[i]
+            same = np.flatnonzero((np.abs(n - n[k]).max(axis=1) < 1e-9) & (np.abs(offset - offset[k]) < 1e-9))
+            out.append(ribs[same[np.argmax(length[same])]])
+    return np.unique(np.array(out, dtype=np.int64))
 
 
 def _shortlist(gain, kinds, per_kind: int) -> np.ndarray:
