@@ -46,7 +46,7 @@ def dof_labels(dofs) -> list:
 
 def correlate(test_modes, model, model_modes, min_mac: float = 0.5, close: float = 0.005, tol=None,
               sets=None) -> Correlation:
-    """Pair measured modes (:class:`pcbdyn.testdata.Modes`) with the modes of ``model``.
+    """Pair measured modes (:class:`pcbdyn.testdata.MeasuredModes`) with the modes of ``model``.
 
     The model is read at each test DOF through the shell shape functions (points off the model
     raise, naming them); pairing is by MAC with frequency as tie-breaker and best combinations for

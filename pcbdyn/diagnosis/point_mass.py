@@ -17,7 +17,7 @@ import numpy as np
 from ..fe import MassProperty
 from ..fe.elements.discrete import mass_matrices
 from ..fixtures.supports import disc_footprint, mass_footprint
-from .catalogue import register, Blocks, copy_model, node_candidates, on_nearest_node
+from .catalogue import register, Blocks, node_candidates, on_nearest_node
 
 
 class _Lumped:
@@ -78,7 +78,7 @@ class _Lumped:
         return out
 
     def apply(self, model, candidate, value: float):
-        m = copy_model(model)
+        m = model.copy()
         conn, W = self.footprint(model, candidate)
         m.add(f"effects.{candidate.name}", "mass", [conn], self._property(value, W))
         return m

@@ -110,8 +110,7 @@ class ParametricModel:
         for k in values:
             if k not in self.quantities:
                 raise ModelError(f"'{k}' is not a quantity of this model")
-        model = Model(self.model.nodes, dict(self.model.sets), dict(self.model.node_groups), set(self.model.fixed),
-                      list(self.model.mpcs), self.model.free)
+        model = self.model.copy()
         for name, prop in self.properties(values).items():
             es = model.sets[name]
             model.sets[name] = replace(es, prop=prop)

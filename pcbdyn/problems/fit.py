@@ -181,7 +181,7 @@ def fit(problem, measured, *, method: str = "freq", noise=(None, None), shapes: 
         max_iter: int = 20, tol_freq_pct: float = TOL_FREQ_PCT, tol_param_pct: float = 0.5, min_mac: float = 0.5,
         progress=None) -> Fit:
     """Fit ``problem`` (:class:`~.problem.UpdateProblem`, its ``p0`` the start) to ``measured``
-    [(configuration or None, :class:`pcbdyn.testdata.Modes`)] or [(structure index, configuration, Modes)].
+    [(configuration or None, :class:`pcbdyn.testdata.MeasuredModes`)] or [(structure index, configuration, Modes)].
 
     ``method``: "freq" (shapes added when ``shapes`` is "auto" and the frequencies leave a direction
     open, always with "always", never with "never"), "modal", "qms" or "fbm". ``noise``: (frequency %,

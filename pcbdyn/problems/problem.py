@@ -8,7 +8,7 @@ blocks that carry their own pairing and rigid-mode count, so that configurations
 and structures stack freely. Typical use::
 
     prob = UpdateProblem(load_board("board.toml"), ["t_PGA", "t_JLCC"])
-    test = read_uff("test.uff").modes                               # pcbdyn.testdata.Modes
+    test = read_uff("test.uff").modes                               # pcbdyn.testdata.MeasuredModes
     check = [prob.configuration(None, test, "freq")]                # frequencies, MAC pairing
     cfgs = prob.mode_configurations(None, test, "qms")              # or: QMS, one block per mode
     res, before, after = run(prob, cfgs, solver="bounded", check=check)
@@ -91,7 +91,7 @@ class UpdateProblem:
 
     def configuration(self, config, measured, method: str = "freq", n_modes=None, min_mac: float = 0.5,
                       structure: int = 0, limit: float = FREQ_LIMIT, **options) -> Configuration:
-        """A driver Configuration of ``config`` with its measured modes (:class:`pcbdyn.testdata.Modes`).
+        """A driver Configuration of ``config`` with its measured modes (:class:`pcbdyn.testdata.MeasuredModes`).
 
         Shapes give P and MAC pairing (pairs more than ``limit`` apart in frequency left out); frequencies
         only pair by the test's mode numbers. ``n_modes`` analytical modes are solved per iteration

@@ -15,7 +15,7 @@ import scipy.sparse as sp
 from pcbdyn.fe.frf import frf_modal
 from pcbdyn.fe.modal import Modes as ModelModes
 
-from .data import Dofs, FRFs, Modes, Points, TestData
+from .data import Dofs, FRFs, MeasuredModes, Points, TestData
 from .noise import Noise, noisy_frequencies, noisy_frfs, noisy_shapes
 
 #: FRFs sum every mode up to this multiple of the band's top frequency
@@ -54,7 +54,7 @@ def simulate_test(
     z = np.broadcast_to(np.asarray(zeta, dtype=float), (n,)).copy()
     f = noisy_frequencies(modes.frequencies, noise.frequency_pct, rng)
     shapes = noisy_shapes(at, noise.shape_pct, rng)
-    test_modes = Modes(points, dofs, f, shapes, z)
+    test_modes = MeasuredModes(points, dofs, f, shapes, z)
     frfs = None
     if reference is not None:
         if read_reference is None or f_axis is None:

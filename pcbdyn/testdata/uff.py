@@ -33,7 +33,7 @@ from .data import (
     FILE_FLOOR_HZ,
     Dofs,
     FRFs,
-    Modes,
+    MeasuredModes,
     Points,
     TestData,
     TestDataError,
@@ -301,8 +301,8 @@ def _checked58(d: dict) -> dict:
     return d
 
 
-def _assemble_modes(modes55, geo: Geometry) -> Modes:
-    """One Modes object from the 55 datasets: DOFs are the (node, axis) pairs nonzero in any mode, each
+def _assemble_modes(modes55, geo: Geometry) -> MeasuredModes:
+    """One MeasuredModes object from the 55 datasets: DOFs are the (node, axis) pairs nonzero in any mode, each
     along its node's displacement axis in the global frame.
 
     Nodes absent from a dataset are zero there (dataset 55, note 9)."""
@@ -316,7 +316,7 @@ def _assemble_modes(modes55, geo: Geometry) -> Modes:
     dirs = [geo.direction(n, a + 1) for n, a in zip(all_nodes[node_of], axis_of)]
     dofs = Dofs(all_nodes[node_of], np.array(dirs, float).reshape(-1, 3))
     shapes, mpc = real_modes(psi[node_of, axis_of, :])
-    return Modes(geo.points, dofs, [m[0] for m in modes55], shapes, [m[1] for m in modes55], mpc)
+    return MeasuredModes(geo.points, dofs, [m[0] for m in modes55], shapes, [m[1] for m in modes55], mpc)
 
 
 def _frf_scale(d, kind, L, F) -> float:

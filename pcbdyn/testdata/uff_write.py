@@ -24,7 +24,7 @@ import os
 import numpy as np
 
 from ..atomic import atomic_path
-from .data import FRFs, Modes, TestData, TestDataError
+from .data import FRFs, MeasuredModes, TestData, TestDataError
 
 _KIND_SPEC = {"receptance": 8, "mobility": 11, "accelerance": 12}
 _END = b"    -1\n"
@@ -82,7 +82,7 @@ def mode55(mode_n: int, freq: float, zeta: float, nodes, r) -> str:
     return "".join(out) + _END.decode()
 
 
-def node_table(modes: Modes):
+def node_table(modes: MeasuredModes):
     """Nodes and their (x, y, z) shape values (n_nodes, 3, n_modes) for dataset 55."""
     codes = modes.dofs.codes()
     nodes, row = np.unique(modes.dofs.point_ids, return_inverse=True)

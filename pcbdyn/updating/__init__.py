@@ -28,8 +28,8 @@ from .sensitivity import (
     eigenvector_derivatives_modal,
     frequencies_hz,
     frequency_derivatives,
+    pencil_modes,
     perturbation_derivatives,
-    solve_modes,
 )
 from .solvers import (
     RankDeficiencyWarning,
@@ -87,7 +87,7 @@ __all__ = [
     "solve_bayes",
     "solve_bounded",
     "solve_ls",
-    "solve_modes",
+    "pencil_modes",
     "solve_tls",
     "stack",
     "std_row_weights",
