@@ -27,9 +27,9 @@ import numpy as np
 from .. import targets
 from ..components.library import locate, read_package, search_path
 from ..domain import StructureError
+from ..testdata.noise import add_noise
 from ..updating.iteration import build_equations
 from ..updating.solvers import covariance
-from ..updating.success import add_noise
 from ..updating.weighting import NOISE_REDRAWS
 from .error_budget import measured_mesh_steps, noise_sigma
 from .fit import fit

@@ -17,12 +17,12 @@ from ..fe.model import Model
 from ..fe.properties import ShellProperty
 from ..fe.reduction import guyan
 from ..testdata import read_points_csv
+from ..testdata.noise import add_noise
 from ..updating import matching
 from ..updating.equations import fbm_equations, frequency_equations, frf_receptance_equations, qms_equations
 from ..updating.pbc import stack
 from ..updating.sensitivity import frequencies_hz, pencil_modes
 from ..updating.study import StudyCase, unit_weighted
-from ..updating.success import add_noise
 from ..updating.weighting import unit_row_weights
 from .problem import UpdateProblem
 

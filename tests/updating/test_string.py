@@ -6,8 +6,8 @@ import warnings
 import numpy as np
 import pytest
 
+from pcbdyn.testdata import add_noise
 from pcbdyn.updating import (
-    add_noise,
     Configuration,
     RankDeficiencyWarning,
     fbm_equations,
