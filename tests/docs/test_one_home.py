@@ -102,3 +102,13 @@ def test_report_is_handed_plain_results():
     assert not bad
     assert "pcbdyn.report.correlation_plots" in _imported(PACKAGE / "report" / "correlation_report.py")
     assert "pcbdyn.fe.effective_mass" in _imported(PACKAGE / "report" / "modes.py")
+
+
+def test_report_saves_figures_one_way_and_shares_no_private_helper():
+    """Figures are saved by :func:`pcbdyn.report.files.save_figure` only; a helper one report module lends
+    another is public."""
+    assert [h.split(":")[0] for h in text(r"\.savefig\(")] == ["pcbdyn/report/files.py"] * 2
+    private = [f"{f.relative_to(ROOT)}:{node.lineno}" for f in sorted((PACKAGE / "report").rglob("*.py"))
+               for node in ast.walk(ast.parse(f.read_text())) if isinstance(node, ast.ImportFrom) and node.level
+               for a in node.names if a.name.startswith("_")]
+    assert not private
