@@ -117,7 +117,19 @@ class ParametricModel:
         return replace(self, model=model, quantities={**self.quantities, **values})
 
     def with_parameters(self, values: dict):
-        """A copy with parameters {name: value [SI]} set (each value goes to all its targets)."""
+        """A copy with parameters set, each value going to all its targets.
+
+        Parameters
+        ----------
+        values : dict
+            {parameter name: value [SI]}.
+
+        Returns
+        -------
+        ParametricModel
+            A copy (of the same class) whose ``model`` shares the nodes and the unchanged element
+            sets; the sets that depend on the parameters are made anew.
+        """
         q = {}
         for name, v in values.items():
             q.update(self.parameters[name].quantities(v))

@@ -69,9 +69,27 @@ def _length_col(path, df, cols, name, unit, required=True):
 
 
 def read_points_csv(path, unit: str | None = None):
-    """(Points, Dofs) from a CSV with columns point, x, y, [z], [dir]; one row per point and
-    direction (a point may appear on several rows with different directions, same coordinates).
-    ``unit`` is used for coordinate columns written without one."""
+    """The measurement points and their measured directions, from a points CSV.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        A CSV with columns point, x, y, [z], [dir]; one row per point and direction (a point may
+        appear on several rows with different directions, same coordinates).
+    unit : str, optional
+        The unit of coordinate columns written without one (``x [mm]`` states its own).
+
+    Returns
+    -------
+    (Points, Dofs)
+        Point ids and coordinates [m]; the measured DOFs (point id, unit direction).
+
+    Examples
+    --------
+    >>> points, dofs = read_points_csv("examples/six_part_card/points.csv")
+    >>> len(points.ids), len(dofs)
+    (81, 81)
+    """
     df, cols = _table(path)
     key = "point" if "point" in cols else "id" if "id" in cols else None
     if key is None:

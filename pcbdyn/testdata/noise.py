@@ -13,10 +13,34 @@ import numpy as np
 
 
 def add_noise(values, pct: float, seed=None, name: str = "the") -> np.ndarray:
-    """values (1 + p/100 eps), eps uniform in [-1, 1] drawn per component (thesis eqs. 5.72-5.74);
-    complex values (FRFs) get a real factor, as in eq. 5.74. ``seed``: a Generator (drawn from, so
-    that successive calls differ) or a seed; ``name``: the quantity, named in the error a negative
-    ``pct`` raises."""
+    """Measurement noise of a simulated test: values (1 + p/100 eps), eps uniform in [-1, 1] drawn
+    per component (thesis eqs. 5.72-5.74).
+
+    Parameters
+    ----------
+    values : array_like
+        Frequencies, shape components or FRF values; complex values (FRFs) get a real factor, as in
+        eq. 5.74.
+    pct : float
+        The noise level p [%], at least 0.
+    seed : int or numpy.random.Generator, optional
+        A Generator is drawn from (so that successive calls differ); a seed makes the draw repeatable.
+    name : str
+        The quantity, named in the error a negative ``pct`` raises.
+
+    Returns
+    -------
+    numpy.ndarray
+        The noisy values, of the shape of ``values``.
+
+    Examples
+    --------
+    >>> f = add_noise([100.0, 200.0, 300.0], 1.0, seed=0)
+    >>> bool(abs(f / [100.0, 200.0, 300.0] - 1).max() <= 0.01)
+    True
+    >>> bool((add_noise([100.0], 1.0, seed=0) == f[:1]).all())
+    True
+    """
     if pct < 0:
         raise ValueError(f"{name} noise level must be a non-negative percentage, got {pct}")
     v = np.asarray(values)
@@ -41,7 +65,15 @@ def noisy_frfs(H, pct: float, seed=None) -> np.ndarray:
 
 @dataclass(frozen=True)
 class Noise:
-    """Noise levels in percent for frequencies, mode shapes and FRFs (thesis eq. 5.72-5.74)."""
+    """Noise levels in percent for frequencies, mode shapes and FRFs (thesis eq. 5.72-5.74).
+
+    Examples
+    --------
+    >>> Noise.parse("f=0.2,shape=2")
+    Noise(frequency_pct=0.2, shape_pct=2.0, frf_pct=0.0)
+    >>> Noise.parse("1")
+    Noise(frequency_pct=1.0, shape_pct=1.0, frf_pct=1.0)
+    """
 
     frequency_pct: float = 0.0
     shape_pct: float = 0.0

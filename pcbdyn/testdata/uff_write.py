@@ -140,6 +140,16 @@ def frf58(frfs: FRFs, i: int, j: int, binary: bool) -> bytes:
 def write_uff(path, data: TestData, binary: bool | None = None, geometry: str = "2411") -> None:
     """Write units (164, SI), points (2411, or 15), modes (55) and FRFs (58/58b) atomically.
 
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The Universal File written.
+    data : TestData
+        Points, and modes and/or FRFs (:func:`pcbdyn.testdata.simulate.simulate_on_model` makes one);
+        :func:`pcbdyn.testdata.read_uff` has an example of both.
+
+    Notes
+    -----
     ``binary``: FRFs as 58b; None chooses ASCII 58 unless the frequency axis is uneven or its start
     and step would lose digits in the ASCII header. ``geometry``: "2411" (double precision) or "15"
     (single precision, for older tools). The precision of each dataset is in the module notes.
