@@ -24,6 +24,7 @@ from matplotlib.path import Path as PolyPath
 
 from .. import targets
 from ..fe import BeamProperty, EdgeSpringProperty, MassProperty, SpringProperty
+from ..fe.model import SHELL_TYPES
 from .entries import BoardError, RibSection
 
 
@@ -126,7 +127,7 @@ def effect_sets(board, mesh, q: dict, makers: dict) -> list:
         path = PolyPath(e.polygon)
         for name in list(makers):
             mk = makers[name]
-            if mk.etype not in ("quad4", "tri3") or not len(mk.conn):
+            if mk.etype not in SHELL_TYPES or not len(mk.conn):
                 continue
             inside = path.contains_points(mesh.nodes[mk.conn][:, :, :2].mean(axis=1))
             if not inside.any():

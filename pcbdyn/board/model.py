@@ -22,6 +22,7 @@ from ..components import models as parts
 from ..domain import check_mesh_size as check_size
 from ..domain import configuration_of
 from ..fe import Model
+from ..fe.model import SHELL_TYPES
 from ..fe.parametric import ParametricModel, SetMaker
 from ..fixtures import supports
 from . import effects
@@ -147,7 +148,7 @@ def build_model(board, config: str | None = None, mesh_size: float | None = None
     masses += [(targets.member(targets.entry("configurations", cfg.name), m.name), m) for m in (cfg.masses if cfg else [])]
     for name, m in masses:
         node = point_nodes[name]
-        shells = [(t, mesh.all_cells(t)) for t in ("quad4", "tri3")]
+        shells = [(t, mesh.all_cells(t)) for t in SHELL_TYPES]
         add(*supports.point_mass(name, node, m, q, supports.mass_footprint(mesh.nodes, shells, node, m.mass, m.inertia)))
     for mk in effects.effect_sets(board, mesh, q, makers):
         add(*mk)

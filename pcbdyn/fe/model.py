@@ -11,6 +11,8 @@ from .mesh import NDOF, dof_index
 #: nodes per cell for each element type
 NODES_PER_CELL = {"quad4": 4, "tri3": 3, "beam2": 2, "edge_spring": 2, "edge_joint": 4, "mass": 1,
                    "embedded_beam2": 8}
+#: the shell element types (plates: bending and membrane), in the order sets of them are made
+SHELL_TYPES = ("quad4", "tri3")
 
 
 class ModelError(ValueError):

@@ -38,6 +38,8 @@ def test_each_concept_has_one_home():
     assert [h.split(":")[0] for h in text(r"replace\(\w+, sets=|Model\([\w.]+\.nodes, ")] == ["pcbdyn/fe/model.py"]
     assert [h.split(":")[0] for h in text(r"^\s*def (?:add_noise|noisy_\w+|_perturb)\(")] == ["pcbdyn/testdata/noise.py"] * 4
     assert [h.split(":")[0] for h in text(r"\.uniform\(-1\.0, 1\.0")] == ["pcbdyn/testdata/noise.py"]
+    assert [h.split(":")[0] for h in text(r"[\"']quad4[\"'], [\"']tri3[\"']|[\"']tri3[\"'], [\"']quad4[\"']")] == [
+        "pcbdyn/fe/model.py"]  # SHELL_TYPES
 
 
 def _built_target(node) -> bool:
