@@ -20,10 +20,10 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 import numpy as np  # noqa: E402
 
 from pcbdyn.board import load_board  # noqa: E402
-from pcbdyn.fe.modal import solve_modes as fe_modes  # noqa: E402
+from pcbdyn.fe.modal import solve_modes  # noqa: E402
 from pcbdyn.updating import build_equations, solve_bounded  # noqa: E402
 from pcbdyn.problems import UpdateProblem  # noqa: E402
-from pcbdyn.testdata import Modes  # noqa: E402
+from pcbdyn.testdata import MeasuredModes  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -46,7 +46,7 @@ def bench(name, board, n_modes, points=None):
     prob = UpdateProblem(board)
     sysm = prob.system(None)
     t = time.perf_counter()
-    modes = fe_modes(sysm.pm.model, n_modes=n_modes)
+    modes = solve_modes(sysm.pm.model, n_modes=n_modes)
     t_modal = time.perf_counter() - t
     p = prob.p0 * 1.0001
     bm = sysm.at(p)
@@ -58,7 +58,7 @@ def bench(name, board, n_modes, points=None):
     t = time.perf_counter()
     K, M, dKs, dMs = sysm.model(p)
     t_sens = time.perf_counter() - t
-    cfg = prob.configuration(None, Modes.frequencies_only(modes.frequencies * 1.01), "freq")
+    cfg = prob.configuration(None, MeasuredModes.frequencies_only(modes.frequencies * 1.01), "freq")
     t = time.perf_counter()
     (A, b), _, _ = build_equations([cfg], p)  # model(p) cached: modes + equations
     t_eq = time.perf_counter() - t
@@ -79,7 +79,7 @@ def bench(name, board, n_modes, points=None):
         pts, dofs = read_points_csv(points)
         xyz = pts.xyz[pts.index(dofs.point_ids)]
         shapes = np.asarray(model_probe(sysm.pm.model, xyz, dofs.directions).P @ modes.shapes)
-        meas = Modes(pts, dofs, modes.frequencies * 1.01, shapes)
+        meas = MeasuredModes(pts, dofs, modes.frequencies * 1.01, shapes)
         qms = prob.mode_configurations(None, meas, "qms")
         t = time.perf_counter()
         build_equations(qms, p)
@@ -98,7 +98,7 @@ def qms_card() -> None:
     tests = []
     for k, c in enumerate([None, "c2", "c3"]):
         pm = card.build(c, mesh_size=card.mesh_size / 2).with_parameters({"t_PGA": 4.55e-3, "t_CQFP": 4.095e-3})
-        td = simulate_on_model(pm.model, fe_modes(pm.model, n_modes=7), pts, dofs,
+        td = simulate_on_model(pm.model, solve_modes(pm.model, n_modes=7), pts, dofs,
                                noise=Noise(frequency_pct=0.2, shape_pct=2.0), seed=k)
         tests.append((c, td.modes))
     load, wall, cpu = os.getloadavg()[0], time.perf_counter(), time.process_time()

@@ -106,6 +106,37 @@ class Target:
         return KINDS[self.collection, self.attribute]
 
 
+def entry(collection: str, name: str) -> str:
+    """``<collection>.<name>`` (``components.U1``, ``fixtures.guide``): one entry of an array of tables.
+    Its targets start with it, and a model names the element sets and the points the entry makes
+    after it. With :func:`target` and :func:`member`, the one place these names are built."""
+    return f"{collection}.{name}"
+
+
+def member(entry_name: str, part: str) -> str:
+    """``<entry>.<part>``: a quantity of the entry named ``entry_name`` (made by :func:`entry`), a target
+    when the entry's collection has that kind (``masses.m1.mass``) and a quantity no parameter reaches
+    otherwise (``configurations.drop.m1.mass``); or one of the entry's element sets
+    (``line_masses.l1.3``, ``regions.r1.board``)."""
+    return f"{entry_name}.{part}"
+
+
+def prefix(collection: str, name: str) -> str:
+    """``<collection>.<name>.``: what every name under the entry starts with (its quantities, sets and
+    points); a structure nested in another (a card in a box, ``cards.card1.``) has its own names
+    prefixed with it."""
+    return member(entry(collection, name), "")
+
+
+def target(collection: str, name: str | None, attribute: str) -> str:
+    """The target ``<collection>.<name>.<attribute>`` (``components.U1.mass``), or ``<table>.<attribute>``
+    (``board.E``) for a table, whose ``name`` is None. A kind :data:`KINDS` does not know is a
+    TargetError: a misspelt target would make a quantity no parameter reaches."""
+    if (collection, attribute) not in KINDS or (collection in TABLES) != (name is None):
+        raise TargetError(f"{collection}.{name}.{attribute} is not a target; targets are {known()}")
+    return str(Target(collection, name, attribute))
+
+
 def known(collections=None) -> str:
     """The target patterns of ``collections`` (default all), for messages."""
     return ", ".join(k.pattern for k in KINDS.values() if collections is None or k.collection in collections)

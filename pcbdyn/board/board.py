@@ -103,7 +103,35 @@ class Board(Configured):
 
     # -------------------------------------------------------------------- domain-model interface
     def build(self, config: str | None = None, mesh_size: float | None = None, shared_mesh: bool = False) -> BoardModel:
-        """The FE model of configuration ``config`` (None: the base one); see :func:`.model.build_model`."""
+        """The FE model of configuration ``config`` as a function of the board's quantities.
+
+        Parameters
+        ----------
+        config : str, optional
+            A ``[[configurations]]`` name (None: the base configuration).
+        mesh_size : float, optional
+            Element size [m] (default: the board's ``mesh_size``).
+        shared_mesh : bool
+            Mesh every configuration's points, so that all configurations share one mesh.
+
+        Returns
+        -------
+        BoardModel
+            A :class:`pcbdyn.fe.parametric.ParametricModel`: ``model`` (the :class:`pcbdyn.fe.Model`),
+            ``parameters`` (the ``[[parameters]]``), ``with_parameters({name: value})`` (a copy at
+            other values, SI) and ``point_nodes``. See :func:`.model.build_model`.
+
+        Examples
+        --------
+        >>> from pcbdyn.fe.modal import solve_modes
+        >>> card = load_board("examples/six_part_card/board.toml").build()
+        >>> sorted(card.parameters)
+        ['E_board', 't_CQFP', 't_JLCC', 't_PGA']
+        >>> f = solve_modes(card.model, n_modes=2).frequencies
+        >>> thicker = solve_modes(card.with_parameters({"t_PGA": 4.2e-3}).model, n_modes=2).frequencies
+        >>> bool(thicker[0] > f[0])
+        True
+        """
         return build_model(self, config, mesh_size, shared_mesh)
 
     def check_points(self, points, source) -> None:
@@ -154,7 +182,27 @@ def smeared_density(board: Board, c: Component) -> float:
 
 
 def load_board(path) -> Board:
-    """Read and validate a board.toml."""
+    """Read and validate a board.toml (the format: docs/board-toml.md).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The board.toml; the component library and any stackup it names are found from it.
+
+    Returns
+    -------
+    Board
+        The board's outline, plate, parts, fixtures, effects, configurations and ``[[parameters]]``,
+        in SI. A :class:`BoardError` names the file, the field and the fix of the first mistake.
+
+    Examples
+    --------
+    >>> board = load_board("examples/six_part_card/board.toml")
+    >>> [p.name for p in board.parameters]
+    ['t_PGA', 't_JLCC', 't_CQFP', 'E_board']
+    >>> board.thickness                              # SI: m
+    0.0028
+    """
     return parse_board(read_toml(path, BoardError)[1], Path(path))
 
 

@@ -22,7 +22,9 @@ from dataclasses import dataclass
 import numpy as np
 from matplotlib.path import Path as PolyPath
 
+from .. import targets
 from ..fe import BeamProperty, EdgeSpringProperty, MassProperty, SpringProperty
+from ..fe.model import SHELL_TYPES
 from .entries import BoardError, RibSection
 
 
@@ -91,14 +93,14 @@ def _path_edges(board, mesh, path, where) -> np.ndarray:
 def apply_fixture(board, mesh, f, point_nodes: dict, q: dict) -> list:
     """Makers [(name, etype, conn, deps, make)] of a point_spring or edge_spring fixture."""
     if f.type == "point_spring":
-        key = f"fixtures.{f.name}.k"
+        key, name = targets.target("fixtures", f.name, "k"), targets.entry("fixtures", f.name)
         q.setdefault(key, float(f.k))
-        return [(f"fixtures.{f.name}", "spring", [[point_nodes[f"fixtures.{f.name}"]]], (key,),
+        return [(name, "spring", [[point_nodes[name]]], (key,),
                  lambda q, key=key: SpringProperty(k=(0.0, 0.0, q[key], 0.0, 0.0, 0.0)))]
-    key = f"fixtures.{f.name}.k_rot"
+    key, name = targets.target("fixtures", f.name, "k_rot"), targets.entry("fixtures", f.name)
     q.setdefault(key, float(f.k_rot))
-    chain = _chain(board, mesh, f.segment, f"fixtures.{f.name}")
-    return [(f"fixtures.{f.name}", "edge_spring", np.column_stack([chain[:-1], chain[1:]]), (key,),
+    chain = _chain(board, mesh, f.segment, name)
+    return [(name, "edge_spring", np.column_stack([chain[:-1], chain[1:]]), (key,),
              lambda q, key=key: edge_spring_property(q[key]))]
 
 
@@ -107,30 +109,30 @@ def effect_sets(board, mesh, q: dict, makers: dict) -> list:
     in place (their cells inside a region move to ``regions.<name>.<set>``)."""
     out = []
     for e in board.line_masses:
-        key = f"line_masses.{e.name}.mass"
+        key, name = targets.target("line_masses", e.name, "mass"), targets.entry("line_masses", e.name)
         q.setdefault(key, e.mass)
-        chain = _chain(board, mesh, e.segment, f"line_masses.{e.name}")
+        chain = _chain(board, mesh, e.segment, name)
         for k, (n, w) in enumerate(zip(chain, tributary_weights(mesh.nodes[chain, :2]))):
-            out.append((f"line_masses.{e.name}.{k}", "mass", [[int(n)]], (key,),
+            out.append((targets.member(name, str(k)), "mass", [[int(n)]], (key,),
                         lambda q, key=key, w=w: MassProperty(q[key] * w)))
     for e in board.stiffeners:
-        key = f"stiffeners.{e.name}.EI"
+        key, name = targets.target("stiffeners", e.name, "EI"), targets.entry("stiffeners", e.name)
         q.setdefault(key, e.EI)
-        edges = _path_edges(board, mesh, e.path, f"stiffeners.{e.name}")
-        out.append((f"stiffeners.{e.name}", "beam2", edges, (key, "board.thickness"),
+        edges = _path_edges(board, mesh, e.path, name)
+        out.append((name, "beam2", edges, (key, "board.thickness"),
                     lambda q, key=key, s=e.section: rib_property(q[key], q.get("board.thickness", board.plate.t), s)))
     for e in board.regions:
-        key = f"regions.{e.name}.stiffness_factor"
+        key = targets.target("regions", e.name, "stiffness_factor")
         q.setdefault(key, e.stiffness_factor)
         path = PolyPath(e.polygon)
         for name in list(makers):
             mk = makers[name]
-            if mk.etype not in ("quad4", "tri3") or not len(mk.conn):
+            if mk.etype not in SHELL_TYPES or not len(mk.conn):
                 continue
             inside = path.contains_points(mesh.nodes[mk.conn][:, :, :2].mean(axis=1))
             if not inside.any():
                 continue
-            new = f"regions.{e.name}.{name}"
+            new = targets.member(targets.entry("regions", e.name), name)
             makers[new] = type(mk)(mk.etype, mk.conn[inside], mk.deps + (key,),
                                    lambda q, key=key, make=mk.make: ScaledShell(make(q), q[key]))
             if inside.all():

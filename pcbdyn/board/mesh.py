@@ -22,6 +22,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..fe.model import SHELL_TYPES
+
 _LOCK = threading.Lock()  # gmsh is one global state per process (a child's, or this one's without fork)
 
 
@@ -43,7 +45,7 @@ class BoardMesh:
         """Unique element edges (2-node cells) lying on the line x=value (axis 0) or y=value (axis 1)."""
         on = np.abs(self.nodes[:, axis] - value) < tol
         edges = []
-        for etype in ("quad4", "tri3"):
+        for etype in SHELL_TYPES:
             conn = self.all_cells(etype)
             if not len(conn):
                 continue
@@ -67,7 +69,7 @@ class BoardMesh:
         if chain.size < 2 or abs(s[chain[0]]) > tol or abs(s[chain[-1]] - L) > tol:
             raise RuntimeError(f"segment {p0.tolist()} -> {p1.tolist()} m is not a line of mesh nodes")
         known = set()
-        for etype in ("quad4", "tri3"):
+        for etype in SHELL_TYPES:
             conn = self.all_cells(etype)
             if len(conn):
                 e = np.sort(np.stack([conn, np.roll(conn, -1, axis=1)], axis=-1).reshape(-1, 2), axis=1)

@@ -17,10 +17,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import targets
 from ..components import models as parts
 from ..domain import check_mesh_size as check_size
 from ..domain import configuration_of
 from ..fe import Model
+from ..fe.model import SHELL_TYPES
 from ..fe.parametric import ParametricModel, SetMaker
 from ..fixtures import supports
 from . import effects
@@ -46,7 +48,7 @@ class BoardModel(ParametricModel):
         """(suspects {name: node}, footprints {name: polygon [m]}, plate thickness [m]) for a diagnosis:
         measurement points and declared masses are prime suspects, part footprints candidate regions."""
         suspects = {n: v for n, v in self.point_nodes.items() if n.startswith(("points.", "masses."))}
-        footprints = {f"components.{c.ref}": c.corners() for c in self.board.components}
+        footprints = {targets.entry("components", c.ref): c.corners() for c in self.board.components}
         return suspects, footprints, self.board.thickness
 
 
@@ -59,11 +61,11 @@ def check_mesh_size(board, size: float) -> None:
 def mesh_points(board, config, shared: bool = False) -> list:
     """Named points that must be mesh nodes; ``shared``: those of every configuration, so that all
     configurations mesh alike."""
-    pts = [(f"masses.{m.name}", m.at) for m in board.masses]
+    pts = [(targets.entry("masses", m.name), m.at) for m in board.masses]
     for c in (board.configurations if shared else [config] if config is not None else []):
-        pts += [(f"configurations.{c.name}.{m.name}", m.at) for m in c.masses]
+        pts += [(targets.member(targets.entry("configurations", c.name), m.name), m.at) for m in c.masses]
     pts += [(f"points.{i + 1}", p) for i, p in enumerate(board.points)]
-    pts += [(f"fixtures.{f.name}", f.at) for f in board.fixtures if f.type == "point_spring"]
+    pts += [(targets.entry("fixtures", f.name), f.at) for f in board.fixtures if f.type == "point_spring"]
     return pts
 
 
@@ -86,7 +88,7 @@ def build_model(board, config: str | None = None, mesh_size: float | None = None
     cfg = configuration_of(board, config, BoardError)
     check_mesh_size(board, mesh_size or board.mesh_size)
     named = mesh_points(board, cfg, shared_mesh)
-    regions = [(f"components.{c.ref}", c.corners()) for c in board.components] if board.smear == "none" else []
+    regions = [(targets.entry("components", c.ref), c.corners()) for c in board.components] if board.smear == "none" else []
     strips = [s for f in board.fixtures if f.edge is not None
               if (s := supports.strip_polygon(board.outline, f)) is not None]
     strips += [supports.pad_polygon(f) for f in board.fixtures if f.type == "standoff"]
@@ -109,24 +111,24 @@ def build_model(board, config: str | None = None, mesh_size: float | None = None
 
     def add_shells(name, cells, deps, make):
         for etype, conn in cells.items():
-            add(name if etype == "quad4" else f"{name}.{etype}", etype, conn, deps, make)
+            add(name if etype == "quad4" else targets.member(name, etype), etype, conn, deps, make)
 
     nsm = parts.global_nsm(board)
     add_shells("board", mesh.cells.get("board", {}), parts.board_keys(board),
                lambda q: parts.base_property(board, q, nsm))
     for c in board.components if board.smear == "none" else []:
-        name = f"components.{c.ref}"
+        name = targets.entry("components", c.ref)
         add_shells(name, mesh.cells[name], parts.region_keys(board, c),
                    lambda q, c=c: parts.region_property(board, c, q))
     model = Model(mesh.nodes.copy())
     for c in board.components if board.smear == "none" else []:
         if c.model == "lumped":
-            name = f"components.{c.ref}"
+            name = targets.entry("components", c.ref)
             centre = int(model.add_nodes([[c.at[0], c.at[1], 0.0]])[0])
             footprint = np.unique(np.concatenate([conn.ravel() for conn in mesh.cells[name].values()]))
             parts.follow_footprint(model, centre, footprint)
             point_nodes[name] = centre
-            add(f"{name}.mass", "mass", [[centre]], (f"{name}.mass",), lambda q, c=c: parts.lumped_mass(c, q))
+            add(targets.member(name, "mass"), "mass", [[centre]], (targets.target("components", c.ref, "mass"),), lambda q, c=c: parts.lumped_mass(c, q))
     supported = False
     for f in board.fixtures:
         if f.edge is not None:
@@ -135,18 +137,18 @@ def build_model(board, config: str | None = None, mesh_size: float | None = None
             supported = True
         elif f.type == "standoff":
             centre = int(model.add_nodes([[f.at[0], f.at[1], 0.0]])[0])
-            point_nodes[f"fixtures.{f.name}"] = centre
+            point_nodes[targets.entry("fixtures", f.name)] = centre
             for mk in supports.apply_standoff(model, centre, f, q, grounded=not housed):
                 add(*mk)
             supported = True
         elif f.type in ("point_spring", "edge_spring"):  # springs to ground that leave rigid motions free
             for mk in effects.apply_fixture(board, mesh, f, point_nodes, q):
                 add(*mk)
-    masses = [(f"masses.{m.name}", m) for m in board.masses]
-    masses += [(f"configurations.{cfg.name}.{m.name}", m) for m in (cfg.masses if cfg else [])]
+    masses = [(targets.entry("masses", m.name), m) for m in board.masses]
+    masses += [(targets.member(targets.entry("configurations", cfg.name), m.name), m) for m in (cfg.masses if cfg else [])]
     for name, m in masses:
         node = point_nodes[name]
-        shells = [(t, mesh.all_cells(t)) for t in ("quad4", "tri3")]
+        shells = [(t, mesh.all_cells(t)) for t in SHELL_TYPES]
         add(*supports.point_mass(name, node, m, q, supports.mass_footprint(mesh.nodes, shells, node, m.mass, m.inertia)))
     for mk in effects.effect_sets(board, mesh, q, makers):
         add(*mk)

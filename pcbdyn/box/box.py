@@ -151,7 +151,7 @@ class Box(Configured):
         tail = dst.name[len(self.path.stem):] if dst.name.startswith(self.path.stem) else f".{dst.name}"
         doc = tomlkit.parse(self.path.read_text(encoding="utf-8"))
         for i, card in enumerate(self.cards):
-            own = {t.split(".", 2)[2]: v for t, v in assignments.items() if t.startswith(f"cards.{card.name}.")}
+            own = {t.split(".", 2)[2]: v for t, v in assignments.items() if t.startswith(targets.prefix("cards", card.name))}
             path = board = card.board.path
             if own:
                 path = board.with_name(board.stem + tail)

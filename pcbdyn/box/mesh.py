@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..board.mesh import generate_quads, gmsh_session, mesh_nodes, run_gmsh, surface_cells, tagged_nodes, used_nodes
+from ..fe.model import SHELL_TYPES
 
 
 @dataclass
@@ -33,7 +34,7 @@ class BoxMesh:
         """[(etype, conn)] of one plate's cells (all plates' when None)."""
         if plate is not None:
             return [(k, c) for k, c in self.cells[plate].items() if len(c)]
-        return [(k, self.all_cells(k)) for k in ("quad4", "tri3") if len(self.all_cells(k))]
+        return [(k, self.all_cells(k)) for k in SHELL_TYPES if len(self.all_cells(k))]
 
     def plate_nodes(self, plate: str) -> np.ndarray:
         return np.unique(np.concatenate([c.ravel() for _, c in self.shells(plate)]))

@@ -20,6 +20,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from .. import targets
 from ..domain import check_mesh_size, configuration_of
 from ..fe import EdgeSpringProperty, Model, OrthotropicShellProperty, ShellProperty, dof_index
 from ..fe.assembly import assemble
@@ -56,14 +57,14 @@ class BoxModel(ParametricModel):
         """(suspects {name: node}, footprints {name: plate corners (4, 3)}, thinnest plate [m]) for a
         diagnosis: the declared masses are prime suspects, the plates candidate regions."""
         suspects = {n: v for n, v in self.point_nodes.items() if n.startswith("masses.")}
-        footprints = {f"plates.{p.name}": p.corners() for p in self.box.plates}
+        footprints = {targets.entry("plates", p.name): p.corners() for p in self.box.plates}
         return suspects, footprints, min(p.thickness for p in self.box.plates)
 
     def share_groups(self) -> dict:
         """{label: element sets} of the parts a mode's energy is shared among: the plates (ribs with
         their plate)."""
-        return {p.name: [n for n in self.model.sets if n.startswith((f"plates.{p.name}", *(
-            f"ribs.{r.name}" for r in self.box.ribs if r.plate == p.name)))] for p in self.box.plates}
+        return {p.name: [n for n in self.model.sets if n.startswith((targets.entry("plates", p.name), *(
+            targets.entry("ribs", r.name) for r in self.box.ribs if r.plate == p.name)))] for p in self.box.plates}
 
     def mode_shares(self, shapes) -> np.ndarray:
         """(n_parts, n_modes): each part's (:meth:`share_groups`) share of each mode's kinetic energy."""
@@ -107,34 +108,33 @@ def _tie_across(model, slave: int, master, e) -> None:
 
 def _shell(plate, q: dict):
     """The plate's shell property at quantities ``q``."""
-    key = f"plates.{plate.name}"
+    rho, t = q[targets.target("plates", plate.name, "rho")], q[targets.target("plates", plate.name, "thickness")]
     mat, shear = plate.material, 5.0 / 6.0 * q[SHEAR_KEY]
     if mat.orthotropic:
-        return OrthotropicShellProperty(*mat.E, mat.nu, q[f"{key}.rho"], q[f"{key}.thickness"], axis=tuple(plate.u),
-                                        shear_factor=shear)
-    return ShellProperty(q[f"{key}.E"], mat.nu, q[f"{key}.rho"], q[f"{key}.thickness"], shear_factor=shear)
+        return OrthotropicShellProperty(*mat.E, mat.nu, rho, t, axis=tuple(plate.u), shear_factor=shear)
+    return ShellProperty(q[targets.target("plates", plate.name, "E")], mat.nu, rho, t, shear_factor=shear)
 
 
 def initial_quantities(box) -> dict:
     """Every quantity a parameter may address, at the box's values."""
     q = {SHEAR_KEY: 1.0}
     for p in box.plates:
-        q[f"plates.{p.name}.thickness"] = p.thickness
-        q[f"plates.{p.name}.rho"] = p.material.rho
+        q[targets.target("plates", p.name, "thickness")] = p.thickness
+        q[targets.target("plates", p.name, "rho")] = p.material.rho
         if not p.material.orthotropic:
-            q[f"plates.{p.name}.E"] = p.material.E
+            q[targets.target("plates", p.name, "E")] = p.material.E
     for r in box.ribs:
-        q[f"ribs.{r.name}.height"], q[f"ribs.{r.name}.width"] = r.height, r.width
+        q[targets.target("ribs", r.name, "height")], q[targets.target("ribs", r.name, "width")] = r.height, r.width
     for j in box.joints:
-        q[f"joints.{j.name}.k_rot"] = j.k_rot
+        q[targets.target("joints", j.name, "k_rot")] = j.k_rot
     return q
 
 
 def _named_points(box, config, shared: bool) -> list:
     """[(name, plate, xyz)] of the points that must be nodes: point masses."""
-    masses = [(f"masses.{m.name}", m) for m in box.masses]
+    masses = [(targets.entry("masses", m.name), m) for m in box.masses]
     for c in (box.configurations if shared else [config] if config is not None else []):
-        masses += [(f"configurations.{c.name}.{m.name}", m) for m in c.masses]
+        masses += [(targets.member(targets.entry("configurations", c.name), m.name), m) for m in c.masses]
     return [(name, m.plate, box.plate(m.plate).point(*m.at)) for name, m in masses]
 
 
@@ -156,8 +156,8 @@ def _joint_nodes(box, mesh, model, plate_map: dict, q: dict, makers: dict) -> No
                 _tie_across(model, int(copy), int(orig), c.direction)
             other = plate_map[b.name][chain]
             cells = np.column_stack([chain[:-1], chain[1:], other[:-1], other[1:]])
-            key = f"joints.{j.name}.k_rot"
-            name = f"joints.{j.name}" if f"joints.{j.name}" not in makers else f"joints.{j.name}#{len(makers)}"
+            key, name = targets.target("joints", j.name, "k_rot"), targets.entry("joints", j.name)
+            name = name if name not in makers else f"{name}#{len(makers)}"
             makers[name] = SetMaker("edge_joint", cells, (key,), lambda q, key=key, n=tuple(a.normal):
                                     EdgeSpringProperty(k=(0.0, 0.0, 0.0, q[key], 0.0, 0.0), normal=n))
 
@@ -216,22 +216,25 @@ def build_model(box, config: str | None = None, mesh_size: float | None = None, 
     plate_map = {p.name: np.arange(len(mesh.nodes)) for p in box.plates}
     _joint_nodes(box, mesh, model, plate_map, q, makers)
     for p in box.plates:
-        keys = (SHEAR_KEY,) + tuple(k for k in q if k.startswith(f"plates.{p.name}."))
+        own = (targets.target("plates", p.name, a) for a in ("thickness", "rho", "E"))
+        keys = (SHEAR_KEY,) + tuple(k for k in own if k in q)
         for etype, conn in mesh.cells[p.name].items():
-            name = f"plates.{p.name}" if etype == "quad4" else f"plates.{p.name}.{etype}"
+            name = targets.entry("plates", p.name)
+            name = name if etype == "quad4" else targets.member(name, etype)
             makers[name] = SetMaker(etype, plate_map[p.name][conn], keys, lambda q, p=p: _shell(p, q))
     chains = [plate_map[r.plate][mesh.chain(*line, mesh.plate_nodes(r.plate))] for r, line in zip(box.ribs, ribs)]
     if box.rib_model == "beam":
         for r, chain in zip(box.ribs, chains):
             plate = box.plate(r.plate)
             m = plate.normal * (1.0 if r.side == "+n" else -1.0)
-            keys = (f"ribs.{r.name}.height", f"ribs.{r.name}.width", f"plates.{plate.name}.thickness")
-            makers[f"ribs.{r.name}"] = SetMaker(
+            keys = (targets.target("ribs", r.name, "height"), targets.target("ribs", r.name, "width"),
+                    targets.target("plates", plate.name, "thickness"))
+            makers[targets.entry("ribs", r.name)] = SetMaker(
                 "beam2", np.column_stack([chain[:-1], chain[1:]]), keys,
                 lambda q, r=r, m=m, k=keys: rib_section(r.material.E, r.material.nu, r.material.rho, q[k[0]], q[k[1]],
                                                         m, q[k[2]]))
     else:
-        strips = [(f"ribs.{r.name}", chain, box.plate(r.plate).normal * (1.0 if r.side == "+n" else -1.0),
+        strips = [(targets.entry("ribs", r.name), chain, box.plate(r.plate).normal * (1.0 if r.side == "+n" else -1.0),
                    box.plate(r.plate).thickness, r.height, r.width, r.material) for r, chain in zip(box.ribs, chains)]
         made, ends = add_strips(model, strips, size)
         for name, conn, prop in made:
@@ -240,8 +243,8 @@ def build_model(box, config: str | None = None, mesh_size: float | None = None, 
         hold_ends(model, ends, {int(n): s.type for s in box.supports for n in _edge_nodes(box, mesh, plate_map, s)})
     _hold(box, mesh, model, plate_map)
     point_nodes = {name: int(plate_map[plate][n]) for (name, plate, _), n in zip(named, mesh.point_nodes)}
-    masses = [(f"masses.{m.name}", m) for m in box.masses] + [(f"configurations.{cfg.name}.{m.name}", m)
-                                                               for m in (cfg.masses if cfg else [])]
+    masses = [(targets.entry("masses", m.name), m) for m in box.masses]
+    masses += [(targets.member(targets.entry("configurations", cfg.name), m.name), m) for m in (cfg.masses if cfg else [])]
     for name, m in masses:
         n, etype, conn, deps, make = supports.point_mass(name, point_nodes[name], m, q)
         makers[n] = SetMaker(etype, np.asarray(conn, dtype=np.int64), deps, make)

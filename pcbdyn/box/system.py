@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import targets
 from ..board.model import build_model as build_card
 from ..fe import EdgeSpringProperty, SpringProperty, dof_index
 from ..fe.assembly import assemble
@@ -82,7 +83,7 @@ class SystemModel(BoxModel):
     def share_groups(self) -> dict:
         """The plates (ribs with their plate) and the cards, each one part of a mode's energy."""
         groups = super().share_groups()
-        groups.update({name: [n for n in self.model.sets if n.startswith(f"cards.{name}.")] for name in self.cards})
+        groups.update({name: [n for n in self.model.sets if n.startswith(targets.prefix("cards", name))] for name in self.cards})
         return groups
 
     def reduced_parts(self, modes: int | None = None) -> list:
@@ -136,7 +137,7 @@ def _interfaces(box, card, local) -> list:
     for hold in box.holds[card.name]:
         f, plate = hold.fixture, box.plate(hold.plate)
         if f.type == "standoff":
-            c = np.array([local.point_nodes[f"fixtures.{f.name}"]])
+            c = np.array([local.point_nodes[targets.entry("fixtures", f.name)]])
             x = card.point(local.model.nodes[c])
             if hold.rib is not None:
                 rib = box.rib(hold.rib)
@@ -151,10 +152,15 @@ def _interfaces(box, card, local) -> list:
     return out
 
 
+def _hold_point(card, i: int, k: int) -> str:
+    """The name of housing point ``k`` of hold ``i`` of ``card`` (its interface with the housing)."""
+    return targets.prefix("cards", card.name) + f"holds.{i}.{k}"
+
+
 def _place(model, q, makers, point_nodes, card, local) -> PlacedCard:
     """Add card ``local`` (its BoardModel) to the system ``model`` in its frame; its quantities, makers
     and named points under ``cards.<name>.``."""
-    prefix = f"cards.{card.name}."
+    prefix = targets.prefix("cards", card.name)
     first = model.n_nodes
     K, M = assemble(local.model)
     nodes, fixed, mpcs = placed(local.model, card.R, card.origin, first, idle_dofs(local.model, K, M))
@@ -182,7 +188,7 @@ def _hold(model, q, makers, pc, hold, c_nodes, strip, h_nodes, taken: set) -> No
     ``hold.fixture`` says (see the module doc); ``taken``: card nodes already held by another fixture
     (a corner two fixtures share keeps the first one's ties)."""
     f = hold.fixture
-    key = f"cards.{pc.card.name}.fixtures.{f.name}"
+    key = targets.prefix("cards", pc.card.name) + targets.entry("fixtures", f.name)
     free = np.array([int(c) not in taken for c in c_nodes])
     twins = _twins(model, c_nodes, h_nodes)
     for c, t in zip(c_nodes[free], twins[free]):
@@ -192,9 +198,10 @@ def _hold(model, q, makers, pc, hold, c_nodes, strip, h_nodes, taken: set) -> No
     taken.update(int(c) for c in c_nodes)
     if f.type == "standoff":
         if f.k != "rigid":
-            q[f"{key}.k"] = float(f.k)
-            makers[key] = SetMaker("spring", np.column_stack([c_nodes, twins]), (f"{key}.k",),
-                                   lambda q, k=f"{key}.k": SpringProperty(k=(q[k], q[k], q[k], 0.0, 0.0, 0.0)))
+            k_key = targets.prefix("cards", pc.card.name) + targets.target("fixtures", f.name, "k")
+            q[k_key] = float(f.k)
+            makers[key] = SetMaker("spring", np.column_stack([c_nodes, twins]), (k_key,),
+                                   lambda q, k=k_key: SpringProperty(k=(q[k], q[k], q[k], 0.0, 0.0, 0.0)))
         return
     rot = edge_rotation(f)
     e = model.nodes[c_nodes[-1]] - model.nodes[c_nodes[0]]
@@ -206,9 +213,10 @@ def _hold(model, q, makers, pc, hold, c_nodes, strip, h_nodes, taken: set) -> No
         else:
             _tie_across(model, int(c), int(t), e)
     if not isinstance(rot, str):
-        q[f"{key}.k_rot"] = float(rot)
+        k_key = targets.prefix("cards", pc.card.name) + targets.target("fixtures", f.name, "k_rot")
+        q[k_key] = float(rot)
         cells = np.column_stack([c_nodes[:-1], c_nodes[1:], twins[:-1], twins[1:]])
-        makers[key] = SetMaker("edge_joint", cells, (f"{key}.k_rot",), lambda q, k=f"{key}.k_rot", n=tuple(
+        makers[key] = SetMaker("edge_joint", cells, (k_key,), lambda q, k=k_key, n=tuple(
             pc.card.normal): EdgeSpringProperty(k=(0.0, 0.0, 0.0, q[k], 0.0, 0.0), normal=n))
     along = (model.nodes[c_nodes] - model.nodes[c_nodes[0]]) @ e
     for s in strip:
@@ -252,7 +260,7 @@ def build_system(box, config: str | None = None, mesh_size: float | None = None,
         locals_[card.name] = local
         faces[card.name] = _interfaces(box, card, local)
         for i, (hold, _, _, h) in enumerate(faces[card.name]):
-            points += [(f"cards.{card.name}.holds.{i}.{k}", hold.plate, x) for k, x in enumerate(h)]
+            points += [(_hold_point(card, i, k), hold.plate, x) for k, x in enumerate(h)]
             if len(h) > 1:
                 lines.append((h[0], h[-1]))
     bm = build_model(box, config, mesh_size, shared_mesh, points=points, lines=lines, bind=False)
@@ -263,7 +271,7 @@ def build_system(box, config: str | None = None, mesh_size: float | None = None,
         pc = _place(model, q, makers, point_nodes, card, locals_[card.name])
         taken: set = set()
         for i, (hold, c, strip, h) in enumerate(faces[card.name]):
-            h_nodes = np.array([bm.point_nodes[f"cards.{card.name}.holds.{i}.{k}"] for k in range(len(h))])
+            h_nodes = np.array([bm.point_nodes[_hold_point(card, i, k)] for k in range(len(h))])
             _hold(model, q, makers, pc, hold, c + pc.first, strip + pc.first, h_nodes, taken)
             pc.interface = np.union1d(pc.interface, c + pc.first)
             if len(h) > 1:

@@ -16,6 +16,7 @@ def analyse(board, config, stds: dict | None = None) -> dict:
     (``stds``: the library's family standard deviations, :func:`pcbdyn.problems.uncertainty.library_uncertainty`,
     propagated to each frequency)."""
     from ..fe.effective_mass import effective_mass
+    from ..fe.model import SHELL_TYPES
     from ..report.modes import format_table, free_note, mode_table
 
     label = config or "base"
@@ -34,7 +35,7 @@ def analyse(board, config, stds: dict | None = None) -> dict:
         std = frequency_std(bm, modes, stds)
         table.insert(2, "+- sd [Hz]", std)
     click.echo(f"\n{board.name} [{label}]: {mass * 1e3:.2f} g, {bm.model.n_dof} DOFs, "
-               f"{sum(len(es.conn) for es in bm.model.sets.values() if es.etype in ('quad4', 'tri3'))} shells"
+               f"{sum(len(es.conn) for es in bm.model.sets.values() if es.etype in SHELL_TYPES)} shells"
                + (f", {modes.n_rigid} rigid-body modes" if modes.n_rigid else ""))
     warning = empty_band(board, bm, modes, K, M)
     click.echo(f"warning: {warning}\n" if warning else format_table(table) + "\n")

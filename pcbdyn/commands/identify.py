@@ -30,7 +30,8 @@ def parse_select(text: str) -> list:
     return out
 
 
-def _mac(v) -> float | None:
+def _number_or_none(v) -> float | None:
+    """A JSON value: the float, or None (null) where there is none (NaN: a mode without that neighbour)."""
     return None if math.isnan(v) else float(v)
 
 
@@ -109,7 +110,7 @@ def command(frfs_uff, band, max_order, select, kind, points_file, out, chart, js
                            for p, d in zip(frfs.reference.point_ids, frfs.reference.directions)],
             "criteria": result.criteria, "notes": result.notes,
             "modes": [{"n": j + 1, "frequency_hz": float(m.frequencies[j]), "damping_ratio": float(m.damping[j]),
-                       **result.quality[j], "mac_neighbours": {"previous": _mac(result.mac_neighbours[j, 0]),
-                                                               "next": _mac(result.mac_neighbours[j, 1])}}
+                       **result.quality[j], "mac_neighbours": {"previous": _number_or_none(result.mac_neighbours[j, 0]),
+                                                               "next": _number_or_none(result.mac_neighbours[j, 1])}}
                       for j in range(m.n_modes)],
         })

@@ -29,6 +29,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from .. import targets
 from ..fe import MassProperty, ShellProperty
 
 
@@ -71,13 +72,17 @@ def global_nsm(board) -> float:
     return sum(c.mass for c in board.components) / board.outline.area()
 
 
+def _key(c, attribute: str) -> str:
+    """The target ``components.<ref>.<attribute>`` of part ``c``."""
+    return targets.target("components", c.ref, attribute)
+
+
 def region_keys(board, c) -> tuple:
-    key = f"components.{c.ref}"
     own = {
         "lumped": (),
-        "spread": (f"{key}.mass",),
-        "smeared_local": (f"{key}.E", f"{key}.rho"),
-        "equivalent_thickness": (f"{key}.thickness", f"{key}.mass"),
+        "spread": (_key(c, "mass"),),
+        "smeared_local": (_key(c, "E"), _key(c, "rho")),
+        "equivalent_thickness": (_key(c, "thickness"), _key(c, "mass")),
     }[c.model]
     if c.model == "smeared_local":  # its own E and density, at the board's thickness
         shared = (SHEAR_KEY,) + (("board.thickness",) if board.isotropic is not None else ())
@@ -88,22 +93,21 @@ def region_keys(board, c) -> tuple:
 
 def region_property(board, c, q: dict):
     """Shell property of the elements under part ``c``."""
-    key = f"components.{c.ref}"
     if c.model == "lumped":
         return base_property(board, q)
     if c.model == "spread":
-        return base_property(board, q, nsm=q[f"{key}.mass"] / c.area)
+        return base_property(board, q, nsm=q[_key(c, "mass")] / c.area)
     E, nu, m_b, t_b = board_isotropic(board, q)
     if c.model == "smeared_local":
-        return _sheared(ShellProperty(q[f"{key}.E"], nu, q[f"{key}.rho"], t_b), q)
-    T = q[f"{key}.thickness"]
-    rho = (q[f"{key}.mass"] + m_b * c.area) / (T * c.area)  # eq. 7.7
+        return _sheared(ShellProperty(q[_key(c, "E")], nu, q[_key(c, "rho")], t_b), q)
+    T = q[_key(c, "thickness")]
+    rho = (q[_key(c, "mass")] + m_b * c.area) / (T * c.area)  # eq. 7.7
     return _sheared(ShellProperty(E, nu, rho, T), q)
 
 
 def lumped_mass(c, q: dict) -> MassProperty:
     """Point mass of a lumped part with the in-plane-axis rotary inertia of a uniform a x b x h box."""
-    m = q[f"components.{c.ref}.mass"]
+    m = q[_key(c, "mass")]
     a, b = c.size
     h = c.height
     return MassProperty(m, (m * (b**2 + h**2) / 12.0, m * (a**2 + h**2) / 12.0, 0.0))
@@ -115,14 +119,13 @@ def initial_quantities(board) -> dict:
     if board.smear == "global":
         return q
     for c in board.components:
-        key = f"components.{c.ref}"
-        q[f"{key}.mass"] = c.mass
+        q[_key(c, "mass")] = c.mass
         if c.model == "equivalent_thickness":
-            q[f"{key}.thickness"] = c.thickness
+            q[_key(c, "thickness")] = c.thickness
         if c.model == "smeared_local":
-            E = board.quantity(f"{key}.E")
-            q[f"{key}.E"] = E if E is not None else (c.E if c.E is not None else board.plate.equivalent_isotropic()[0])
-            q[f"{key}.rho"] = board.quantity(f"{key}.rho")
+            E = board.quantity(_key(c, "E"))
+            q[_key(c, "E")] = E if E is not None else (c.E if c.E is not None else board.plate.equivalent_isotropic()[0])
+            q[_key(c, "rho")] = board.quantity(_key(c, "rho"))
     return q
 
 

@@ -46,11 +46,43 @@ def dof_labels(dofs) -> list:
 
 def correlate(test_modes, model, model_modes, min_mac: float = 0.5, close: float = 0.005, tol=None,
               sets=None) -> Correlation:
-    """Pair measured modes (:class:`pcbdyn.testdata.Modes`) with the modes of ``model``.
+    """Pair measured modes with the modes of ``model`` by MAC (thesis eq. 2.3) and give the COMAC
+    (eq. 2.4) of each measured DOF.
 
     The model is read at each test DOF through the shell shape functions (points off the model
     raise, naming them); pairing is by MAC with frequency as tie-breaker and best combinations for
     close model modes (:func:`pair_modes`); COMAC is over the pairs, with combinations applied.
+
+    Parameters
+    ----------
+    test_modes : pcbdyn.testdata.MeasuredModes
+        The measured modes, with shapes.
+    model : pcbdyn.fe.Model
+        The model (a board's: ``board.build().model``).
+    model_modes : pcbdyn.fe.modal.Modes
+        Its modes (:func:`pcbdyn.fe.modal.solve_modes`).
+    min_mac : float
+        Pairs below this MAC are left unpaired.
+
+    Returns
+    -------
+    Correlation
+        ``pairing.pairs`` (each with ``test``, ``model`` (0-based), ``df_pct``, ``mac``), the model at
+        the test DOFs and the COMAC.
+
+    Examples
+    --------
+    >>> from pcbdyn.board import load_board
+    >>> from pcbdyn.fe.modal import solve_modes
+    >>> from pcbdyn.testdata import read_points_csv
+    >>> from pcbdyn.testdata.simulate import simulate_on_model
+    >>> card = "examples/six_part_card/"
+    >>> model = load_board(card + "board.toml").build().model
+    >>> modes = solve_modes(model, n_modes=7)
+    >>> points, dofs = read_points_csv(card + "points.csv")
+    >>> test = simulate_on_model(model, modes, points, dofs).modes      # no noise: the model itself
+    >>> [(p.test + 1, p.model + 1, round(p.mac, 3)) for p in correlate(test, model, modes).pairing.pairs][:3]
+    [(1, 1, 1.0), (2, 2, 1.0), (3, 3, 1.0)]
     """
     probe = model_probe(model, test_modes.dof_xyz(), test_modes.dofs.directions, sets=sets, tol=tol)
     at = np.asarray(probe.P @ model_modes.shapes)

@@ -22,9 +22,29 @@ def _unit_scale(a) -> np.ndarray:
 
 
 def mac(phi_x, phi_a) -> np.ndarray:
-    """MAC matrix (n_x, n_a): |phi_x^H phi_a|^2 / ((phi_x^H phi_x)(phi_a^H phi_a)) (thesis eq. 2.3).
+    """The modal assurance criterion of every pair of columns (thesis eq. 2.3).
 
-    Columns are shapes at the same DOFs (rows); complex shapes are allowed. A zero shape gives 0.
+    MAC_ij = |phi_x,i^H phi_a,j|^2 / ((phi_x,i^H phi_x,i)(phi_a,j^H phi_a,j)): 1 for shapes that
+    differ by a factor only, 0 for orthogonal ones. The one MAC of pcbdyn: pairing, updating and
+    diagnosis call it.
+
+    Parameters
+    ----------
+    phi_x, phi_a : array_like, (n_dof,) or (n_dof, n_modes)
+        Shapes as columns at the same DOFs (rows), real or complex, in any scaling. A zero shape
+        gives 0.
+
+    Returns
+    -------
+    numpy.ndarray, (n_x, n_a)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> x = np.array([[1.0, 0.0], [2.0, 1.0], [1.0, 0.0]])
+    >>> print(mac(x, -3 * x).round(3))
+    [[1.    0.667]
+     [0.667 1.   ]]
     """
     X, A = _unit_scale(_cols(phi_x, "phi_x")), _unit_scale(_cols(phi_a, "phi_a"))
     if X.shape[0] != A.shape[0]:

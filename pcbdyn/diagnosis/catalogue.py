@@ -117,12 +117,6 @@ def kind(name: str):
         raise CatalogueError(f"unknown effect kind '{name}' (use one of {', '.join(KINDS)})") from None
 
 
-def copy_model(model):
-    """A shallow copy of an fe.Model whose sets, groups and constraints can be extended freely."""
-    return replace(model, sets=dict(model.sets), node_groups=dict(model.node_groups),
-                   fixed=set(model.fixed), mpcs=list(model.mpcs))
-
-
 def _by_kind(candidates):
     groups: dict = {}
     for i, c in enumerate(candidates):

@@ -13,7 +13,7 @@ import numpy as np
 
 from ..board.effects import edge_spring_property
 from ..fe.elements import kernel
-from .catalogue import register, AlongSides, Blocks, copy_model
+from .catalogue import register, AlongSides, Blocks
 
 
 class _EdgeStiffness(AlongSides):
@@ -30,7 +30,7 @@ class _EdgeStiffness(AlongSides):
         return [Blocks(conn, Ke, Me, np.repeat(np.arange(len(edges)), [e.shape[0] for e in edges]))]
 
     def apply(self, model, candidate, value: float):
-        m = copy_model(model)
+        m = model.copy()
         m.add(f"effects.{candidate.name}", "edge_spring", candidate.data["edges"], edge_spring_property(value))
         return m
 

@@ -15,7 +15,7 @@ import numpy as np
 from ..fe import SpringProperty
 from ..fe.elements.discrete import point_spring
 from ..fe.probe import model_probe
-from .catalogue import register, Blocks, Candidate, copy_model, node_candidates, on_nearest_node
+from .catalogue import register, Blocks, Candidate, node_candidates, on_nearest_node
 
 
 class _GroundSpring:
@@ -47,7 +47,7 @@ class _GroundSpring:
         return out
 
     def apply(self, model, candidate, value: float):
-        m = copy_model(model)
+        m = model.copy()
         w = candidate.data.get("point_weights")
         m.add(f"effects.{candidate.name}", "spring", [candidate.nodes.tolist()],
               SpringProperty(k=value * _spring(candidate), weights=None if w is None else tuple(w)))

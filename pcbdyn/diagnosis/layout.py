@@ -21,7 +21,8 @@ import numpy as np
 from matplotlib.path import Path as PolyPath
 from scipy.spatial import cKDTree
 
-SHELLS = ("quad4", "tri3")
+from ..fe.model import SHELL_TYPES
+
 #: direction change [deg] above which a boundary node is a corner that ends a straight side
 CORNER_DEG = 15.0
 
@@ -300,7 +301,7 @@ def _thickness(prop) -> float:
 def from_model(model, suspects=None, footprints=None, thickness: float | None = None, plates=None) -> Layout:
     """The layout of the shell sets of any fe.Model; boundary sides from the cell edges used once,
     support lines from its edge-spring sets."""
-    shells = tuple(n for n, s in model.sets.items() if s.etype in SHELLS and len(s.conn))
+    shells = tuple(n for n, s in model.sets.items() if s.etype in SHELL_TYPES and len(s.conn))
     if not shells:
         raise ValueError("the model has no shell elements: candidate effects are placed on a plate")
     e, count = np.unique(_edges([model.sets[n].conn for n in shells]), axis=0, return_counts=True)

@@ -8,7 +8,7 @@ import numpy as np
 
 from ..board.effects import tributary_weights
 from ..fe import MassProperty
-from .catalogue import register, AlongSides, Blocks, copy_model
+from .catalogue import register, AlongSides, Blocks
 
 
 class _LineMass(AlongSides):
@@ -27,7 +27,7 @@ class _LineMass(AlongSides):
         return [Blocks(nodes[:, None], np.zeros_like(Me), Me, owner)]
 
     def apply(self, model, candidate, value: float):
-        m = copy_model(model)
+        m = model.copy()
         for k, (n, w) in enumerate(zip(candidate.nodes, tributary_weights(model.nodes[candidate.nodes, :2]))):
             m.add(f"effects.{candidate.name}.{k}", "mass", [[int(n)]], MassProperty(value * w))
         return m

@@ -215,7 +215,7 @@ def diagnose(structure, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_s
              max_effects: int = 3, alpha: float = ALPHA, progress=None, workers: int | None = None,
              scheduler=None, quick: bool = False, record: dict | None = None) -> Diagnosis:
     """Diagnose ``structure`` (a board, or any structure of :mod:`pcbdyn.domain`) against ``tests`` =
-    [(configuration name or None, :class:`pcbdyn.testdata.Modes`)]. ``workers`` local processes (None:
+    [(configuration name or None, :class:`pcbdyn.testdata.MeasuredModes`)]. ``workers`` local processes (None:
     the cores; 1: this process) or the Dask cluster at ``scheduler`` run the independent solves of
     the finer meshes (:mod:`.finer`) and fits of the candidate scans (:mod:`.scan`); the results do
     not depend on where they ran. ``quick``: a first look that costs a fraction of the run: the

@@ -16,8 +16,9 @@ import numpy as np
 
 from ..fe import MassProperty
 from ..fe.elements.discrete import mass_matrices
+from ..fe.model import SHELL_TYPES
 from ..fixtures.supports import disc_footprint, mass_footprint
-from .catalogue import register, Blocks, copy_model, node_candidates, on_nearest_node
+from .catalogue import register, Blocks, node_candidates, on_nearest_node
 
 
 class _Lumped:
@@ -55,7 +56,7 @@ class _Lumped:
         radius = candidate.data.get("radius")
         if radius is None and self.param == "mass":
             return np.array([node]), None
-        shells = [(s.etype, s.conn) for s in model.sets.values() if s.etype in ("quad4", "tri3")]
+        shells = [(s.etype, s.conn) for s in model.sets.values() if s.etype in SHELL_TYPES]
         if radius is None:
             return mass_footprint(model.nodes, shells, node, 0.0, 1.0)[0], None
         return disc_footprint(model.nodes, shells, candidate.data["centre"], float(radius))
@@ -78,7 +79,7 @@ class _Lumped:
         return out
 
     def apply(self, model, candidate, value: float):
-        m = copy_model(model)
+        m = model.copy()
         conn, W = self.footprint(model, candidate)
         m.add(f"effects.{candidate.name}", "mass", [conn], self._property(value, W))
         return m

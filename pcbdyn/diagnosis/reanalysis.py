@@ -32,7 +32,7 @@ RANK_TOL = 1e-8
 RIGID_SHARE = 1e-6
 
 
-class _Modes:
+class _BasisModes:
     """The part of :class:`pcbdyn.fe.modal.Modes` a paired state and its sensitivities read, in
     the coefficients of a reduced basis: ``frequencies`` [Hz], ``n_rigid``, ``omega2``, ``coef``
     (n_basis, n_rigid + n_elastic) of [rigid, elastic]."""
@@ -148,7 +148,7 @@ class Reanalysis:
             first = cfg.lam[cfg.cs.modes.n_rigid] if cfg.lam.size > cfg.cs.modes.n_rigid else 1.0
             nr = int(np.count_nonzero(lam < RIGID_SHARE * first))
             keep = np.r_[np.arange(nr), nr + np.arange(min(cfg.n_modes, lam.size - nr))]
-            modes = _Modes(lam[keep], coef[:, keep], nr)
+            modes = _BasisModes(lam[keep], coef[:, keep], nr)
             at_points = None if points is None else points @ modes.coef
             U = None if at_points is None else at_points[:, nr:]
             st.configs.append(paired_state(cfg.ob, cfg.cs.model, None, None, modes, U, at_points))

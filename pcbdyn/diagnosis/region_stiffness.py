@@ -21,7 +21,7 @@ import numpy as np
 
 from ..board.effects import ScaledShell
 from ..fe.elements import kernel
-from .catalogue import register, Blocks, Candidate, copy_model
+from .catalogue import register, Blocks, Candidate
 
 
 def _centroid(conns, xy) -> np.ndarray:
@@ -156,7 +156,7 @@ class _RegionStiffness:
         """The region's cells move out of their sets into ``effects.<name>...`` sets whose stiffness
         is (f + value) times that of their base property, f being their present factor (1, or that
         of an overlapping region effect added before); f + value must stay > 0."""
-        m = copy_model(model)
+        m = model.copy()
         for etype, conn in candidate.data["cells"].items():
             for name, in_set, _ in _locate(m, etype, conn):
                 es = m.sets[name]

@@ -31,7 +31,7 @@ from ..fe.assembly import assemble
 from ..fe.modal import solve_modes
 from ..fe.probe import model_probe
 from ..parallel import beside, spare
-from ..testdata import Modes
+from ..testdata import MeasuredModes
 from ..updating.sensitivity import bilinear_forms, eigen_derivatives
 from .catalogue import effect_forms
 from .combined import Effects
@@ -50,7 +50,7 @@ def reading(model, xyz, directions):
 
 @dataclass
 class Observation:
-    """One test configuration in the residual: its measured ``modes`` (:class:`pcbdyn.testdata.Modes`:
+    """One test configuration in the residual: its measured ``modes`` (:class:`pcbdyn.testdata.MeasuredModes`:
     frequencies, and shapes that the model gives as ``read @ u``, ``read`` (n_pts, n_dof) on the full
     DOFs); relative standard deviations ``sigma_f`` (m,) of the frequencies and ``sigma_s`` (m,) of a
     shape component (per RMS of the mode's measured shape); ``f_scale`` (m,): the factor that takes the
@@ -58,7 +58,7 @@ class Observation:
     Without shapes the modes pair by order."""
 
     name: str | None
-    modes: Modes
+    modes: MeasuredModes
     sigma_f: np.ndarray
     read: object = None
     sigma_s: np.ndarray | None = None

@@ -351,13 +351,13 @@ def forward_select(model, candidates, f_test, sigma: float, max_effects: int = 3
     """:func:`search` on frequencies alone: ``f_test`` [Hz] paired in order with the first
     len(f_test) elastic modes of ``model``, relative noise ``sigma`` (e.g. 0.002), no declared
     parameters."""
-    from ..testdata import Modes
+    from ..testdata import MeasuredModes
     from .residual import ModalResidual, Observation
 
     f_test = np.asarray(f_test, dtype=float)
     if not sigma > 0:
         raise ValueError(f"sigma (relative frequency noise) must be > 0, got {sigma}")
-    res = ModalResidual([Observation(None, Modes.frequencies_only(f_test), np.full(f_test.size, float(sigma)))],
+    res = ModalResidual([Observation(None, MeasuredModes.frequencies_only(f_test), np.full(f_test.size, float(sigma)))],
                         lambda p: [model])
     return search(res, candidates, max_effects=max_effects, newton_steps=newton_steps, shortlist=shortlist,
                   alpha=alpha)

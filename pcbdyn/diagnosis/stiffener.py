@@ -22,7 +22,7 @@ from ..board.effects import rib_property
 from ..board.entries import RibSection
 from ..fe import EmbeddedBeamProperty
 from ..fe.elements import kernel
-from .catalogue import register, Blocks, Candidate, copy_model
+from .catalogue import register, Blocks, Candidate
 
 
 class _Stiffener:
@@ -130,7 +130,7 @@ class _Stiffener:
     def apply(self, model, candidate, value: float):
         if not value > 0:
             raise ValueError(f"{candidate.name}: a stiffener's EI must be > 0 N m^2, got {value}")
-        m = copy_model(model)
+        m = model.copy()
         m.add(f"effects.{candidate.name}", "embedded_beam2", candidate.data["conn"], self._property(value, candidate))
         return m
 

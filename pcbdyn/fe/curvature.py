@@ -15,7 +15,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .mesh import NDOF
-from .model import ModelError
+from .model import SHELL_TYPES, ModelError
 from .probe import locate
 
 _XI = np.array([-1.0, 1.0, 1.0, -1.0])
@@ -42,7 +42,7 @@ def curvature_matrix(model, points, sets=None, tol: float | None = None) -> sp.c
     point i of ``points`` (n, 2 or 3) from the DOF vector, on the quad4/tri3 sets (all, or
     ``sets``) of a model whose shells lie in the x-y plane."""
     names = list(model.sets) if sets is None else list(sets)
-    cells = [(model.sets[n].etype, model.sets[n].conn) for n in names if model.sets[n].etype in ("quad4", "tri3")]
+    cells = [(model.sets[n].etype, model.sets[n].conn) for n in names if model.sets[n].etype in SHELL_TYPES]
     if not cells:
         raise ModelError("the model has no quad4 or tri3 cells to read curvatures on")
     if np.ptp(model.nodes[:, 2]) > 1e-9 * max(np.ptp(model.nodes[:, :2]), 1.0):

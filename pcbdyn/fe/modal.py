@@ -363,14 +363,50 @@ def eigenpairs(Kr, Mr, n_modes: int | None = None, f_max: float | None = None, f
 
 def solve_modes(model, n_modes: int | None = None, f_max: float | None = None, K=None, M=None,
                 keep_factor: bool = False) -> Modes:
-    """The first elastic modes of ``model``: ``n_modes`` of them, or all up to ``f_max`` [Hz], or,
-    with both, the first ``n_modes`` of those up to ``f_max`` (default: 10 modes).
+    """The first elastic modes of ``model``: K phi = omega^2 M phi, phi^T M phi = 1.
 
     Rigid-body modes of a free model (``model.free``) are counted and returned apart; a model not
     declared free that has one raises :class:`ModelError` naming the DOFs that move. Asking for
     more modes than the model has returns all of them (``len(frequencies)`` tells how many).
-    ``K, M``: already assembled full matrices (skips the assembly). ``keep_factor``: keep the
-    factorisations in ``Modes.shifted`` (see the module doc). See :func:`eigenpairs`.
+    See :func:`eigenpairs` for the solver.
+
+    Parameters
+    ----------
+    model : pcbdyn.fe.Model
+        Nodes, element sets and constraints (a board's is ``board.build().model``).
+    n_modes : int, optional
+        How many elastic modes; with ``f_max`` too, the first ``n_modes`` of those up to ``f_max``
+        (default: 10 modes when neither is given).
+    f_max : float, optional
+        Every elastic mode up to this frequency [Hz].
+    K, M : sparse matrices, optional
+        The model's assembled full stiffness and mass matrices, when the caller has them (skips
+        the assembly).
+    keep_factor : bool
+        Keep the factorisations in ``Modes.shifted`` for static and FRF solves (see the module doc).
+
+    Returns
+    -------
+    Modes
+        ``frequencies`` [Hz], full-length mass-normalised ``shapes`` (one column per mode),
+        ``rigid_shapes`` and ``n_rigid`` of a free model.
+
+    Examples
+    --------
+    A 100 x 20 x 1 mm aluminium strip clamped at x = 0 (Euler-Bernoulli: 82 Hz; the plate is
+    stiffer by its width's Poisson restraint):
+
+    >>> from pcbdyn.fe import Model, ShellProperty
+    >>> from pcbdyn.fe.generate import nodes_where, rectangle
+    >>> nodes, cells = rectangle(0.1, 0.02, 20, 4)
+    >>> strip = Model(nodes)
+    >>> _ = strip.add("plate", "quad4", cells, ShellProperty(E=70e9, nu=0.3, rho=2700.0, t=1e-3))
+    >>> strip.fix(nodes_where(nodes, x=0.0))
+    >>> modes = solve_modes(strip, n_modes=3)
+    >>> print(modes.frequencies.round(1))
+    [ 83.4 523.6 827.9]
+    >>> modes.shapes.shape, modes.n_rigid
+    ((630, 3), 0)
     """
     if n_modes is None and f_max is None:
         n_modes = 10

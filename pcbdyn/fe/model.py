@@ -11,6 +11,8 @@ from .mesh import NDOF, dof_index
 #: nodes per cell for each element type
 NODES_PER_CELL = {"quad4": 4, "tri3": 3, "beam2": 2, "edge_spring": 2, "edge_joint": 4, "mass": 1,
                    "embedded_beam2": 8}
+#: the shell element types (plates: bending and membrane), in the order sets of them are made
+SHELL_TYPES = ("quad4", "tri3")
 
 
 class ModelError(ValueError):
@@ -140,9 +142,16 @@ class Model:
         """Make global DOF ``dof_b`` equal to ``dof_a``."""
         self.constrain(dof_b, [(dof_a, 1.0)])
 
+    def copy(self) -> "Model":
+        """A shallow copy whose sets, node groups, fixed DOFs and constraints can be added to or
+        replaced without touching this model (the node array and the element sets themselves are
+        shared: neither is changed in place). The one way a model is copied."""
+        return replace(self, sets=dict(self.sets), node_groups=dict(self.node_groups), fixed=set(self.fixed),
+                       mpcs=list(self.mpcs))
+
     def with_property(self, name: str, **changes) -> "Model":
-        """A shallow copy whose set ``name`` has its property fields changed (for re-analysis)."""
-        new = replace(self, sets=dict(self.sets))
+        """A copy whose set ``name`` has its property fields changed (for re-analysis)."""
+        new = self.copy()
         es = self.sets[name]
         new.sets[name] = replace(es, prop=replace(es.prop, **changes))
         return new

@@ -110,15 +110,26 @@ class ParametricModel:
         for k in values:
             if k not in self.quantities:
                 raise ModelError(f"'{k}' is not a quantity of this model")
-        model = Model(self.model.nodes, dict(self.model.sets), dict(self.model.node_groups), set(self.model.fixed),
-                      list(self.model.mpcs), self.model.free)
+        model = self.model.copy()
         for name, prop in self.properties(values).items():
             es = model.sets[name]
             model.sets[name] = replace(es, prop=prop)
         return replace(self, model=model, quantities={**self.quantities, **values})
 
     def with_parameters(self, values: dict):
-        """A copy with parameters {name: value [SI]} set (each value goes to all its targets)."""
+        """A copy with parameters set, each value going to all its targets.
+
+        Parameters
+        ----------
+        values : dict
+            {parameter name: value [SI]}.
+
+        Returns
+        -------
+        ParametricModel
+            A copy (of the same class) whose ``model`` shares the nodes and the unchanged element
+            sets; the sets that depend on the parameters are made anew.
+        """
         q = {}
         for name, v in values.items():
             q.update(self.parameters[name].quantities(v))

@@ -20,7 +20,7 @@ import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
 from .mesh import NDOF
-from .model import ModelError
+from .model import SHELL_TYPES, ModelError
 
 _XI = np.array([-1.0, 1.0, 1.0, -1.0])
 _ETA = np.array([-1.0, -1.0, 1.0, 1.0])
@@ -225,5 +225,5 @@ def model_probe(model, points, directions=(0.0, 0.0, 1.0), sets=None, tol: float
                 missing: str = "raise") -> Probe:
     """:func:`interpolation_matrix` on the quad4/tri3 element sets of ``model`` (all, or ``sets``)."""
     names = list(model.sets) if sets is None else list(sets)
-    cells = [(model.sets[n].etype, model.sets[n].conn) for n in names if model.sets[n].etype in ("quad4", "tri3")]
+    cells = [(model.sets[n].etype, model.sets[n].conn) for n in names if model.sets[n].etype in SHELL_TYPES]
     return interpolation_matrix(model.nodes, cells, points, directions, tol, missing, model.n_dof)

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..correlation.mac import automac
-from ..testdata import Modes, TestDataError, real_modes
+from ..testdata import MeasuredModes, TestDataError, real_modes
 from . import lscf, stability
 from .quality import indicators
 
@@ -29,7 +29,7 @@ class Identification:
     ``criteria``: the rules of the choice (:func:`.stability.criteria`); ``notes``: what the choice
     says to the user (requests of ``select`` that shared a pole)."""
 
-    modes: Modes
+    modes: MeasuredModes
     chart: stability.Chart
     chosen: list
     selection: str
@@ -87,9 +87,10 @@ def _neighbours(phi) -> np.ndarray:
 
 
 def identify(frfs, band=None, max_order: int = 40, select=None) -> Identification:
-    """Modes of ``frfs`` (:class:`pcbdyn.testdata.FRFs`) in ``band`` (lo, hi) [Hz] (default: the
-    FRF axis above 0 Hz), from model orders up to 2 ``max_order`` (capped at a quarter of the
-    band's lines); ``select``: frequencies [Hz] to pick poles near instead of the automatic choice."""
+    """The modes (:class:`pcbdyn.testdata.MeasuredModes`) of ``frfs`` (:class:`pcbdyn.testdata.FRFs`)
+    in ``band`` (lo, hi) [Hz] (default: the FRF axis above 0 Hz), from model orders up to 2
+    ``max_order`` (capped at a quarter of the band's lines); ``select``: frequencies [Hz] to pick
+    poles near instead of the automatic choice."""
     f_all = frfs.frequencies
     if band is None:
         band = (float(f_all[f_all > 0].min()), float(f_all.max()))
@@ -109,7 +110,7 @@ def identify(frfs, band=None, max_order: int = 40, select=None) -> Identificatio
     phi, mpc = real_modes(psi)
     big = np.argmax(np.abs(phi), axis=0)
     phi = phi * np.sign(phi[big, np.arange(phi.shape[1])])
-    modes = Modes(frfs.points, frfs.response, c.frequency[chosen], phi, c.damping[chosen], mpc)
+    modes = MeasuredModes(frfs.points, frfs.response, c.frequency[chosen], phi, c.damping[chosen], mpc)
     return Identification(modes, c, chosen, "auto" if select is None else "manual", scaling,
                           (float(lo), float(hi)), order, _neighbours(phi), indicators(psi, mpc, c, groups),
                           stability.criteria(len(rows)), notes)

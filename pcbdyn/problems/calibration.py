@@ -27,9 +27,9 @@ import numpy as np
 from .. import targets
 from ..components.library import locate, read_package, search_path
 from ..domain import StructureError
+from ..testdata.noise import add_noise
 from ..updating.iteration import build_equations
 from ..updating.solvers import covariance
-from ..updating.success import add_noise
 from ..updating.weighting import NOISE_REDRAWS
 from .error_budget import measured_mesh_steps, noise_sigma
 from .fit import fit
@@ -159,7 +159,7 @@ def family_structure(structure, start: dict, extra=(), parts=None):
         if not parts.get(fam):
             continue
         lo, hi = value / FAMILY_RANGE, value * FAMILY_RANGE
-        entry = {"name": fam, "target": [f"components.{c.ref}.thickness" for c in parts[fam]],
+        entry = {"name": fam, "target": [targets.target("components", c.ref, "thickness") for c in parts[fam]],
                  "bounds": [targets.quantity(lo, "mm"), targets.quantity(hi, "mm")]}
         specs.append(targets.parameter_spec(entry, f"family {fam}", s.quantity, structure.path.name))
     return replace(s, parameters=specs + list(extra))

@@ -9,6 +9,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from ..correlation.mac import mac
 from ..domain import MAX_MODES, StructureError
 from ..fe.assembly import element_matrices, scatter
 from ..fe.generate import rectangle
@@ -16,13 +17,12 @@ from ..fe.model import Model
 from ..fe.properties import ShellProperty
 from ..fe.reduction import guyan
 from ..testdata import read_points_csv
+from ..testdata.noise import add_noise
 from ..updating import matching
 from ..updating.equations import fbm_equations, frequency_equations, frf_receptance_equations, qms_equations
-from ..updating.iteration import mac_matrix
 from ..updating.pbc import stack
-from ..updating.sensitivity import frequencies_hz, solve_modes
+from ..updating.sensitivity import frequencies_hz, pencil_modes
 from ..updating.study import StudyCase, unit_weighted
-from ..updating.success import add_noise
 from ..updating.weighting import unit_row_weights
 from .problem import UpdateProblem
 
@@ -134,8 +134,8 @@ class SimulatedFreePCB(StudyCase):
         self.configs = []
         for added in (np.zeros(nn), dm):
             Mc, Mxc = self.M + np.diag(added), Mx + np.diag(added)
-            lam_a, _ = solve_modes(self.K, Mc)
-            lam_x, phi_x = solve_modes(Kx, Mxc)
+            lam_a, _ = pencil_modes(self.K, Mc)
+            lam_x, phi_x = pencil_modes(Kx, Mxc)
             el = slice(3, 3 + self.n_modes)  # 3 rigid-body modes (w, rx, ry)
             f_a, f_x = frequencies_hz(lam_a[el]), frequencies_hz(lam_x[el])
             f_u = np.sort(np.concatenate([(1 - freq_margin) * np.minimum(f_a, f_x),
@@ -199,14 +199,14 @@ class StructureCase(StudyCase):
         P = sysm.measurement_matrix(points.xyz[points.index(dofs.point_ids)], dofs.directions)
         nr, el = sysm.n_rigid, slice(sysm.n_rigid, sysm.n_rigid + int(n_modes))
         Kx, Mx, _, _ = sysm.model(self.p_x)
-        lam_x, phi_full = solve_modes(Kx, Mx, nr + int(n_modes))
+        lam_x, phi_full = pencil_modes(Kx, Mx, nr + int(n_modes))
         K, M, dKs, dMs = sysm.model(self.p_a)
-        lam_a, Phi_a = solve_modes(K, M, nr + int(n_modes))
+        lam_a, Phi_a = pencil_modes(K, M, nr + int(n_modes))
         self.omega_x, self.phi_x = np.sqrt(lam_x[el]), np.asarray(P @ phi_full[:, el])
-        mac = np.diag(mac_matrix(np.asarray(P @ Phi_a[:, el]), self.phi_x))
-        if np.any(mac < 0.8):
+        paired = np.diag(mac(np.asarray(P @ Phi_a[:, el]), self.phi_x))
+        if np.any(paired < 0.8):
             raise CaseError(f"truth: the true board's modes do not pair in order with the model's (MAC "
-                             f"{np.round(mac, 2).tolist()}); use smaller errors or fewer modes (n_modes)")
+                             f"{np.round(paired, 2).tolist()}); use smaller errors or fewer modes (n_modes)")
         self.K, self.M, self.dKs, self.dMs = matching.reduce_system(K, M, dKs, dMs, P)
         blk = frequency_equations(lam_a[el], Phi_a[:, el], frequencies_hz(lam_x[el]), dKs, dMs, self.p_a)
         self._d = unit_row_weights(blk.A)

@@ -47,7 +47,7 @@ class Extreme:
 
 
 def model_modes_needed(test) -> int:
-    """Model modes to solve for pairing ``test`` (:class:`pcbdyn.testdata.Modes`): room for modes the
+    """Model modes to solve for pairing ``test`` (:class:`pcbdyn.testdata.MeasuredModes`): room for modes the
     test missed and for a boundary condition that reorders them."""
     return max(math.ceil(1.5 * test.n_modes), test.n_modes + 4, int(test.numbers.max()) + 4)
 

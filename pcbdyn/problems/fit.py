@@ -180,9 +180,47 @@ def fit(problem, measured, *, method: str = "freq", noise=(None, None), shapes: 
         scan_start: bool = True, model_pct=None, mesh_check: bool = False, solver: str = "bounded",
         max_iter: int = 20, tol_freq_pct: float = TOL_FREQ_PCT, tol_param_pct: float = 0.5, min_mac: float = 0.5,
         progress=None) -> Fit:
-    """Fit ``problem`` (:class:`~.problem.UpdateProblem`, its ``p0`` the start) to ``measured``
-    [(configuration or None, :class:`pcbdyn.testdata.Modes`)] or [(structure index, configuration, Modes)].
+    """Fit the parameters of ``problem`` to measured modes: the weighted least squares of the frequency
+    (and shape) residuals in units of their noise, judged by chi^2 against its degrees of freedom
+    (thesis eq. 4.28); the steps are in the module docstring.
 
+    Parameters
+    ----------
+    problem : UpdateProblem
+        The structures and the parameters updated; its ``p0`` is the start.
+    measured : list
+        [(configuration or None, :class:`pcbdyn.testdata.MeasuredModes`)], or [(structure index,
+        configuration, modes)] for several structures.
+    noise : (float or None, float or None)
+        Uniform noise bounds of the frequencies and shapes [%]; None where the test does not state it.
+
+    Returns
+    -------
+    Fit
+        ``values`` {name: value [SI]}, ``p``, ``status`` ("converged" when it succeeded), ``verdict``
+        (chi^2, degrees of freedom, probability), ``before``/``after`` correlation states.
+
+    Examples
+    --------
+    A card whose PGAs are 20 % thicker (4.2 mm) than its board.toml says (3.5 mm):
+
+    >>> from pcbdyn.board import load_board
+    >>> from pcbdyn.fe.modal import solve_modes
+    >>> from pcbdyn.problems import UpdateProblem
+    >>> from pcbdyn.testdata import Noise, read_points_csv
+    >>> from pcbdyn.testdata.simulate import simulate_on_model
+    >>> card = "examples/six_part_card/"
+    >>> board = load_board(card + "board.toml")
+    >>> truth = board.build().with_parameters({"t_PGA": 4.2e-3}).model
+    >>> points, dofs = read_points_csv(card + "points.csv")
+    >>> test = simulate_on_model(truth, solve_modes(truth, n_modes=7), points, dofs,
+    ...                          noise=Noise(frequency_pct=0.2, shape_pct=2.0), seed=1)
+    >>> result = fit(UpdateProblem(board, ["t_PGA"]), [(None, test.modes)], noise=(0.2, 2.0))
+    >>> result.status, round(result.values["t_PGA"] * 1e3, 2)          # mm
+    ('converged', 4.21)
+
+    Notes
+    -----
     ``method``: "freq" (shapes added when ``shapes`` is "auto" and the frequencies leave a direction
     open, always with "always", never with "never"), "modal", "qms" or "fbm". ``noise``: (frequency %,
     shape %) uniform bounds, None where not stated (:data:`DEFAULT_NOISE`). ``scan_start``: scan log-scale

@@ -3,7 +3,7 @@ methods, with the frequency configurations the before/after tables are made of."
 
 from __future__ import annotations
 
-from ..testdata import Modes, TestDataError, excitations, read_uff
+from ..testdata import MeasuredModes, TestDataError, excitations, read_uff
 from ..updating.frf_lines import resonance_lines
 
 
@@ -27,6 +27,6 @@ def frf_configurations(problem, files, method: str, freqs=None, damping: str = "
             check.append(problem.configuration(name, td.modes, "freq", structure=structure))
         else:
             notes.append(f"{path.name}: no modes in the file; the before/after tables use its FRF peaks paired by order")
-            check.append(problem.configuration(name, Modes.frequencies_only(resonance_lines(meas[0].frequencies, meas[0].H)),
+            check.append(problem.configuration(name, MeasuredModes.frequencies_only(resonance_lines(meas[0].frequencies, meas[0].H)),
                                                "freq", structure=structure))
     return check, cfgs, notes

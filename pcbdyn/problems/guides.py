@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+from .. import targets
 from ..board.entries import BoardError
 from ..targets import KINDS, ParameterSpec
 
@@ -29,7 +30,8 @@ def wedge_locks(board) -> list:
 
 
 def target(fixture_name: str) -> str:
-    return f"fixtures.{fixture_name}.k_rot"
+    """The target of the rotational stiffness of guide ``fixture_name``."""
+    return targets.target("fixtures", fixture_name, "k_rot")
 
 
 def with_guides(board, k: dict, parameters: list = ()):

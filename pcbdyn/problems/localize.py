@@ -7,12 +7,12 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..testdata.noise import add_noise
 from ..updating import matching
 from ..updating.indicators import fbm_residuals
 from ..updating.iteration import build_equations
 from ..updating.study import localise
 from ..updating.subset import EXPLAIN_TOL, explain_tol_from_noise, tls_qrf
-from ..updating.success import add_noise
 from ..updating.weighting import NOISE_REDRAWS, tls_column_weight_from_noise
 
 

@@ -8,7 +8,7 @@ blocks that carry their own pairing and rigid-mode count, so that configurations
 and structures stack freely. Typical use::
 
     prob = UpdateProblem(load_board("board.toml"), ["t_PGA", "t_JLCC"])
-    test = read_uff("test.uff").modes                               # pcbdyn.testdata.Modes
+    test = read_uff("test.uff").modes                               # pcbdyn.testdata.MeasuredModes
     check = [prob.configuration(None, test, "freq")]                # frequencies, MAC pairing
     cfgs = prob.mode_configurations(None, test, "qms")              # or: QMS, one block per mode
     res, before, after = run(prob, cfgs, solver="bounded", check=check)
@@ -37,7 +37,17 @@ class UpdateProblem:
     (default: all, in order of first appearance). ``mesh_size`` [m] overrides the structures' own.
     Attributes: ``parameters`` (:class:`pcbdyn.fe.parametric.Parameter` of each name, from the first
     structure that has it), ``p0`` (their values, SI), ``bounds`` ((lower, upper) arrays),
-    ``log_scale`` (indices of stiffness parameters), ``units`` (display units of the files)."""
+    ``log_scale`` (indices of stiffness parameters), ``units`` (display units of the files).
+
+    Examples
+    --------
+    >>> from pcbdyn.board import load_board
+    >>> problem = UpdateProblem(load_board("examples/six_part_card/board.toml"), ["t_PGA", "E_board"])
+    >>> problem.names, problem.units
+    (['t_PGA', 'E_board'], ['mm', 'Pa'])
+    >>> problem.p0.tolist()                                            # SI: 3.5 mm, 26 GPa
+    [0.0035, 26000000000.0]
+    """
 
     def __init__(self, structures, names=None, mesh_size=None):
         self.structures = list(structures) if isinstance(structures, (list, tuple)) else [structures]
@@ -91,7 +101,7 @@ class UpdateProblem:
 
     def configuration(self, config, measured, method: str = "freq", n_modes=None, min_mac: float = 0.5,
                       structure: int = 0, limit: float = FREQ_LIMIT, **options) -> Configuration:
-        """A driver Configuration of ``config`` with its measured modes (:class:`pcbdyn.testdata.Modes`).
+        """A driver Configuration of ``config`` with its measured modes (:class:`pcbdyn.testdata.MeasuredModes`).
 
         Shapes give P and MAC pairing (pairs more than ``limit`` apart in frequency left out); frequencies
         only pair by the test's mode numbers. ``n_modes`` analytical modes are solved per iteration
@@ -170,7 +180,29 @@ class UpdateProblem:
         return dict(zip(self.names, np.asarray(p, float).tolist()))
 
     def write_updated(self, p, dst, structure: int = 0, source: str = "pcbdyn update"):
-        """The structure's file with its parameters at ``p`` written to ``dst`` (comments kept)."""
+        """The structure's file with its parameters at ``p`` written to ``dst`` (comments kept).
+
+        Parameters
+        ----------
+        p : array_like
+            The parameters [SI], in the order of ``names`` (a fit's ``p``).
+        dst : str or pathlib.Path
+            The file written (atomically).
+        structure : int
+            Which of the problem's structures.
+        source : str
+            Named in the comment that marks each updated value.
+
+        Examples
+        --------
+        >>> import os, tempfile
+        >>> from pcbdyn.board import load_board
+        >>> problem = UpdateProblem(load_board("examples/six_part_card/board.toml"), ["t_PGA"])
+        >>> dst = os.path.join(tempfile.mkdtemp(), "board.updated.toml")
+        >>> _ = problem.write_updated([4.2e-3], dst)
+        >>> round(load_board(dst).quantity("components.U1.thickness"), 9)   # SI: 4.2 mm
+        0.0042
+        """
         s = self.structures[structure]
         own = {p.name for p in s.parameters}
         return s.write_updated({n: v for n, v in self.values(p).items() if n in own}, dst, source)

@@ -90,7 +90,7 @@ class ConfigSystem:
                    "instead (biased); put the excitation on a mesh node")
 
     def pairing(self, measured, min_mac: float = 0.5, limit: float = FREQ_LIMIT):
-        """The driver's pairing callable for the measured modes ``measured`` (:class:`pcbdyn.testdata.Modes`):
+        """The driver's pairing callable for the measured modes ``measured`` (:class:`pcbdyn.testdata.MeasuredModes`):
         by MAC (:func:`pcbdyn.correlation.pairing.pair_modes`) when shapes are measured, pairs more than
         ``limit`` apart in frequency left out, else by the test's mode numbers; rigid-body modes never pair."""
         return ShapePairing(min_mac, self.n_rigid, None if measured.shapes is not None else measured.numbers, limit)

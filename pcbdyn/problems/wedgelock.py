@@ -169,7 +169,7 @@ def fit_wedge_locks(board, tests, per_guide: bool | None = None, tol_pct: float 
                     shape_noise_pct: float | None = None,
                     probe_tol: float | None = None, max_iter: int = 20, progress=None) -> WedgeLockResult:
     """The two steps on ``board`` (with wedge_lock fixtures) against ``tests`` [(configuration or None,
-    :class:`pcbdyn.testdata.Modes`)]. ``per_guide``: True fits one stiffness per guide, False one shared,
+    :class:`pcbdyn.testdata.MeasuredModes`)]. ``per_guide``: True fits one stiffness per guide, False one shared,
     None decides from the data. ``tol_pct``: the tolerance that accepts clamped (default noise + mesh
     error); ``noise_pct``: the test's frequency noise (uniform bound, %; default :data:`DEFAULT_NOISE_PCT`);
     ``shape_noise_pct``: its shape noise (uniform bound, %; default :data:`.fit.DEFAULT_NOISE`'s), which

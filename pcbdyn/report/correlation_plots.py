@@ -15,32 +15,16 @@ from pathlib import Path
 
 import numpy as np
 
-from .files import atomic_path
+from .files import PLOT, pyplot, save_figure
 from .labels import place_labels
 
 CMAP = "coolwarm"
 
 
-def _plt():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
-def _save(fig, path) -> None:
-    plt = _plt()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=110, bbox_inches="tight")
-    plt.close(fig)
-
-
 def mac_matrix(path, M, pairs, f_test, f_model, title: str = "MAC (pairs framed in red)",
                rows: str = "test mode") -> None:
     """The MAC matrix (``rows`` modes down, model modes across) with values and the pairs framed."""
-    plt = _plt()
+    plt = pyplot()
     from matplotlib.patches import Rectangle
 
     M = np.asarray(M)
@@ -59,13 +43,13 @@ def mac_matrix(path, M, pairs, f_test, f_model, title: str = "MAC (pairs framed 
     ax.set_ylabel(f"{rows}: frequency [Hz]")
     ax.set_title(title)
     fig.colorbar(im, ax=ax, fraction=0.046, pad=0.04)
-    _save(fig, path)
+    save_figure(fig, path, **PLOT)
 
 
 def frequency_plot(path, pairs, band_pct: float = 5.0) -> None:
     """Model against test frequency of each pair, on the 45-degree line with +-``band_pct`` lines;
     each point is labelled test/model mode and coloured by its MAC."""
-    plt = _plt()
+    plt = pyplot()
     ft = np.array([p.f_test for p in pairs])
     fa = np.array([p.f_model for p in pairs])
     macs = np.array([p.mac_combined for p in pairs])
@@ -89,10 +73,10 @@ def frequency_plot(path, pairs, band_pct: float = 5.0) -> None:
     ax.set_title("paired frequencies (labels: test/model mode)")
     ax.legend(loc="upper left", fontsize=8)
     fig.colorbar(sc, ax=ax, fraction=0.046, pad=0.04, label="MAC")
-    _save(fig, path)
+    save_figure(fig, path, **PLOT)
 
 
-def _outline(ax, outline) -> None:
+def draw_outline(ax, outline) -> None:
     """Draw the board outline and holes [mm], with a margin so that markers on the edges show whole."""
     for poly in [outline.vertices, *outline.holes]:
         v = np.vstack([poly, poly[:1]]) * 1e3
@@ -103,7 +87,8 @@ def _outline(ax, outline) -> None:
     ax.set_ylim(lo[1] - pad, hi[1] + pad)
 
 
-def _shell_triangulation(model):
+def shell_triangulation(model):
+    """The model's shells as one matplotlib triangulation in mm (quads split in two), for maps."""
     from matplotlib.tri import Triangulation
 
     tris = []
@@ -135,8 +120,8 @@ def shape_overlays(out_dir, model, outline, pairs, test_xy, test_w, model_at_tes
     coloured markers. The test is scaled by the modal scale factor onto ``model_at_test`` (the
     model at the test DOFs), then both by the model's largest value at the points, so equal colours
     mean equal motion. Returns the file names."""
-    plt = _plt()
-    tri = _shell_triangulation(model)
+    plt = pyplot()
+    tri = shell_triangulation(model)
     xy = np.asarray(test_xy) * 1e3
     w_abs = np.abs(np.asarray(test_w))
     moving = w_abs.max(axis=1) > 1e-9 * (w_abs.max() or 1.0)  # points at rest (held edges) bend no nodal line
@@ -155,7 +140,7 @@ def shape_overlays(out_dir, model, outline, pairs, test_xy, test_w, model_at_tes
             ax.tricontour(ptri, xs[moving], levels=[0.0], colors="k", linewidths=1.2, linestyles="--")
         ax.scatter(xy[:, 0], xy[:, 1], c=np.clip(xs, -1, 1), cmap=CMAP, vmin=-1, vmax=1, s=70, marker="s",
                    edgecolors="k", linewidths=1.0, zorder=3)
-        _outline(ax, outline)
+        draw_outline(ax, outline)
         ax.plot([], [], "k-", label="model nodal line")
         ax.plot([], [], "k--", label="test nodal line")
         ax.scatter([], [], c="w", marker="s", edgecolors="k", label="test points (colour: test)")
@@ -169,7 +154,7 @@ def shape_overlays(out_dir, model, outline, pairs, test_xy, test_w, model_at_tes
         ax.set_title(f"test {p.test + 1}: {p.f_test:.1f} Hz  /  model {p.model + 1}{combo}: {p.f_model:.1f} Hz\n"
                      f"df = {p.df_pct:+.2f} %, MAC = {p.mac_combined:.3f}", fontsize=10)
         name = f"{prefix}_{k + 1:02d}_test{p.test + 1}_model{p.model + 1}.png"
-        _save(fig, Path(out_dir) / name)
+        save_figure(fig, Path(out_dir) / name, **PLOT)
         names.append(name)
     return names
 
@@ -178,18 +163,18 @@ def comac_map(path, outline, xy, values, labels, lines=None) -> None:
     """COMAC per measured DOF at its point on the board outline (low = test and model disagree), over the
     test's wireframe ``lines`` (n, 2, 3) [m] when given; on a structure in 3-D (``outline`` None, ``xy`` the
     points (k, 3)) a 3-D map."""
-    plt = _plt()
+    plt = pyplot()
     lo = min(0.9, float(np.min(values)))
     if outline is None:
         from .pictures3d import point_map_3d
 
         fig = plt.figure(figsize=(7.0, 6.0))
         point_map_3d(fig, 111, xy, values, "COMAC", "RdYlGn", lo, 1.0, "COMAC per point over the pairs")
-        _save(fig, path)
+        save_figure(fig, path, **PLOT)
         return
     xy = np.asarray(xy) * 1e3
     fig, ax = plt.subplots(figsize=(6.0, 5.6))
-    _outline(ax, outline)  # lo spreads the usual 0.9-1 range over the colours
+    draw_outline(ax, outline)  # lo spreads the usual 0.9-1 range over the colours
     if lines is not None:
         from matplotlib.collections import LineCollection
 
@@ -202,4 +187,4 @@ def comac_map(path, outline, xy, values, labels, lines=None) -> None:
     fig.colorbar(sc, ax=ax, fraction=0.046, pad=0.04, label="COMAC")
     worst = np.argsort(values)[: min(5, len(values))]
     place_labels(ax, xy[worst], [f"{labels[i]}\n{values[i]:.2f}" for i in worst], fontsize=7)
-    _save(fig, path)
+    save_figure(fig, path, **PLOT)

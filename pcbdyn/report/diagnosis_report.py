@@ -57,14 +57,14 @@ def summary(state) -> dict:
 def plot_evidence(path, board, evidence, effects) -> None:
     """Where the residual points: the chi^2 a point mass (and a ground spring) at each node would
     remove once the declared parameters are fitted, with the effects found marked."""
-    from .correlation_plots import _plt, _save
+    from .files import PLOT, pyplot, save_figure
     from .labels import place_labels
 
     kinds = list(evidence)
     if getattr(board, "outline", None) is None:  # a structure in 3-D: 3-D maps
         from .pictures3d import point_map_3d
 
-        fig = _plt().figure(figsize=(6.5 * max(len(kinds), 1), 5.5))
+        fig = pyplot().figure(figsize=(6.5 * max(len(kinds), 1), 5.5))
         grid = fig.add_gridspec(1, max(len(kinds), 1))
         for k, kind in enumerate(kinds):
             xyz, gain = evidence[kind]
@@ -72,9 +72,9 @@ def plot_evidence(path, board, evidence, effects) -> None:
                               title=f"evidence for a {kind.replace('_', ' ')}")
             for e in effects:
                 ax.scatter(*np.asarray(e["at_mm"], float)[:, None], marker="*", s=200, c="r", edgecolors="w")
-        _save(fig, path)
+        save_figure(fig, path, **PLOT)
         return
-    fig, axes = _plt().subplots(1, max(len(kinds), 1), figsize=(5.5 * max(len(kinds), 1), 5.0), squeeze=False,
+    fig, axes = pyplot().subplots(1, max(len(kinds), 1), figsize=(5.5 * max(len(kinds), 1), 5.0), squeeze=False,
                                 layout="constrained")
     outline = np.vstack([board.outline.vertices, board.outline.vertices[:1]]) * 1e3
     for ax, kind in zip(axes[0], kinds):
@@ -87,7 +87,7 @@ def plot_evidence(path, board, evidence, effects) -> None:
         ax.set(title=f"evidence for a {kind.replace('_', ' ')}", xlabel="x [mm]", ylabel="y [mm]", aspect="equal")
     for ax in axes[0][:len(kinds)]:
         place_labels(ax, [e["at_mm"] for e in effects], [e["type"] for e in effects], color="r")
-    _save(fig, path)
+    save_figure(fig, path, **PLOT)
 
 
 def enriched_effects(diagnosis) -> list:

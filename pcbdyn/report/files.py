@@ -12,7 +12,7 @@ from pathlib import Path
 
 from ..atomic import atomic_path
 
-__all__ = ["atomic_path", "json_to_stdout", "save_figure", "write_text", "write_json"]
+__all__ = ["PLOT", "atomic_path", "json_to_stdout", "pyplot", "save_figure", "write_text", "write_json"]
 
 #: the standard output a ``--json -`` run keeps for its JSON while its report goes to stderr
 _JSON_STDOUT = contextvars.ContextVar("pcbdyn_json_stdout", default=None)
@@ -21,6 +21,21 @@ _JSON_STDOUT = contextvars.ContextVar("pcbdyn_json_stdout", default=None)
 def write_text(path, text: str) -> None:
     with atomic_path(path) as tmp:
         tmp.write_text(text)
+
+
+#: savefig options of the plots (MAC matrices, spectra, maps, charts): 110 dpi, trimmed to the drawing
+PLOT = {"dpi": 110, "bbox_inches": "tight"}
+
+
+def pyplot():
+    """matplotlib.pyplot on the Agg backend: every figure of a report is drawn for a file, never a window
+    (a command may run where there is no display)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
 
 
 def save_figure(fig, path, colours: int | None = None, **options) -> Path:

@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import temporary_folder
+from ..fe.model import SHELL_TYPES
 from .files import save_figure
 from .pictures3d import mode_pictures_3d
 from .rendering import CMAP, OTHER, QUANTITY, STYLE, picture_names, render_child, trim
@@ -105,7 +106,7 @@ def mode_pictures(vtu: Path, model, frequencies, shapes, out_dir: Path, prefix: 
 
     out_dir = Path(out_dir)
     names = picture_names(prefix, len(frequencies))
-    cells = [es.conn for es in model.sets.values() if es.etype in ("quad4", "tri3")]
+    cells = [es.conn for es in model.sets.values() if es.etype in SHELL_TYPES]
     tris = [c for c in cells if c.shape[1] == 3] + [c[:, [0, 1, 2]] for c in cells if c.shape[1] == 4]
     tris += [c[:, [0, 2, 3]] for c in cells if c.shape[1] == 4]
     tri = Triangulation(model.nodes[:, 0] * 1e3, model.nodes[:, 1] * 1e3, np.concatenate(tris))

@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import temporary_folder
+from ..fe.model import SHELL_TYPES
 from .files import save_figure
 from .rendering import CMAP, OTHER, QUANTITY_3D, STYLE, normal_displacement, picture_names, render_child, trim
 
@@ -36,7 +37,7 @@ def _view(fig, slot, model, shape, signed, outlines, azim: float, title: str):
     moved = xyz + WARP * span * u / max(np.linalg.norm(u, axis=1).max(), 1e-300)
     cmap = colormaps[CMAP]
     for es in model.sets.values():
-        if es.etype in ("quad4", "tri3"):
+        if es.etype in SHELL_TYPES:
             faces = Poly3DCollection(moved[es.conn], facecolors=cmap(0.5 + 0.5 * signed[es.conn].mean(axis=1)),
                                      edgecolors=(0.4, 0.4, 0.4, 0.35), linewidths=0.2)
             ax.add_collection3d(faces)

@@ -11,8 +11,7 @@ import pandas as pd
 
 from ..vibration.spectra import G
 from ..vibration.srs import PV_SEVERE, pseudo_velocity
-from .correlation_plots import _plt, _save
-from .files import write_text
+from .files import PLOT, pyplot, save_figure, write_text
 from .vibration_report import format_table, margin_map, modes_line, modes_section, verdict, verdict_page
 from .vibration_report import modes_table as vibration_modes_table
 
@@ -82,7 +81,7 @@ def summary_lines(s) -> list:
 
 def srs_plot(path, s) -> None:
     """The SRS [g] and its pseudo-velocity [m/s] with the 100 in/s line, log-log, modes in grey."""
-    plt = _plt()
+    plt = pyplot()
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11.0, 4.6))
     pv = pseudo_velocity(s.srs_f, s.srs_value)
     what = "specification" if s.combination is not None else "maximax absolute acceleration"
@@ -96,7 +95,7 @@ def srs_plot(path, s) -> None:
         ax.legend(fontsize=8)
     ax1.set(xlabel="frequency [Hz]", ylabel="SRS [g]", title=f"shock response spectrum: {s.input.name}")
     ax2.set(xlabel="frequency [Hz]", ylabel="pseudo-velocity [m/s]", title="pseudo-velocity (board modes in grey)")
-    _save(fig, path)
+    save_figure(fig, path, **PLOT)
 
 
 def write_outputs(out: Path, board, model, s) -> list:

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .correlation_plots import _plt, _save
+from .files import PLOT, pyplot, save_figure
 from .labels import place_labels
 
 #: code -> (marker, colour, legend)
@@ -24,7 +24,7 @@ ROWS = [(0, 2), (0, 11), (0, 20)]
 def stabilisation_chart(path, result, frfs) -> None:
     """Write the chart of ``result`` (:class:`pcbdyn.identification.Identification`) over the mean
     magnitude of the FRFs it came from (``frfs``, :class:`pcbdyn.testdata.FRFs`)."""
-    plt = _plt()
+    plt = pyplot()
     c = result.chart
     lo, hi = result.band
     fig, ax = plt.subplots(figsize=(10, 6))
@@ -50,4 +50,4 @@ def stabilisation_chart(path, result, frfs) -> None:
     # the chosen modes' numbers above the chart, a row higher where a neighbour's would overlap
     place_labels(ax, [(f, 1.0) for f in result.modes.frequencies], [str(k + 1) for k in range(n)],
                  xycoords=ax.get_xaxis_transform(), offsets=ROWS, color="tab:red", fontsize=7)
-    _save(fig, path)
+    save_figure(fig, path, **PLOT)

@@ -10,8 +10,8 @@ import numpy as np
 import pandas as pd
 
 from ..vibration.spectra import G
-from .correlation_plots import _outline, _plt, _save, _shell_triangulation
-from .files import write_text
+from .correlation_plots import draw_outline, shell_triangulation
+from .files import PLOT, pyplot, save_figure, write_text
 
 
 def parts_table(a) -> pd.DataFrame:
@@ -83,11 +83,11 @@ def margin_map(path, board, model, field_mm, field_label: str, parts, margin_lab
     from matplotlib.colors import TwoSlopeNorm
     from matplotlib.patches import Polygon
 
-    plt = _plt()
+    plt = pyplot()
     (x0, y0), (x1, y1) = board.outline.bbox
     fig, ax = plt.subplots(figsize=(7.5, float(np.clip(6.0 * (y1 - y0) / (x1 - x0), 3.0, 7.5)) + 2.0))
-    _outline(ax, board.outline)
-    cf = ax.tricontourf(_shell_triangulation(model), np.nan_to_num(field_mm), levels=12, cmap="Greys", alpha=0.6)
+    draw_outline(ax, board.outline)
+    cf = ax.tricontourf(shell_triangulation(model), np.nan_to_num(field_mm), levels=12, cmap="Greys", alpha=0.6)
     fig.colorbar(cf, ax=ax, fraction=0.046, pad=0.02, label=field_label)
     cmap, norm = plt.get_cmap("RdYlGn"), TwoSlopeNorm(vmin=-1.0, vcenter=0.0, vmax=1.0)
     corners = {c.ref: c.corners() for c in board.components}
@@ -100,7 +100,7 @@ def margin_map(path, board, model, field_mm, field_label: str, parts, margin_lab
     fig.colorbar(sm, ax=ax, orientation="horizontal", fraction=0.05, pad=0.1, label=f"{margin_label} (clipped at +-100 %)")
     ax.set(aspect="equal", xlabel="x [mm]", ylabel="y [mm]")
     ax.set_title(title, fontsize=10)
-    _save(fig, path)
+    save_figure(fig, path, **PLOT)
 
 
 def board_map(path, board, model, a) -> None:
@@ -112,7 +112,7 @@ def board_map(path, board, model, a) -> None:
 
 def spectra_plot(path, a) -> None:
     """Input PSD and the absolute acceleration PSD at each part [g^2/Hz], log-log."""
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(7.5, 4.8))
     f = a.grid
     ax.loglog(f, a.psd.at(f) / G**2, "k-", lw=2, label=f"input {a.psd.name} ({a.input_grms:.2f} grms)")
@@ -123,7 +123,7 @@ def spectra_plot(path, a) -> None:
     ax.set(xlabel="frequency [Hz]", ylabel="acceleration PSD [g^2/Hz]", title="response at the parts (modes in grey)")
     ax.legend(fontsize=7, ncol=2)
     ax.grid(True, which="both", alpha=0.3)
-    _save(fig, path)
+    save_figure(fig, path, **PLOT)
 
 
 def spectra_csv(a) -> str:

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .correlation_plots import _plt, _save
+from .files import PLOT, pyplot, save_figure
 from .update_report import format_correlation
 
 UNIT = "N*m/rad/m"
@@ -78,7 +78,7 @@ def _pct(v) -> str:
 def plot_history(path, d: dict) -> None:
     """Per iteration: max |df| and the frequency residue [%] (thesis Fig. 7.38) and each guide's
     stiffness on a log scale (Fig. 7.39)."""
-    plt = _plt()
+    plt = pyplot()
     h = d["history"]
     it = [e["iteration"] for e in h]
     fig, ax = plt.subplots(1, 2, figsize=(10, 3.8))
@@ -93,14 +93,14 @@ def plot_history(path, d: dict) -> None:
     for a in ax:
         a.set_xticks(it)
     fig.tight_layout()
-    _save(fig, path)
+    save_figure(fig, path, **PLOT)
 
 
 def plot_frequencies(path, d: dict) -> None:
     """Each paired test mode's model frequency against a stiffness shared by the guides (the scan
     between the extremes), the hinged and clamped values as its limits, the test's frequency with its
     tolerance band, and the fitted stiffness of each guide (dashed when the springs were not kept)."""
-    plt = _plt()
+    plt = pyplot()
     k = np.asarray(d["scan"]["k"])
     modes = [(c["configuration"], m) for c in d["scan"]["configurations"] for m in c["test_modes"]]
     limits = {kind: {(c["configuration"], q["test_mode"]): q["f_model_hz"]
@@ -130,4 +130,4 @@ def plot_frequencies(path, d: dict) -> None:
         ax.axis("off")
     axes.ravel()[0].legend(fontsize=7)
     fig.tight_layout()
-    _save(fig, path)
+    save_figure(fig, path, **PLOT)

@@ -15,7 +15,7 @@ import re
 import numpy as np
 
 from ..units import LENGTHS, shown
-from .data import FILE_FLOOR_HZ, Dofs, Modes, Points, TestDataError, check_frequencies
+from .data import FILE_FLOOR_HZ, Dofs, MeasuredModes, Points, TestDataError, check_frequencies
 from .uff_write import _atomic
 
 _HEAD = re.compile(r"^\s*([A-Za-z][A-Za-z0-9 ]*?)\s*(?:[\[(]\s*([^\])]*)\s*[\])]|_(mm|cm|m|um|in))?\s*$")
@@ -69,9 +69,27 @@ def _length_col(path, df, cols, name, unit, required=True):
 
 
 def read_points_csv(path, unit: str | None = None):
-    """(Points, Dofs) from a CSV with columns point, x, y, [z], [dir]; one row per point and
-    direction (a point may appear on several rows with different directions, same coordinates).
-    ``unit`` is used for coordinate columns written without one."""
+    """The measurement points and their measured directions, from a points CSV.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        A CSV with columns point, x, y, [z], [dir]; one row per point and direction (a point may
+        appear on several rows with different directions, same coordinates).
+    unit : str, optional
+        The unit of coordinate columns written without one (``x [mm]`` states its own).
+
+    Returns
+    -------
+    (Points, Dofs)
+        Point ids and coordinates [m]; the measured DOFs (point id, unit direction).
+
+    Examples
+    --------
+    >>> points, dofs = read_points_csv("examples/six_part_card/points.csv")
+    >>> len(points.ids), len(dofs)
+    (81, 81)
+    """
     df, cols = _table(path)
     key = "point" if "point" in cols else "id" if "id" in cols else None
     if key is None:
@@ -122,7 +140,7 @@ def _write_text(path, text):
     _atomic(path, write)
 
 
-def write_modes_csv(freq_path, shapes_path, modes: Modes) -> None:
+def write_modes_csv(freq_path, shapes_path, modes: MeasuredModes) -> None:
     """Frequencies (with damping and MPC) and shapes (one row per DOF) as two CSV files."""
     buf = io.StringIO()
     buf.write("mode,frequency [Hz],damping ratio,mpc\n")
@@ -138,8 +156,8 @@ def write_modes_csv(freq_path, shapes_path, modes: Modes) -> None:
     _write_text(shapes_path, buf.getvalue())
 
 
-def read_modes_csv(freq_path, shapes_path) -> Modes:
-    """Modes from the two CSV files written by :func:`write_modes_csv` (or by hand: damping and mpc
+def read_modes_csv(freq_path, shapes_path) -> MeasuredModes:
+    """Measured modes from the two CSV files written by :func:`write_modes_csv` (or by hand: damping and mpc
     columns are optional; shape columns are named 'mode 1', 'mode 2', ...)."""
     df, cols = _table(freq_path)
     if "frequency" not in cols:
@@ -165,6 +183,6 @@ def read_modes_csv(freq_path, shapes_path) -> Modes:
     shapes = np.column_stack([numbers(shapes_path, sf, scols[n][0]) for n in names])
     uid, first = np.unique(ids, return_index=True)
     try:
-        return Modes(Points(uid, xyz[first]), Dofs(ids, d), f, shapes, zeta, mpc)
+        return MeasuredModes(Points(uid, xyz[first]), Dofs(ids, d), f, shapes, zeta, mpc)
     except TestDataError as exc:
         raise TestDataError(f"{freq_path}, {shapes_path}: {exc}") from None

@@ -154,7 +154,7 @@ FILE_FLOOR_HZ = 0.01
 def check_frequencies(frequencies, where: str = "modes", numbers=None, floor: float = 0.0) -> np.ndarray:
     """Measured natural frequencies [Hz] as floats: each a finite number above 0 (0 Hz or below is a rigid-body
     mode or a mistyped value) and, with ``floor`` (the readers of files pass :data:`FILE_FLOOR_HZ`), not below
-    it. The one home of this rule: :class:`Modes` (whose simulated modes keep floor 0) and the readers (which
+    it. The one home of this rule: :class:`MeasuredModes` (whose simulated modes keep floor 0) and the readers (which
     give ``where``: the file, dataset or table row) call it. ``numbers``: the modes' numbers, to name the one
     refused."""
     f = np.asarray(frequencies, dtype=float).ravel()
@@ -191,7 +191,7 @@ def check_damping(damping, n: int, where: str = "modes", numbers=None) -> np.nda
 def check_shapes(shapes, where: str = "modes", numbers=None, nonzero: bool = True) -> None:
     """Measured shapes (n_dof, n_modes), real or complex: every value a finite number at most MAX_SHAPE in size,
     and (``nonzero``) no shape zero at every DOF (it pairs with nothing). The one home of this rule (see
-    :func:`check_frequencies`). :class:`Modes` itself admits a zero shape: a test simulated on a flat board's
+    :func:`check_frequencies`). :class:`MeasuredModes` itself admits a zero shape: a test simulated on a flat board's
     model reads its in-plane modes as zero at out-of-plane DOFs; a file's record may not hold one."""
     a = np.abs(np.asarray(shapes))
     if not np.isfinite(a).all():
@@ -208,7 +208,7 @@ def check_shapes(shapes, where: str = "modes", numbers=None, nonzero: bool = Tru
 
 
 @dataclass
-class Modes:
+class MeasuredModes:
     """Measured (real, normal) modes: frequencies [Hz], viscous damping ratios, shapes (n_dof, n_modes)
     at the measured DOFs; the one measured-modes type of correlation, updating and diagnosis.
 
@@ -245,7 +245,7 @@ class Modes:
         self.mpc = np.ones(n) if self.mpc is None else np.asarray(self.mpc, float).ravel()
 
     @classmethod
-    def frequencies_only(cls, frequencies, numbers=None) -> "Modes":
+    def frequencies_only(cls, frequencies, numbers=None) -> "MeasuredModes":
         """Measured frequencies [Hz] without shapes, of the test's mode ``numbers`` (default 1..n)."""
         return cls(None, None, frequencies, None, numbers=numbers)
 
@@ -272,15 +272,15 @@ class Modes:
         used = self.points.index(np.unique(self.dofs.point_ids))
         return Points(self.points.ids[used], self.points.xyz[used])
 
-    def subset(self, keep) -> "Modes":
+    def subset(self, keep) -> "MeasuredModes":
         """The modes ``keep`` (a boolean mask or indices), with their numbers."""
         k = np.asarray(keep)
-        return Modes(self.points, self.dofs, self.frequencies[k], None if self.shapes is None else self.shapes[:, k],
+        return MeasuredModes(self.points, self.dofs, self.frequencies[k], None if self.shapes is None else self.shapes[:, k],
                      self.damping[k], self.mpc[k], self.numbers[k])
 
-    def without_shapes(self) -> "Modes":
+    def without_shapes(self) -> "MeasuredModes":
         """The frequencies alone (pairing by the test's mode numbers)."""
-        return Modes.frequencies_only(self.frequencies, self.numbers)
+        return MeasuredModes.frequencies_only(self.frequencies, self.numbers)
 
 
 #: FRF kinds and the power of (i omega) that turns a receptance into each
@@ -365,7 +365,7 @@ class TestData:
     wireframe (n, 2) of point ids (trace lines, element edges) and its elements [(descriptor, node ids)]."""
 
     points: Points
-    modes: Modes | None = None
+    modes: MeasuredModes | None = None
     frfs: FRFs | None = None
     skipped: list = field(default_factory=list)
     wireframe: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int64))

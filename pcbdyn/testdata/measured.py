@@ -7,14 +7,14 @@ from pathlib import Path
 
 import numpy as np
 
-from .data import FILE_FLOOR_HZ, Modes, TestDataError, check_frequencies
+from .data import FILE_FLOOR_HZ, MeasuredModes, TestDataError, check_frequencies
 from .uff import read_uff
 
 #: configuration names of a frequency table that mean the base configuration
 BASE_NAMES = ("base", "c1", "")
 
 
-def read_modes(path) -> Modes:
+def read_modes(path) -> MeasuredModes:
     """The measured modes of a UFF file; a clear error when there are none."""
     return read_test(path).modes
 
@@ -59,7 +59,7 @@ def _configuration(structure, name, source) -> str:
 
 
 def read_tests(structure, base, extras=()) -> list:
-    """[(configuration name or None, Modes)] of the base test file ``base`` and of ``extras``
+    """[(configuration name or None, MeasuredModes)] of the base test file ``base`` and of ``extras``
     [(configuration name, file)] of ``structure``'s perturbed configurations."""
     data = [(None, read_modes(base))]
     for name, path in extras:
@@ -68,7 +68,7 @@ def read_tests(structure, base, extras=()) -> list:
 
 
 def read_frequency_table(path, structure) -> list:
-    """[(configuration or None, Modes of frequencies only)] from a CSV of measured frequencies with
+    """[(configuration or None, MeasuredModes of frequencies only)] from a CSV of measured frequencies with
     columns configuration, mode, frequency_hz (configuration base or c1: the base configuration);
     each mode pairs with the model's elastic mode of its number."""
     from ..domain import MAX_MODES
@@ -93,5 +93,5 @@ def read_frequency_table(path, structure) -> list:
         if np.unique(nc).size < nc.size:
             raise TestDataError(f"{path.name}: configuration {name}: a mode number is given twice; give each mode once")
         check_frequencies(fc, f"{path.name}: configuration {name}", nc, floor=FILE_FLOOR_HZ)
-        out.append((cfg, Modes.frequencies_only(fc, nc)))
+        out.append((cfg, MeasuredModes.frequencies_only(fc, nc)))
     return out

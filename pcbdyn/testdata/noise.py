@@ -1,4 +1,5 @@
-"""Measurement noise for simulated tests, the thesis' uniform multiplicative models (eq. 5.72-5.74).
+"""Measurement noise for simulated tests, the thesis' uniform multiplicative models (eq. 5.72-5.74):
+the one noise model of pcbdyn (simulated tests, calibration and localisation studies use it).
 
 Each value is multiplied by (1 + p/100 * eps) with eps uniform in [-1, 1], drawn independently per
 frequency (eq. 5.72), per shape component (eq. 5.73) or per FRF value (eq. 5.74). p is a percentage.
@@ -11,36 +12,68 @@ from dataclasses import dataclass
 import numpy as np
 
 
-def _rng(seed):
-    return seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
+def add_noise(values, pct: float, seed=None, name: str = "the") -> np.ndarray:
+    """Measurement noise of a simulated test: values (1 + p/100 eps), eps uniform in [-1, 1] drawn
+    per component (thesis eqs. 5.72-5.74).
 
+    Parameters
+    ----------
+    values : array_like
+        Frequencies, shape components or FRF values; complex values (FRFs) get a real factor, as in
+        eq. 5.74.
+    pct : float
+        The noise level p [%], at least 0.
+    seed : int or numpy.random.Generator, optional
+        A Generator is drawn from (so that successive calls differ); a seed makes the draw repeatable.
+    name : str
+        The quantity, named in the error a negative ``pct`` raises.
 
-def _perturb(values, pct, seed, name):
+    Returns
+    -------
+    numpy.ndarray
+        The noisy values, of the shape of ``values``.
+
+    Examples
+    --------
+    >>> f = add_noise([100.0, 200.0, 300.0], 1.0, seed=0)
+    >>> bool(abs(f / [100.0, 200.0, 300.0] - 1).max() <= 0.01)
+    True
+    >>> bool((add_noise([100.0], 1.0, seed=0) == f[:1]).all())
+    True
+    """
     if pct < 0:
         raise ValueError(f"{name} noise level must be a non-negative percentage, got {pct}")
     v = np.asarray(values)
-    eps = _rng(seed).uniform(-1.0, 1.0, size=v.shape)
+    eps = np.random.default_rng(seed).uniform(-1.0, 1.0, size=v.shape)
     return (1.0 + pct / 100.0 * eps) * v
 
 
 def noisy_frequencies(f, pct: float, seed=None) -> np.ndarray:
     """f_i (1 + p/100 eps_i) (thesis eq. 5.72)."""
-    return _perturb(f, pct, seed, "frequency")
+    return add_noise(f, pct, seed, "frequency")
 
 
 def noisy_shapes(phi, pct: float, seed=None) -> np.ndarray:
     """phi_ij (1 + p/100 eps_ij) for every DOF i and mode j (thesis eq. 5.73)."""
-    return _perturb(phi, pct, seed, "mode shape")
+    return add_noise(phi, pct, seed, "mode shape")
 
 
 def noisy_frfs(H, pct: float, seed=None) -> np.ndarray:
     """H_ij(w_k) (1 + p/100 eps_ijk), eps real, for every FRF and frequency line (thesis eq. 5.74)."""
-    return _perturb(H, pct, seed, "FRF")
+    return add_noise(H, pct, seed, "FRF")
 
 
 @dataclass(frozen=True)
 class Noise:
-    """Noise levels in percent for frequencies, mode shapes and FRFs (thesis eq. 5.72-5.74)."""
+    """Noise levels in percent for frequencies, mode shapes and FRFs (thesis eq. 5.72-5.74).
+
+    Examples
+    --------
+    >>> Noise.parse("f=0.2,shape=2")
+    Noise(frequency_pct=0.2, shape_pct=2.0, frf_pct=0.0)
+    >>> Noise.parse("1")
+    Noise(frequency_pct=1.0, shape_pct=1.0, frf_pct=1.0)
+    """
 
     frequency_pct: float = 0.0
     shape_pct: float = 0.0

@@ -15,7 +15,7 @@ import scipy.sparse as sp
 from pcbdyn.fe.frf import frf_modal
 from pcbdyn.fe.modal import Modes as ModelModes
 
-from .data import Dofs, FRFs, Modes, Points, TestData
+from .data import Dofs, FRFs, MeasuredModes, Points, TestData
 from .noise import Noise, noisy_frequencies, noisy_frfs, noisy_shapes
 
 #: FRFs sum every mode up to this multiple of the band's top frequency
@@ -54,7 +54,7 @@ def simulate_test(
     z = np.broadcast_to(np.asarray(zeta, dtype=float), (n,)).copy()
     f = noisy_frequencies(modes.frequencies, noise.frequency_pct, rng)
     shapes = noisy_shapes(at, noise.shape_pct, rng)
-    test_modes = Modes(points, dofs, f, shapes, z)
+    test_modes = MeasuredModes(points, dofs, f, shapes, z)
     frfs = None
     if reference is not None:
         if read_reference is None or f_axis is None:
@@ -92,14 +92,47 @@ def simulate_on_model(
     K=None,
     M=None,
 ) -> TestData:
-    """:func:`simulate_test` on a shell model, reading it at the points through the shape functions.
+    """A modal test as it would be measured on a shell model (:func:`simulate_test`), the model read at
+    the points through the shape functions, with the thesis' noise (eqs. 5.72-5.74).
 
+    Parameters
+    ----------
+    model : pcbdyn.fe.Model
+        The structure tested (a board's: ``board.build().model``).
+    modes : pcbdyn.fe.modal.Modes
+        Its modes (:func:`pcbdyn.fe.modal.solve_modes`).
+    points, dofs : Points, Dofs
+        Where and in which directions the test measures (:func:`pcbdyn.testdata.read_points_csv`).
+    noise : Noise
+        Noise levels [%] of the frequencies, shapes and FRFs; ``seed`` makes the draw repeatable.
+
+    Returns
+    -------
+    TestData
+        ``points``, ``modes`` (:class:`pcbdyn.testdata.MeasuredModes`) and, with ``excite`` and
+        ``f_axis``, ``frfs``.
+
+    Notes
+    -----
     ``excite`` (x, y, z) [m]: the excitation point (FRFs are written when it and ``f_axis`` are
     given); it joins the points with id ``excite_id`` (default: one above the largest id) unless a
     point already sits there. ``frf_modes`` (e.g. :func:`frf_modes`): when given, the FRFs sum them and add
     the static compliance of all the model's other modes (:func:`pcbdyn.fe.frf.residual_flexibility`; ``K,
     M``: the assembled matrices, if at hand), the model's complete FRF but for the dynamics of the modes far
     above the band; else they sum ``modes`` alone.
+
+    Examples
+    --------
+    >>> from pcbdyn.board import load_board
+    >>> from pcbdyn.fe.modal import solve_modes
+    >>> from pcbdyn.testdata import Noise, read_points_csv
+    >>> card = "examples/six_part_card/"
+    >>> model = load_board(card + "board.toml").build().model
+    >>> points, dofs = read_points_csv(card + "points.csv")
+    >>> test = simulate_on_model(model, solve_modes(model, n_modes=7), points, dofs,
+    ...                          noise=Noise(frequency_pct=0.2, shape_pct=2.0), seed=1)
+    >>> test.modes.n_modes, test.modes.shapes.shape
+    (7, (81, 7))
     """
     from pcbdyn.fe.probe import model_probe
 

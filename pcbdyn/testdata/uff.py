@@ -33,7 +33,7 @@ from .data import (
     FILE_FLOOR_HZ,
     Dofs,
     FRFs,
-    Modes,
+    MeasuredModes,
     Points,
     TestData,
     TestDataError,
@@ -191,9 +191,41 @@ def real_modes(psi: np.ndarray):
 def read_uff(path, points: Points | None = None, frf_kind: str | None = None) -> TestData:
     """Points, modes and FRFs of a UFF file, in SI units and the board frame.
 
-    ``points``: coordinates to use when the file has no geometry (15/2411), or to replace it (its
-    directions are then global). ``frf_kind``: receptance, mobility or accelerance, for FRFs whose
-    dataset does not say (ordinate data type 0). Unsupported datasets are listed in
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        A Universal File (datasets 15/2411 points, 55 modes, 58/58b FRFs, 164 units).
+    points : Points, optional
+        Coordinates to use instead of the file's geometry.
+    frf_kind : str, optional
+        receptance, mobility or accelerance, for FRFs whose dataset does not say.
+
+    Returns
+    -------
+    TestData
+        ``points``, ``modes`` (:class:`pcbdyn.testdata.MeasuredModes`, or None), ``frfs`` (or None),
+        ``skipped`` (the datasets not read).
+
+    Examples
+    --------
+    Written by :func:`pcbdyn.testdata.write_uff` and read back:
+
+    >>> import os, tempfile
+    >>> import numpy as np
+    >>> from pcbdyn.testdata import Dofs, MeasuredModes, Points, TestData, write_uff
+    >>> points = Points([1, 2], [[0.0, 0.0, 0.0], [0.1, 0.0, 0.0]])
+    >>> dofs = Dofs([1, 2], [[0.0, 0.0, 1.0], [0.0, 0.0, 1.0]])
+    >>> modes = MeasuredModes(points, dofs, [120.0], [[0.5], [1.0]], damping=[0.01])
+    >>> path = os.path.join(tempfile.mkdtemp(), "test.uff")
+    >>> write_uff(path, TestData(points, modes))
+    >>> back = read_uff(path).modes
+    >>> back.frequencies, back.shapes.ravel(), back.damping
+    (array([120.]), array([0.5, 1. ]), array([0.01]))
+
+    Notes
+    -----
+    ``points`` replace the file's geometry (15/2411) or stand for a missing one (its directions are
+    then global); ``frf_kind`` is for datasets of ordinate data type 0. Unsupported datasets are listed in
     ``TestData.skipped``. FRFs share one frequency axis; response/reference pairs absent from the file
     are NaN in ``H``. Every DOF's direction is global: a direction code means the axis of its node's
     displacement system (:mod:`.uff_geometry`), signed as written. Files without a dataset 164 are read
@@ -301,8 +333,8 @@ def _checked58(d: dict) -> dict:
     return d
 
 
-def _assemble_modes(modes55, geo: Geometry) -> Modes:
-    """One Modes object from the 55 datasets: DOFs are the (node, axis) pairs nonzero in any mode, each
+def _assemble_modes(modes55, geo: Geometry) -> MeasuredModes:
+    """One MeasuredModes object from the 55 datasets: DOFs are the (node, axis) pairs nonzero in any mode, each
     along its node's displacement axis in the global frame.
 
     Nodes absent from a dataset are zero there (dataset 55, note 9)."""
@@ -316,7 +348,7 @@ def _assemble_modes(modes55, geo: Geometry) -> Modes:
     dirs = [geo.direction(n, a + 1) for n, a in zip(all_nodes[node_of], axis_of)]
     dofs = Dofs(all_nodes[node_of], np.array(dirs, float).reshape(-1, 3))
     shapes, mpc = real_modes(psi[node_of, axis_of, :])
-    return Modes(geo.points, dofs, [m[0] for m in modes55], shapes, [m[1] for m in modes55], mpc)
+    return MeasuredModes(geo.points, dofs, [m[0] for m in modes55], shapes, [m[1] for m in modes55], mpc)
 
 
 def _frf_scale(d, kind, L, F) -> float:

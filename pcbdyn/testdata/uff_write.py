@@ -24,7 +24,7 @@ import os
 import numpy as np
 
 from ..atomic import atomic_path
-from .data import FRFs, Modes, TestData, TestDataError
+from .data import FRFs, MeasuredModes, TestData, TestDataError
 
 _KIND_SPEC = {"receptance": 8, "mobility": 11, "accelerance": 12}
 _END = b"    -1\n"
@@ -82,7 +82,7 @@ def mode55(mode_n: int, freq: float, zeta: float, nodes, r) -> str:
     return "".join(out) + _END.decode()
 
 
-def node_table(modes: Modes):
+def node_table(modes: MeasuredModes):
     """Nodes and their (x, y, z) shape values (n_nodes, 3, n_modes) for dataset 55."""
     codes = modes.dofs.codes()
     nodes, row = np.unique(modes.dofs.point_ids, return_inverse=True)
@@ -140,6 +140,16 @@ def frf58(frfs: FRFs, i: int, j: int, binary: bool) -> bytes:
 def write_uff(path, data: TestData, binary: bool | None = None, geometry: str = "2411") -> None:
     """Write units (164, SI), points (2411, or 15), modes (55) and FRFs (58/58b) atomically.
 
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The Universal File written.
+    data : TestData
+        Points, and modes and/or FRFs (:func:`pcbdyn.testdata.simulate.simulate_on_model` makes one);
+        :func:`pcbdyn.testdata.read_uff` has an example of both.
+
+    Notes
+    -----
     ``binary``: FRFs as 58b; None chooses ASCII 58 unless the frequency axis is uneven or its start
     and step would lose digits in the ASCII header. ``geometry``: "2411" (double precision) or "15"
     (single precision, for older tools). The precision of each dataset is in the module notes.

@@ -28,8 +28,8 @@ from .sensitivity import (
     eigenvector_derivatives_modal,
     frequencies_hz,
     frequency_derivatives,
+    pencil_modes,
     perturbation_derivatives,
-    solve_modes,
 )
 from .solvers import (
     RankDeficiencyWarning,
@@ -47,11 +47,10 @@ from .solvers import (
     solve_tls,
 )
 from .subset import Subset, qr_basic_solution, svd_qr, threshold_selection, tls_qrf
-from .success import add_noise, success_ratio, success_statistics
+from .success import success_ratio, success_statistics
 from .weighting import std_row_weights, tls_column_weight, unit_row_weights, weight_rows
 
 __all__ = [
-    "add_noise",
     "bayes_alpha",
     "bilinear_forms",
     "Block",
@@ -87,7 +86,7 @@ __all__ = [
     "solve_bayes",
     "solve_bounded",
     "solve_ls",
-    "solve_modes",
+    "pencil_modes",
     "solve_tls",
     "stack",
     "std_row_weights",

@@ -14,11 +14,12 @@ from typing import Callable
 
 import numpy as np
 
+from ..correlation.mac import mac
 from . import equations as eq
 from . import matching
 from .errors import UpdatingError
 from .pbc import stack
-from .sensitivity import frequencies_hz, solve_modes
+from .sensitivity import frequencies_hz, pencil_modes
 from .shapes import shape_derivatives, shape_residual, shape_rows, shape_sigma
 from .solvers import frequency_residue
 from .weighting import std_row_weights, unit_row_weights, weight_rows
@@ -90,12 +91,6 @@ class Configuration:
             raise ValueError(f"matching={self.matching!r}; choose 'expand' or 'reduce'")
 
 
-def mac_matrix(a, b) -> np.ndarray:
-    """MAC between the columns of a and b (real or complex)."""
-    num = np.abs(a.conj().T @ b) ** 2
-    return num / np.outer(np.einsum("ij,ij->j", a.conj(), a).real, np.einsum("ij,ij->j", b.conj(), b).real)
-
-
 def mac_pairing(f_a, phi_a, f_x, phi_x) -> np.ndarray:
     """Analytical mode index for each measured mode: largest MAC, ties broken by the closest
     frequency, each analytical mode used once (greedy on decreasing MAC). Without shapes: by
@@ -104,7 +99,7 @@ def mac_pairing(f_a, phi_a, f_x, phi_x) -> np.ndarray:
     if phi_x is None:
         score = -np.abs(f_a[:, None] / f_x[None, :] - 1)
     else:
-        score = mac_matrix(phi_a, phi_x) - 1e-6 * np.abs(f_a[:, None] / f_x[None, :] - 1)
+        score = mac(phi_a, phi_x) - 1e-6 * np.abs(f_a[:, None] / f_x[None, :] - 1)
     pairs = -np.ones(f_x.size, int)
     S = score.copy()
     for _ in range(min(S.shape)):
@@ -121,7 +116,7 @@ def _state(cfg: Configuration, p, pairing):
     out = {"K": K, "M": M, "dKs": dKs, "dMs": dMs}
     if cfg.f_x is not None:
         n_modes = cfg.n_modes or min(K.shape[0], max(2 * np.size(cfg.f_x), np.size(cfg.f_x) + 4))
-        out.update(paired_state(cfg, *solve_modes(K, M, n_modes), pairing))
+        out.update(paired_state(cfg, *pencil_modes(K, M, n_modes), pairing))
     return out
 
 
@@ -149,7 +144,7 @@ def paired_state(cfg: Configuration, lam, Phi, pairing=None) -> dict:
            "lam_all": lam, "Phi_all": Phi, "phi_am": phi_am[:, ia], "sigma": frequency_residue(f_a[ia], f_x[used]),
            "max_err_pct": float(np.max(np.abs(1 - f_a[ia] / f_x[used])) * 100)}
     if cfg.phi_x is not None:
-        out["mac"] = np.diag(mac_matrix(phi_am[:, ia], np.asarray(cfg.phi_x)[:, used]))
+        out["mac"] = np.diag(mac(phi_am[:, ia], np.asarray(cfg.phi_x)[:, used]))
     return out
 
 

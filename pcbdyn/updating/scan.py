@@ -27,7 +27,7 @@ import scipy.linalg as sla
 
 from .driver import _better, _key, evaluate
 from .iteration import paired_state
-from .sensitivity import solve_modes
+from .sensitivity import pencil_modes
 
 #: parameters scanned jointly at most
 MAX_SCANNED = 3
@@ -148,7 +148,7 @@ class _Ritz:
     def __init__(self, cfg, anchors, ranges, p0):
         self.cfg = cfg
         self.n = cfg.n_modes or 2 * np.size(cfg.f_x) + 4
-        Phi = np.hstack([solve_modes(*cfg.model(p)[:2], self.n)[1] for p in anchors])
+        Phi = np.hstack([pencil_modes(*cfg.model(p)[:2], self.n)[1] for p in anchors])
         U, sv, _ = np.linalg.svd(Phi, full_matrices=False)
         B = U[:, sv > 1e-10 * sv[0]]
         self.indices = [j for j, _, _ in ranges]

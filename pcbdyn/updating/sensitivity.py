@@ -18,10 +18,14 @@ def as_dense(A) -> np.ndarray:
     return A.toarray() if sp.issparse(A) else np.asarray(A)
 
 
-def solve_modes(K, M, n_modes: int | None = None):
+def pencil_modes(K, M, n_modes: int | None = None):
     """Lowest ``n_modes`` eigenpairs (default: all) of K phi = lambda M phi as (lambda, Phi), sorted,
     Phi mass-normalised; rigid-body modes of a free system are included (lambda ~ 0), so pair
     measured modes with elastic ones only. Solved by the FE engine's :func:`pcbdyn.fe.modal.eigenpairs`.
+
+    Not :func:`pcbdyn.fe.modal.solve_modes`: that one takes a model (its constraints, its rigid-body
+    check) and returns elastic :class:`~pcbdyn.fe.modal.Modes` in Hz; this one takes a bare matrix
+    pencil, as the sensitivity formulas (thesis section 3.2) do, and returns every eigenpair in lambda.
     """
     if K.shape != M.shape or K.shape[0] != K.shape[1]:
         raise ValueError(f"K {K.shape} and M {M.shape} must be square and of equal size")

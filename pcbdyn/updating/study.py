@@ -30,9 +30,10 @@ import numpy as np
 import pandas as pd
 
 from ..parallel import run_jobs
+from ..testdata.noise import add_noise
 from .solvers import RankDeficiencyWarning, solve_ls
 from .subset import qr_basic_solution, svd_qr, threshold_selection, tls_qrf
-from .success import add_noise, success_ratio, success_statistics
+from .success import success_ratio, success_statistics
 from .weighting import NOISE_REDRAWS, tls_column_weight_from_noise, unit_row_weights, weight_rows
 
 METHODS = ("tls-qrf", "svd-qr", "qr", "min-norm")

@@ -1,5 +1,5 @@
-"""Success ratio of parameter error localisation and the simulated measurement noise of the
-success-ratio studies (thesis sections 5.3.1 and 5.3.3)."""
+"""Success ratio of parameter error localisation (thesis section 5.3.1); the studies' measurement
+noise is :func:`pcbdyn.testdata.noise.add_noise` (section 5.3.3)."""
 
 from __future__ import annotations
 
@@ -19,12 +19,3 @@ def success_statistics(ratios):
     """Mean and sample standard deviation of success ratios over random shots (thesis eq. 5.66)."""
     r = np.asarray(ratios, float)
     return float(r.mean()), float(r.std(ddof=1)) if r.size > 1 else 0.0
-
-
-def add_noise(values, level_pct: float, rng=None):
-    """values * (1 + level/100 * eps), eps uniform in [-1, 1] per component: the noise model of
-    frequencies, mode shapes and FRFs in the thesis' studies (eqs. 5.72-5.74). Complex values
-    (FRFs) get a real factor, as in eq. 5.74."""
-    rng = np.random.default_rng(rng)
-    v = np.asarray(values)
-    return v * (1.0 + level_pct / 100.0 * rng.uniform(-1.0, 1.0, size=v.shape))

@@ -17,6 +17,7 @@ import scipy.sparse as sp
 
 from ..components.library import LibraryError, find_package
 from ..fe.curvature import curvature_matrix
+from ..fe.model import SHELL_TYPES
 from ..fe.probe import model_probe
 from .spectra import VibrationError
 
@@ -125,7 +126,7 @@ def judged_parts(board, exclude=()) -> list:
 
 def shell_nodes(model) -> np.ndarray:
     """The nodes of the model's shells (the board), where board maps are drawn."""
-    return np.unique(np.concatenate([es.conn.ravel() for es in model.sets.values() if es.etype in ("quad4", "tri3")]))
+    return np.unique(np.concatenate([es.conn.ravel() for es in model.sets.values() if es.etype in SHELL_TYPES]))
 
 
 def _curvature_rows(model, parts) -> tuple:

@@ -21,7 +21,7 @@ from pcbdyn import diagnosis as dg
 from pcbdyn.board import BoardError, build_model, load_board
 from pcbdyn.board.effects import ScaledShell, rib_property
 from pcbdyn.board.enrich import enriched_path
-from pcbdyn.diagnosis.catalogue import Candidate, chain_candidate, copy_model
+from pcbdyn.diagnosis.catalogue import Candidate, chain_candidate
 from pcbdyn.fe.elements import kernel
 from pcbdyn.fe.modal import solve_modes
 
@@ -79,12 +79,12 @@ def same_mesh_diagnosis(bmE, kind, effect):
     m = bmE.model
     if kind in ("point_mass", "point_inertia"):
         name = bd.masses[-1].name
-        base = copy_model(m)
+        base = m.copy()
         del base.sets[f"masses.{name}"]
         return base, Candidate(kind, "c", effect["at"], np.array([bmE.point_nodes[f"masses.{name}"]]))
     if kind == "ground_spring":
         name = bd.fixtures[-1].name
-        base = copy_model(m)
+        base = m.copy()
         del base.sets[f"fixtures.{name}"]
         return base, Candidate(kind, "c", effect["at"], np.array([bmE.point_nodes[f"fixtures.{name}"]]))
     if kind == "region_stiffness":
@@ -98,7 +98,7 @@ def same_mesh_diagnosis(bmE, kind, effect):
     prefix = {"edge_stiffness": lambda: f"fixtures.{bd.fixtures[-1].name}",
               "line_mass": lambda: f"line_masses.{bd.line_masses[-1].name}",
               "stiffener": lambda: f"stiffeners.{bd.stiffeners[-1].name}"}[kind]()
-    base = copy_model(m)
+    base = m.copy()
     for s in [s for s in base.sets if s == prefix or s.startswith(prefix + ".")]:
         del base.sets[s]
     pts = np.asarray(effect["path" if kind == "stiffener" else "segment"])

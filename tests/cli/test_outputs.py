@@ -92,11 +92,11 @@ def own_frequencies(card, tmp_path, t_pga: float) -> Path:
     a test the model fits."""
     from pcbdyn.board import load_board
     from pcbdyn.problems import UpdateProblem
-    from pcbdyn.updating import frequencies_hz, solve_modes
+    from pcbdyn.updating import frequencies_hz, pencil_modes
 
     sysm = UpdateProblem(load_board(card), ["t_PGA"]).system(None)
     K, M, _, _ = sysm.model([t_pga])
-    f = frequencies_hz(solve_modes(K, M, sysm.n_rigid + 5)[0])[sysm.n_rigid:]
+    f = frequencies_hz(pencil_modes(K, M, sysm.n_rigid + 5)[0])[sysm.n_rigid:]
     path = tmp_path / "own.csv"
     path.write_text("configuration,mode,frequency_hz\n" + "".join(f"c1,{i + 1},{v:.4f}\n" for i, v in enumerate(f)))
     return path

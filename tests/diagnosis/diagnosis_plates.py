@@ -52,14 +52,14 @@ def rotary_inertia(model, axis: int, about) -> float:
 
 
 def measured(f, shapes=None, xyz=None, directions=(0.0, 0.0, 1.0)):
-    """Measured modes (pcbdyn.testdata.Modes) of frequencies ``f``, with ``shapes`` at points ``xyz``
+    """Measured modes (pcbdyn.testdata.MeasuredModes) of frequencies ``f``, with ``shapes`` at points ``xyz``
     (default: the origin, for residuals that read shapes through a given matrix) along ``directions``."""
-    from pcbdyn.testdata import Dofs, Modes, Points
+    from pcbdyn.testdata import Dofs, MeasuredModes, Points
 
     if shapes is None:
-        return Modes.frequencies_only(f)
+        return MeasuredModes.frequencies_only(f)
     shapes = np.asarray(shapes, float)
     n = shapes.shape[0]
     ids = np.arange(1, n + 1)
     xyz = np.zeros((n, 3)) if xyz is None else np.asarray(xyz, float)
-    return Modes(Points(ids, xyz), Dofs(ids, directions), f, shapes)
+    return MeasuredModes(Points(ids, xyz), Dofs(ids, directions), f, shapes)

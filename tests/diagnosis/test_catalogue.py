@@ -87,7 +87,7 @@ def test_edge_stiffness_on_the_free_edge_tends_to_holding_its_rotation(plate):
     whole = max(edge, key=lambda c: c.data["length"])
     assert whole.data["length"] == pytest.approx(sum(c.data["length"] for c in edge if "-" not in c.name))
     stiff = dg.add_effect(m, whole, 1e9)
-    held = dg.catalogue.copy_model(m)
+    held = m.copy()
     held.fix(whole.nodes, ("ry",))
     f_stiff, f_held = frequencies(stiff), frequencies(held)
     assert np.all(f_stiff > modes.frequencies)

@@ -12,7 +12,7 @@ from pcbdyn import diagnosis as dg
 from pcbdyn.diagnosis.residual import ModalResidual, Observation
 from pcbdyn.diagnosis.select import Selection, estimate, noticed
 from pcbdyn.fe.modal import solve_modes
-from pcbdyn.testdata import Modes
+from pcbdyn.testdata import MeasuredModes
 
 from test_select import N_MODES, SIGMA, card  # noqa: F401  (the free card with its candidates)
 
@@ -26,7 +26,7 @@ def test_an_effect_the_data_do_not_need_is_dropped(card):
     f = solve_modes(dg.add_effect(m, mass, 0.02), n_modes=N_MODES).frequencies
     rng = np.random.default_rng(4)
     f_test = f * (1.0 + SIGMA * rng.standard_normal(f.size))
-    res = ModalResidual([Observation(None, Modes.frequencies_only(f_test), np.full(N_MODES, SIGMA))], lambda p: [m])
+    res = ModalResidual([Observation(None, MeasuredModes.frequencies_only(f_test), np.full(N_MODES, SIGMA))], lambda p: [m])
     both = [mass, spring]
     fit = estimate(res, np.zeros(0), both, [0.02, 1.0], 8)
     sel = Selection(chosen=[0, 1], values=fit.values, p=fit.p, chi2=[fit.chi2], state=fit.state, cov=fit.cov)

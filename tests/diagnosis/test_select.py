@@ -11,7 +11,7 @@ from pcbdyn.fe import EdgeSpringProperty, MassProperty, Model, ShellProperty
 from pcbdyn.fe.generate import nodes_where, rectangle
 from pcbdyn.fe.modal import solve_modes
 
-from pcbdyn.testdata import Modes
+from pcbdyn.testdata import MeasuredModes
 
 N_MODES, SIGMA = 8, 0.002  # 8 paired modes, 0.2 % frequency noise
 NX, NY = 12, 14  # elements of the 160 x 180 mm card: about 13 mm
@@ -99,7 +99,7 @@ def test_refine_moves_a_segment_found_too_short_to_the_true_run(card):
     side = next(side for side, i, j in runs if (i, j) == (1, 2))
     truth, start = runs[(side, 1, 2)], runs[(side, 1, 1)]
     f_test = solve_modes(dg.add_effect(m, cands[truth], 0.03), n_modes=N_MODES).frequencies
-    res = ModalResidual([Observation(None, Modes.frequencies_only(f_test), np.full(N_MODES, SIGMA))], lambda p: [m])
+    res = ModalResidual([Observation(None, MeasuredModes.frequencies_only(f_test), np.full(N_MODES, SIGMA))], lambda p: [m])
     fit = estimate(res, np.zeros(0), [cands[start]], [0.03], 8)
     assert fit.chi2 > 10.0  # the wrong run cannot explain the data
     sel = Selection(chosen=[start], values=fit.values, p=fit.p, chi2=[fit.chi2], state=fit.state)
@@ -124,10 +124,10 @@ def test_a_mass_with_an_inertia_beside_it_is_refitted_as_one_body(card):
     centre = 0.5 * (m.nodes[a] + m.nodes[b])
     shells = [(s.etype, s.conn) for s in m.sets.values() if s.etype == "quad4"]
     conn, W = disc_footprint(m.nodes, shells, centre, 0.01)
-    truth = dg.catalogue.copy_model(m)
+    truth = m.copy()
     truth.add("part", "mass", [conn], MassProperty(0.04, (4e-6, 4e-6, 0.0), footprint=W))
     f_test = solve_modes(truth, n_modes=N_MODES).frequencies
-    res = ModalResidual([Observation(None, Modes.frequencies_only(f_test), np.full(N_MODES, SIGMA))], lambda p: [m])
+    res = ModalResidual([Observation(None, MeasuredModes.frequencies_only(f_test), np.full(N_MODES, SIGMA))], lambda p: [m])
     by_name = {c.name: i for i, c in enumerate(cands)}
     start = [by_name[f"point_mass@n{a}"], by_name[f"point_mass@n{b}"], by_name[f"point_inertia@n{a}"]]
     fit = estimate(res, np.zeros(0), [cands[i] for i in start], [0.02, 0.02, 2e-6], 8)
@@ -155,7 +155,7 @@ def test_refine_walks_a_region_found_on_the_patch_grid_to_the_true_rectangle(car
     step = 0.16 / NX
     truth = dg.kind("region_stiffness").rectangle(layout, 3 * step, 4 * 0.18 / NY, 7 * step, 9 * 0.18 / NY)
     f_test = solve_modes(dg.add_effect(m, truth, 1.5), n_modes=N_MODES).frequencies
-    res = ModalResidual([Observation(None, Modes.frequencies_only(f_test), np.full(N_MODES, SIGMA))], lambda p: [m])
+    res = ModalResidual([Observation(None, MeasuredModes.frequencies_only(f_test), np.full(N_MODES, SIGMA))], lambda p: [m])
     cands = list(cands)
     patches = [i for i, c in enumerate(cands) if c.kind == "region_stiffness" and rectangle(c) is not None]
     start = min(patches, key=lambda i: np.hypot(*np.subtract(cands[i].at, truth.at)))

@@ -115,7 +115,7 @@ def uff_seeds() -> tuple:
     (tests/data/uff/node_systems.uff), in a folder of their own."""
     import tempfile
 
-    from pcbdyn.testdata import FRFs, Modes, TestData, read_points_csv, write_uff
+    from pcbdyn.testdata import FRFs, MeasuredModes, TestData, read_points_csv, write_uff
     from pcbdyn.testdata.data import Dofs
 
     folder = Path(tempfile.mkdtemp(prefix="pcbdyn-fuzz-seeds-"))
@@ -125,7 +125,7 @@ def uff_seeds() -> tuple:
     shapes = np.column_stack([np.sin(np.pi * (i + 1) * x) * np.sin(np.pi * (j + 1) * y)
                               for i, j in ((0, 0), (1, 0), (0, 1), (1, 1), (2, 0), (0, 2))])
     shapes = shapes[pts.index(dofs.point_ids)] + 1e-3 * rng.standard_normal((len(dofs), 6))
-    modes = Modes(pts, dofs, [160.0, 230.0, 300.0, 420.0, 510.0, 600.0], shapes, np.full(6, 0.01))
+    modes = MeasuredModes(pts, dofs, [160.0, 230.0, 300.0, 420.0, 510.0, 600.0], shapes, np.full(6, 0.01))
     write_uff(folder / "modes.uff", TestData(pts, modes))
     f = np.arange(0.0, 50.0, 2.0)
     H = (1.0 / (1e6 - (2 * np.pi * f) ** 2 * 1.0 + 0j))[:, None, None] * np.ones((1, 2, 1))

@@ -115,14 +115,14 @@ def test_a_sparse_grid_prints_the_pairing_s_aliasing_warnings(tmp_path):
     model mode k (by frequency within what the grid cannot tell apart)."""
     import numpy as np
 
-    from pcbdyn.testdata import Modes
+    from pcbdyn.testdata import MeasuredModes
 
     td = simulated_test(TRUE_K, TRUE_K)
     m = td.modes
     xyz = np.round(m.dof_xyz(), 5)
     xs, ys = np.unique(xyz[:, 0]), np.unique(xyz[:, 1])
     keep = np.flatnonzero(np.isin(xyz[:, 0], xs[[2, 4, 6]]) & np.isin(xyz[:, 1], ys[[0, 6]]))
-    sparse = Modes(m.points, m.dofs.take(keep), m.frequencies, m.shapes[keep], m.damping)
+    sparse = MeasuredModes(m.points, m.dofs.take(keep), m.frequencies, m.shapes[keep], m.damping)
     (tmp_path / "board.toml").write_text(BOARD.read_text())
     write_uff(tmp_path / "sparse.uff", TestData(m.points, sparse))
     res = run("wedgelock", tmp_path / "board.toml", tmp_path / "sparse.uff", "--json", tmp_path / "w.json",

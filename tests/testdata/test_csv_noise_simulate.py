@@ -11,7 +11,7 @@ from pcbdyn.fe.mesh import dof_index
 from pcbdyn.fe.modal import solve_modes
 from pcbdyn.testdata import (
     Dofs,
-    Modes,
+    MeasuredModes,
     Noise,
     Points,
     TestDataError,
@@ -32,7 +32,7 @@ def test_modes_csv_round_trip_is_exact(tmp_path):
     rng = np.random.default_rng(0)
     pts = Points([3, 1, 2], rng.uniform(0, 0.1, (3, 3)))
     dofs = Dofs([1, 2, 3, 3], [[0, 0, 1], [0, 0, -1], [0, 0, 1], [0.6, 0.8, 0]])
-    modes = Modes(pts, dofs, [101.5, 233.25], rng.standard_normal((4, 2)), [0.01, 0.02], [1.0, 0.97])
+    modes = MeasuredModes(pts, dofs, [101.5, 233.25], rng.standard_normal((4, 2)), [0.01, 0.02], [1.0, 0.97])
     write_modes_csv(tmp_path / "f.csv", tmp_path / "s.csv", modes)
     back = read_modes_csv(tmp_path / "f.csv", tmp_path / "s.csv")
     assert np.array_equal(back.frequencies, modes.frequencies)
@@ -113,9 +113,9 @@ def test_simulated_test_matches_the_model_and_pairs_back_after_a_uff_round_trip(
 
 def test_a_mode_invisible_at_the_test_dofs_is_simulated_not_refused():
     """A simulated test may read a mode as zero at every test DOF (a flat board's in-plane mode at
-    out-of-plane DOFs): Modes keeps it, while a file's record may not hold one (test_uff)."""
+    out-of-plane DOFs): MeasuredModes keeps it, while a file's record may not hold one (test_uff)."""
     ids = np.arange(1, 4)
     points = Points(ids, np.column_stack([np.arange(3.0), np.zeros(3), np.zeros(3)]))
     dofs = Dofs(ids, np.tile([0.0, 0.0, 1.0], (3, 1)))
-    m = Modes(points, dofs, [100.0, 5000.0], np.array([[1.0, 0.0], [2.0, 0.0], [3.0, 0.0]]), [0.01, 0.01])
+    m = MeasuredModes(points, dofs, [100.0, 5000.0], np.array([[1.0, 0.0], [2.0, 0.0], [3.0, 0.0]]), [0.01, 0.01])
     assert not m.shapes[:, 1].any()

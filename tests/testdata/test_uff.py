@@ -11,14 +11,14 @@ import pyuff
 from uff_helpers import E13, E20, HEADER55, fixed
 
 from pcbdyn.correlation import mac
-from pcbdyn.testdata import Dofs, FRFs, Modes, Points, TestData, TestDataError, read_uff, real_modes, write_uff
+from pcbdyn.testdata import Dofs, FRFs, MeasuredModes, Points, TestData, TestDataError, read_uff, real_modes, write_uff
 
 
 def sample(kind="accelerance", f_axis=None):
     rng = np.random.default_rng(11)
     pts = Points(np.arange(101, 113), rng.uniform(0, 0.17, (12, 3)) * [1, 1, 0.01])
     dofs = Dofs.from_codes(np.r_[pts.ids, [104, 105]], ["+z"] * 12 + ["+x", "+y"])
-    modes = Modes(pts, dofs, [211.123456789012, 302.7, 397.81234567], rng.standard_normal((14, 3)),
+    modes = MeasuredModes(pts, dofs, [211.123456789012, 302.7, 397.81234567], rng.standard_normal((14, 3)),
                   [0.0123456789, 0.02, 0.005])
     f = np.linspace(0.0, 1000.0, 801) if f_axis is None else f_axis
     H = rng.standard_normal((f.size, 4, 2)) + 1j * rng.standard_normal((f.size, 4, 2))
@@ -191,13 +191,13 @@ def test_malformed_files_fail_with_a_message_naming_the_file_and_dataset(tmp_pat
 @pytest.mark.parametrize("freq, zeta", [(150.0, -0.02), (150.0, 1.0), (150.0, 1.5), (0.0, 0.01), (-150.0, 0.01),
                                         (150.0, 0.0), (150.0, 0.99)])
 def test_a_uff_mode_obeys_the_rules_of_modes(tmp_path, freq, zeta):
-    """A dataset 55 is refused exactly when Modes refuses the same mode, in Modes' words after the dataset and
+    """A dataset 55 is refused exactly when MeasuredModes refuses the same mode, in MeasuredModes' words after the dataset and
     record: a frequency above 0, a damping ratio from 0 to below 1 (a negative one, a curve fit's artefact, too)."""
     rec8 = f"{freq:13.5E}{0.0:13.5E}{zeta:13.5E}{0.0:13.5E}"
     path = write_text(tmp_path / "one.uff", HEADER55.format(rec8=rec8) + "         1\n 1.0E+00 2.0E+00 3.0E+00\n    -1\n")
     point = Points([1], np.zeros((1, 3)))
     try:
-        Modes(point, Dofs.from_codes([1, 1, 1], [1, 2, 3]), [freq], [[1.0], [2.0], [3.0]], [zeta])
+        MeasuredModes(point, Dofs.from_codes([1, 1, 1], [1, 2, 3]), [freq], [[1.0], [2.0], [3.0]], [zeta])
     except TestDataError as exc:
         rule = str(exc).removeprefix("modes: ").replace(" (mode 1)", "")  # the dataset names the mode
         with pytest.raises(TestDataError) as uff_exc:
@@ -224,7 +224,7 @@ def test_a_file_mode_without_motion_or_below_the_elastic_floor_is_refused(tmp_pa
     with pytest.raises(TestDataError, match=rf"m\.uff: dataset #1 \(type 55\): {re.escape(fault)}"):
         read_uff(path, points=point)
     values = [[float(v)] for v in shape.split()]
-    assert Modes(point, Dofs.from_codes([1, 1, 1], [1, 2, 3]), [freq], values).frequencies[0] == freq
+    assert MeasuredModes(point, Dofs.from_codes([1, 1, 1], [1, 2, 3]), [freq], values).frequencies[0] == freq
     at_floor = write_text(tmp_path / "f.uff", HEADER55.format(rec8=f"{0.01:13.5E}{0.0:13.5E}{0.01:13.5E}{0.0:13.5E}")
                           + "         1\n 1.0E+00 2.0E+00 3.0E+00\n    -1\n")
     assert read_uff(at_floor, points=point).modes.frequencies.tolist() == [0.01]

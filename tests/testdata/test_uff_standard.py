@@ -7,7 +7,7 @@ import pytest
 import pyuff
 from uff_helpers import E13, E20, fixed
 
-from pcbdyn.testdata import Dofs, FRFs, Modes, Points, TestData, TestDataError, read_uff, write_uff
+from pcbdyn.testdata import Dofs, FRFs, MeasuredModes, Points, TestData, TestDataError, read_uff, write_uff
 
 
 def card(n_modes=3):
@@ -15,7 +15,7 @@ def card(n_modes=3):
     pts = Points(np.arange(1, 31), np.column_stack([rng.uniform(0, 0.162, 30), rng.uniform(0, 0.178, 30),
                                                     rng.uniform(-1e-3, 3e-3, 30)]))
     dofs = Dofs.from_codes(np.r_[pts.ids, [4, 9]], ["+z"] * 30 + ["+x", "-y"])
-    modes = Modes(pts, dofs, 200.0 + 97.123456789 * np.arange(n_modes), rng.standard_normal((32, n_modes)),
+    modes = MeasuredModes(pts, dofs, 200.0 + 97.123456789 * np.arange(n_modes), rng.standard_normal((32, n_modes)),
                   0.01 + 0.00123456789 * np.arange(n_modes))
     f = np.arange(0.0, 800.0, 0.5)
     H = 1e-4 * (rng.standard_normal((f.size, 2, 1)) + 1j * rng.standard_normal((f.size, 2, 1)))

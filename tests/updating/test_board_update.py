@@ -12,13 +12,13 @@ import numpy as np
 import pytest
 
 from pcbdyn.board import build_model, load_board
-from pcbdyn.fe.modal import solve_modes as fe_modes
+from pcbdyn.fe.modal import solve_modes
 from pcbdyn.testdata.csvio import read_points_csv
 from pcbdyn.testdata.noise import Noise
-from pcbdyn.testdata import Modes
+from pcbdyn.testdata import MeasuredModes
 from pcbdyn.testdata.simulate import simulate_on_model
 from pcbdyn.problems import UpdateProblem, run
-from pcbdyn.updating.sensitivity import eigenvalue_derivatives, solve_modes
+from pcbdyn.updating.sensitivity import eigenvalue_derivatives, pencil_modes
 
 ROOT = Path(__file__).resolve().parents[2]
 CARD = ROOT / "examples" / "six_part_card"
@@ -38,9 +38,9 @@ def test_eigenvalue_derivatives_match_resolves(tmp_path):
     sysm = prob.system(None)
     p0 = prob.p0
     n = 6
-    lam0 = fe_modes(sysm.at(p0).model, n_modes=n).omega2
+    lam0 = solve_modes(sysm.at(p0).model, n_modes=n).omega2
     K, M, dKs, dMs = sysm.model(p0)
-    lam, Phi = solve_modes(K, M, n)
+    lam, Phi = pencil_modes(K, M, n)
     assert np.allclose(lam, lam0, rtol=1e-8)
     dlam = eigenvalue_derivatives(lam, Phi, dKs, dMs)
     for j, name in enumerate(prob.names):
@@ -48,8 +48,8 @@ def test_eigenvalue_derivatives_match_resolves(tmp_path):
         up, dn = p0.copy(), p0.copy()
         up[j] += h
         dn[j] -= h
-        fd = (fe_modes(sysm.at(up).model, n_modes=n).omega2
-              - fe_modes(sysm.at(dn).model, n_modes=n).omega2) / (2 * h)
+        fd = (solve_modes(sysm.at(up).model, n_modes=n).omega2
+              - solve_modes(sysm.at(dn).model, n_modes=n).omega2) / (2 * h)
         scale = np.max(np.abs(lam0)) / p0[j]  # relative to the size of lambda / p
         assert np.max(np.abs(dlam[:, j] - fd)) < 1e-4 * max(np.max(np.abs(fd)), 1e-3 * scale), name
 
@@ -78,7 +78,7 @@ def test_six_part_card_qms_recovers_thicknesses(tmp_path):
     cfgs, full = [], []
     for k, c in enumerate([None, "c2", "c3"]):
         bm = build_model(truth, c)
-        td = simulate_on_model(bm.model, fe_modes(bm.model, n_modes=7), pts, dofs,
+        td = simulate_on_model(bm.model, solve_modes(bm.model, n_modes=7), pts, dofs,
                                noise=Noise(frequency_pct=0.2, shape_pct=2.0), seed=k)
         meas = td.modes
         cfgs += prob.mode_configurations(c, meas, "qms")
@@ -107,7 +107,7 @@ def measured(select):
     for cfg, modes in select.items():
         g = df[(df.configuration == cfg) & df["mode"].isin(modes)]
         out.append((None if cfg == "c1" else cfg,
-                    Modes.frequencies_only(g.frequency_hz.to_numpy(float), g["mode"].to_numpy(int))))
+                    MeasuredModes.frequencies_only(g.frequency_hz.to_numpy(float), g["mode"].to_numpy(int))))
     return out
 
 
@@ -173,7 +173,7 @@ def test_update_command_qms_from_uff(tmp_path):
     files = []
     for k, c in enumerate([None, "c2"]):
         bm = build_model(truth, c)
-        td = simulate_on_model(bm.model, fe_modes(bm.model, n_modes=6), pts, dofs)
+        td = simulate_on_model(bm.model, solve_modes(bm.model, n_modes=6), pts, dofs)
         files.append(tmp_path / f"test{k}.uff")
         write_uff(files[-1], td)
     path = card(tmp_path, "board.toml")

@@ -12,7 +12,7 @@ from pcbdyn.updating import (
     frequencies_hz,
     frequency_equations,
     solve_ls,
-    solve_modes,
+    pencil_modes,
     success_ratio,
     svd_qr,
     tls_qrf,
@@ -26,7 +26,7 @@ ERRORS = [4, 5, 6, 7]  # E5..E8
 
 def _fx(model, p):
     K, M, _, _ = model(p)
-    return frequencies_hz(solve_modes(K, M, 8)[0])
+    return frequencies_hz(pencil_modes(K, M, 8)[0])
 
 
 def test_test_model_is_the_tables_beam(cantilever):
@@ -68,7 +68,7 @@ def test_bounded_solver_stops_at_the_bound(cantilever):
 def _equations(cantilever):
     model, p_a, p_x, _ = cantilever
     K, M, dKs, dMs = model(p_a)
-    lam, Phi = solve_modes(K, M, 8)
+    lam, Phi = pencil_modes(K, M, 8)
     blk = frequency_equations(lam, Phi, _fx(model, p_x), dKs, dMs, p_a)
     return weight_rows(blk.A, blk.b, unit_row_weights(blk.A))
 

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from pcbdyn.updating import Configuration, RankDeficiencyWarning, solve_modes, update
+from pcbdyn.updating import Configuration, RankDeficiencyWarning, pencil_modes, update
 from pcbdyn.updating import matching
 
 from structures import frf, updating_omegas
@@ -15,7 +15,7 @@ from structures import frf, updating_omegas
 
 def _modes(model, p):
     K, M, _, _ = model(p)
-    lam, Phi = solve_modes(K, M)
+    lam, Phi = pencil_modes(K, M)
     return np.sqrt(lam) / (2 * np.pi), Phi
 
 

@@ -10,8 +10,8 @@ from click.testing import CliRunner
 
 from pcbdyn.updating import tls_qrf
 from pcbdyn.problems.cases import SimulatedFreePCB
+from pcbdyn.testdata import add_noise
 from pcbdyn.updating.study import compress, localise, run_study, summarise
-from pcbdyn.updating.success import add_noise
 from pcbdyn.updating.weighting import tls_column_weight, tls_column_weight_from_noise
 
 from reference import thesis_case

@@ -13,7 +13,7 @@ from pcbdyn.updating import (
     frequencies_hz,
     frequency_equations,
     solve_ls,
-    solve_modes,
+    pencil_modes,
     stack,
     svd_reduce,
     unit_row_weights,
@@ -54,14 +54,14 @@ def _chain(added=None):
 def _config(added):
     model = _chain(added)
     K, M, _, _ = model(P_TRUE)
-    return Configuration(model, f_x=frequencies_hz(solve_modes(K, M)[0]), method="freq", name=str(added))
+    return Configuration(model, f_x=frequencies_hz(pencil_modes(K, M)[0]), method="freq", name=str(added))
 
 
 def _blocks(configs, p):
     out = []
     for c in configs:
         K, M, dKs, dMs = c.model(p)
-        lam, Phi = solve_modes(K, M)
+        lam, Phi = pencil_modes(K, M)
         blk = frequency_equations(lam, Phi, c.f_x, dKs, dMs, p)
         out.append(weight_rows(blk.A, blk.b, unit_row_weights(blk.A)))
     return out

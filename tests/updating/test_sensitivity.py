@@ -13,7 +13,7 @@ from pcbdyn.updating import (
     eigenvector_derivatives_modal,
     frequencies_hz,
     frequency_derivatives,
-    solve_modes,
+    pencil_modes,
 )
 
 
@@ -27,12 +27,12 @@ def _fd(resolve, p, j, n_modes, h=1e-5):
 
 def _check(model, p, n_modes):
     K, M, dKs, dMs = model(p)
-    lam, Phi = solve_modes(K, M, n_modes)
+    lam, Phi = pencil_modes(K, M, n_modes)
     analytic = eigenvalue_derivatives(lam, Phi, dKs, dMs)
 
     def resolve(q):
         K, M, _, _ = model(q)
-        return solve_modes(K, M, n_modes)[0]
+        return pencil_modes(K, M, n_modes)[0]
 
     for j in range(p.size):
         fd = _fd(resolve, p, j, n_modes)
@@ -92,7 +92,7 @@ def test_eigenvector_derivatives(string10):
     equals Nelson's result when every mode is kept."""
     model, p_a, _ = string10
     K, M, dKs, dMs = model(p_a)
-    lam, Phi = solve_modes(K, M)
+    lam, Phi = pencil_modes(K, M)
     i, j = 3, 14
     nelson = eigenvector_derivative_nelson(K, M, lam[i], Phi[:, i], dKs[j], dMs[j])
     modal = eigenvector_derivatives_modal(lam, Phi, i, dKs, dMs)[:, j]
@@ -102,7 +102,7 @@ def test_eigenvector_derivatives(string10):
         q = p_a.copy()
         q[j] += dp
         Kq, Mq, _, _ = model(q)
-        v = solve_modes(Kq, Mq)[1][:, i]
+        v = pencil_modes(Kq, Mq)[1][:, i]
         return v * np.sign(v @ (M @ Phi[:, i]))
 
     fd = (shape(h) - shape(-h)) / (2 * h)
@@ -151,7 +151,7 @@ def test_sparse_free_chain_modes():
     n = 2000
     L = sp.diags([-1.0, 2.0, -1.0], [-1, 0, 1], shape=(n, n)).tolil()
     L[0, 0] = L[n - 1, n - 1] = 1.0
-    lam, Phi = solve_modes(L.tocsc(), sp.eye(n, format="csc"), 4)
+    lam, Phi = pencil_modes(L.tocsc(), sp.eye(n, format="csc"), 4)
     exact = 2 - 2 * np.cos(np.pi * np.arange(4) / n)
     assert abs(lam[0]) < 1e-12 and np.allclose(lam[1:], exact[1:], rtol=1e-8)
     assert np.allclose(Phi.T @ Phi, np.eye(4), atol=1e-8)

@@ -18,7 +18,7 @@ from pcbdyn.correlation import correlate
 from pcbdyn.fe import OrthotropicShellProperty
 from pcbdyn.fe.modal import solve_modes
 from pcbdyn.problems import load_structure
-from pcbdyn.testdata import Dofs, Modes, Points, TestData, write_uff
+from pcbdyn.testdata import Dofs, MeasuredModes, Points, TestData, write_uff
 from pcbdyn.testdata.simulate import simulate_on_model
 
 BOARD = board_file("clamped_square_plate.toml")
@@ -41,7 +41,7 @@ def sparse(tmp_path_factory):
     modes = simulate_on_model(tested, solve_modes(tested, n_modes=6), points, dofs, zeta=0.01).modes
     shapes = modes.shapes.copy()
     shapes[0] *= 3.0  # point 1's accelerometer sensitivity entered 3 times too high
-    test = Modes(points, dofs, modes.frequencies, shapes, modes.damping)
+    test = MeasuredModes(points, dofs, modes.frequencies, shapes, modes.damping)
     path = tmp_path_factory.mktemp("sparse") / "test.uff"
     write_uff(path, TestData(points, test))
     return board, path, solve_modes(model, n_modes=12), test

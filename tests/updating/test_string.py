@@ -6,8 +6,8 @@ import warnings
 import numpy as np
 import pytest
 
+from pcbdyn.testdata import add_noise
 from pcbdyn.updating import (
-    add_noise,
     Configuration,
     RankDeficiencyWarning,
     fbm_equations,
@@ -15,7 +15,7 @@ from pcbdyn.updating import (
     frf_receptance_equations,
     qms_equations,
     solve_ls,
-    solve_modes,
+    pencil_modes,
     success_ratio,
     success_statistics,
     svd_qr,
@@ -54,7 +54,7 @@ def test_frf_output_recovers_all_20_parameters(string10, variant):
 
 def _shape_data(model, p_x):
     K, M, _, _ = model(p_x)
-    lam, Phi = solve_modes(K, M)
+    lam, Phi = pencil_modes(K, M)
     return np.sqrt(lam), Phi
 
 
