@@ -5,7 +5,6 @@ what it shows. They use the bundled examples by relative path, so they run from 
 import doctest
 import importlib
 import os
-import time
 from pathlib import Path
 
 import pytest
@@ -25,8 +24,6 @@ MODULES = [
     "pcbdyn.problems.problem",
     "pcbdyn.problems.fit",
 ]
-#: CPU seconds the examples may take together: they run in every ``make test``
-BUDGET_S = 5.0
 
 
 @pytest.fixture(scope="module")
@@ -37,12 +34,9 @@ def at_root():
     os.chdir(here)
 
 
-def test_the_docstring_examples_run_and_are_quick(at_root):
+def test_the_docstring_examples_run(at_root):
     """Every module of the path has an example; none fails (doctest prints the failing lines)."""
-    start = time.process_time()
     results = {name: doctest.testmod(importlib.import_module(name),
                                      optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
                for name in MODULES}
-    elapsed = time.process_time() - start
     assert not [name for name, r in results.items() if r.attempted == 0 or r.failed]
-    assert elapsed < BUDGET_S
