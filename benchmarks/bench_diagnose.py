@@ -2,7 +2,9 @@
 (tests/diagnosis/bench_cases.py) and of the hold-out data computed by another FE code
 (tests/diagnosis/holdout_cases.py, names ho_*): wall time per case and the outcome against the acceptance
 (effect type, location within 15 mm, magnitude within 30 %, max frequency error after < 0.5 %
-where the parameters-only update left > 2 %; noise-only cases: nothing reported).
+where the parameters-only update left > 2 %; noise-only cases: nothing reported). ``make test`` runs
+a few of these cases (``IN_SUITE`` of bench_cases.py and holdout_cases.py); this runs them all, and a
+change to diagnose lands with its table. Known misses (test_holdout.py's ``KNOWN``) are marked so.
 
     python benchmarks/bench_diagnose.py [--cases pm_transducer,noise_card] [--out out/diagnosis_bench]
                                         [--json summary.json]
@@ -27,7 +29,7 @@ sys.path.insert(0, str(ROOT / "tests" / "diagnosis"))
 import bench_cases as bc  # noqa: E402
 import holdout_cases as hc  # noqa: E402
 from test_diagnose_bench import judge, match  # noqa: E402
-from test_holdout import judge_holdout, make_holdout  # noqa: E402
+from test_holdout import KNOWN, judge_holdout, make_holdout  # noqa: E402
 
 CASES = {**bc.BY_NAME, **hc.BY_NAME}
 
@@ -62,7 +64,9 @@ def one(case, out: Path) -> dict:
         e, d = match(data.get("effects", []), tr)
         if e is not None:
             found.append(f"{tr['type']} d={d:.0f}mm mag {100 * (e['magnitude'] / tr['magnitude'] - 1):+.0f}%")
-    return {**row, "outcome": "PASS" if not bad else "FAIL", "why": "; ".join(bad), "found": found,
+    outcome = ("PASS" if not bad else "FAIL") + (" (known miss)" if bad and case.name in KNOWN else
+                                                 " (a known miss passes: update KNOWN)" if case.name in KNOWN else "")
+    return {**row, "outcome": outcome, "why": "; ".join(bad), "found": found,
             "n_effects": len(data.get("effects", [])),
             "before_pct": data.get("before", {}).get("max_freq_error_pct"),
             "params_only_pct": data.get("parameters_only", {}).get("max_freq_error_pct"),
@@ -99,8 +103,10 @@ def main(argv=None):
               f"{fmt(r.get('after_pct')):>7} {r.get('n_effects', '-'):>4}  {r['outcome']}"
               f"{'  ' + ', '.join(r.get('found', [])) if r.get('found') else ''}{'  ' + r['why'] if r['why'] else ''}",
               flush=True)
-    n_pass = sum(r["outcome"] == "PASS" for r in rows)
-    print(f"\n{n_pass}/{len(rows)} cases pass; diagnose total {sum(r['diagnose_s'] for r in rows):.1f} s")
+    n_pass = sum(r["outcome"].startswith("PASS") for r in rows)
+    n_known = sum(r["outcome"] == "FAIL (known miss)" for r in rows)
+    print(f"\n{n_pass}/{len(rows)} cases pass, {n_known} known misses (tests/diagnosis/test_holdout.py KNOWN); "
+          f"diagnose total {sum(r['diagnose_s'] for r in rows):.1f} s")
     if a.json:
         Path(a.json).write_text(json.dumps(rows, indent=1))
 

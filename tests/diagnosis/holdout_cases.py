@@ -71,6 +71,10 @@ CASES = [
 ]
 CASES = [replace(c, truth_mesh=TRUTH_MESH) for c in CASES]
 BY_NAME = {c.name: c for c in CASES}
+#: the hold-out cases ``make test`` runs (as :data:`bench_cases.IN_SUITE`: the others are
+#: ``benchmarks/bench_diagnose.py``'s)
+IN_SUITE = ("ho_noise_card", "ho_noise_wedge", "ho_spring_wedge", "ho_edge_wedge", "ho_line_mass_card",
+            "ho_al_bar", "ho_bracket")
 
 
 def effect_entries(case: Case) -> list:

@@ -131,9 +131,10 @@ def judge(case, truth: dict, data: dict) -> list:
 
 # ---------------------------------------------------------------------------------------- tests
 def cases():
-    """One parameter per case, both tests of a case on one xdist worker (the data are made once)."""
+    """One parameter per case of :data:`bench_cases.IN_SUITE`, both tests of a case on one xdist worker
+    (the data are made once)."""
     out = []
-    for c in bc.CASES:
+    for c in (bc.BY_NAME[n] for n in bc.IN_SUITE):
         marks = [pytest.mark.xdist_group(c.name)]
         out.append(pytest.param(c, marks=marks, id=c.name))
     return out
