@@ -15,7 +15,9 @@ plugin module of this package that registers an object (:func:`register`, into :
   stiffness), so that they cannot be kept from one parameter value to the next (:class:`BlockCache`);
 - ``apply(model, candidate, value) -> Model``: a copy of the model carrying the effect;
 - ``place(layout, candidate) -> Candidate``: the same effect (place and extent) on another
-  mesh's layout (a finer mesh, as a test bench's truth model is).
+  mesh's layout (a finer mesh, as a test bench's truth model is);
+- ``whole(candidates, i) -> int`` (optional): the candidate of which candidate ``i`` is a piece (a
+  stiffener's whole line), tried beside it by the search (:mod:`.select`).
 
 Every effect enters K and M linearly in its parameter, so dK/dp and dM/dp are exact and the
 same at every value, and the first-order eigenvalue sensitivity (thesis eq. 3.11 with k = i)

@@ -32,7 +32,6 @@ from scipy.stats import chi2 as chi2_dist
 
 from .fitting import RANK_STEPS, UPPER, Fit, estimate  # noqa: F401  (re-exported)
 from .scan import Runner, rank, worth_full
-from .stiffener import normal
 
 #: probability that noise alone makes one of the candidates look like an effect (family-wise)
 ALPHA = 0.01
@@ -98,7 +97,7 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
         gain[sel.chosen] = -np.inf
         short = _shortlist(gain, kinds, shortlist)
         order = np.setdiff1d(np.union1d(np.union1d(short, _companions(candidates, sel.chosen)),
-                                        _whole_lines(candidates, short)), sel.chosen)
+                                        _whole(candidates, short)), sel.chosen)
         if not order.size:
             break
         trials = [([candidates[i] for i in sel.chosen + [j]], np.r_[sel.values, max(value[j], 0.0)]) for j in order]
@@ -294,25 +293,12 @@ def _companions(candidates, chosen) -> np.ndarray:
                      and c.nodes.size == 1], dtype=np.int64)
 
 
-def _whole_lines(candidates, idx) -> np.ndarray:
-    """For each stiffener among ``idx``, the longest stiffener candidate on its line: always tried
-    beside it, since a piece can score best on its own where a bar spans the plate (a bar across the
-    card was found as a middle piece whose ends, fitted after, stopped 33 mm short of either edge)."""
-    ribs = [j for j, c in enumerate(candidates) if c.kind == "stiffener"]
-    if not ribs or not any(candidates[i].kind == "stiffener" for i in idx):
-        return np.zeros(0, dtype=np.int64)
-    paths = [np.asarray(candidates[j].geometry["path"], float)[[0, -1]] for j in ribs]
-    n = np.array([normal(q) for q in paths])
-    offset = np.einsum("ij,ij->i", n, np.array([q[0] for q in paths]))
-    length = np.array([np.linalg.norm(q[1] - q[0]) for q in paths])
-    where = {j: k for k, j in enumerate(ribs)}
-    out = []
-    for i in idx:
-        if i in where:
-            k = where[i]
-            same = np.flatnonzero((np.abs(n - n[k]).max(axis=1) < 1e-9) & (np.abs(offset - offset[k]) < 1e-9))
-            out.append(ribs[same[np.argmax(length[same])]])
-    return np.unique(np.array(out, dtype=np.int64))
+def _whole(candidates, idx) -> np.ndarray:
+    """For each of ``idx`` whose kind has pieces of a larger whole (its optional ``whole``: a stiffener on
+    part of a line), that whole: always tried beside it, since a piece can score best on its own where
+    the effect spans the whole."""
+    return np.unique(np.array([candidates[i].spec.whole(candidates, i) for i in idx
+                               if hasattr(candidates[i].spec, "whole")], dtype=np.int64))
 
 
 def _shortlist(gain, kinds, per_kind: int) -> np.ndarray:

@@ -106,6 +106,18 @@ class _Stiffener:
             raise ValueError(f"{candidate.name}: its line misses the plate")
         return c
 
+    def whole(self, candidates, i: int) -> int:
+        """The index of the longest stiffener of ``candidates`` on candidate ``i``'s line (a bar across the
+        card was found as a middle piece whose ends, fitted after, stopped 33 mm short of either edge)."""
+        ribs = [j for j, c in enumerate(candidates) if c.kind == self.name]
+        paths = [np.asarray(candidates[j].geometry["path"], float)[[0, -1]] for j in ribs]
+        n = np.array([normal(q) for q in paths])
+        offset = np.einsum("ij,ij->i", n, np.array([q[0] for q in paths]))
+        length = np.array([np.linalg.norm(q[1] - q[0]) for q in paths])
+        k = ribs.index(i)
+        same = np.flatnonzero((np.abs(n - n[k]).max(axis=1) < 1e-9) & (np.abs(offset - offset[k]) < 1e-9))
+        return ribs[same[np.argmax(length[same])]]
+
     def section_of(self, candidate) -> RibSection:
         """The rib's section: the kind's material at the candidate's height."""
         return replace(self.section, h=candidate.data.get("height", self.section.h))
