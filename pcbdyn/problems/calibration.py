@@ -33,6 +33,7 @@ from ..updating.solvers import covariance
 from ..updating.weighting import NOISE_REDRAWS
 from .error_budget import measured_mesh_steps, noise_sigma
 from .fit import fit
+from .verdict import MIN_PAIRED
 from .problem import UpdateProblem
 from .run import correlation_state
 
@@ -40,8 +41,6 @@ from .run import correlation_state
 FAMILY_RANGE = 3.0
 #: an extra (``--with``) parameter is bounded to [value / r, value * r]: r = 2, springs (log scale) 100
 WITH_RANGE = (2.0, 100.0)
-#: the fraction of a test's modes (with shapes) that must pair by MAC at the start
-MIN_PAIRED = 0.5
 METHODS = ("freq", "qms", "fbm")
 
 
@@ -227,7 +226,7 @@ def config_labels(items) -> list:
 
 def check_pairing(cal: Calibration, check) -> None:
     """A CalibrationError when, at the start, a test's modes do not pair with its board's (fewer than
-    :data:`MIN_PAIRED` of them by MAC: a test of another board, or points in another frame; without
+    :data:`.verdict.MIN_PAIRED` of them by MAC: a test of another board, or points in another frame; without
     shapes, by number: none at all)."""
     for cfg, label in zip(check, config_labels(cal.items)):
         try:

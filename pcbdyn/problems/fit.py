@@ -11,7 +11,7 @@ the answer, and what it means.
    fitted guide stiffness comes out soft to make up for it; the correlation tables keep the measured
    frequencies).
 2. Shapes: when the frequency equations at the start do not determine every parameter (numerically
-   rank-deficient, or a direction whose standard deviation exceeds :data:`UNDETERMINED_SD`) and the test
+   rank-deficient, or a direction whose standard deviation exceeds :data:`.verdict.UNDETERMINED_SD`) and the test
    has shapes, the shapes join the objective (:mod:`pcbdyn.updating.shapes`, method "modal"), in units of
    their stated noise (when none is stated: 2 % to start with, then what the fit's shape residual shows,
    :func:`shape_noise_estimate`, and the fit finished with that).
@@ -22,7 +22,7 @@ the answer, and what it means.
    few pairs are within it; the trust region keeps a pair the linearisation misreads from doing harm),
    the correlation tables with it.
 5. The verdict, the first that applies: "cannot fit" (chi^2 above what its degrees of freedom allow at
-   :data:`ALPHA_FIT`, or fewer than :data:`MIN_PAIRED` of the measured modes paired), "error grew" (a configuration ends worse than it started), "on a bound", "not
+   :data:`.verdict.ALPHA_FIT`, or fewer than :data:`.verdict.MIN_PAIRED` of the measured modes paired), "error grew" (a configuration ends worse than it started), "on a bound", "not
    determined" (with the direction the data leave open), "not converged", "converged". Only a
    "converged" fit succeeded.
 
@@ -40,26 +40,18 @@ import warnings
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from scipy.stats import chi2 as chi2_dist
 
 from ..correlation.pairing import FREQ_LIMIT
 from ..updating.driver import update
-from ..updating.iteration import build_equations, objective_rows, unpaired
+from ..updating.iteration import build_equations
 from ..updating.scan import scan, scanned
-from ..updating.solvers import RankDeficiencyWarning, choose_rank
-from ..units import from_si
+from ..updating.solvers import RankDeficiencyWarning
 from .error_budget import model_errors, noise_sigma
-from .run import TOL_FREQ_PCT, correlation_state, pairing_warnings, undetermined_directions, worse_configurations
+from .run import TOL_FREQ_PCT, correlation_state, pairing_warnings
+from .verdict import judge, values_text, verdict, weak_directions
 
 #: frequency and shape noise [%] (uniform bounds, eqs. 5.72-5.73) assumed when a test states none
 DEFAULT_NOISE = (0.2, 2.0)
-#: chi^2 with a smaller probability than this under the noise: the model cannot fit the test
-ALPHA_FIT = 1e-3
-#: a fit that pairs fewer of the measured modes than this share cannot fit the test, whatever its chi^2
-MIN_PAIRED = 0.5
-#: a parameter direction x = dp/p (d ln p on a log scale) known to worse than this at one sigma is not
-#: determined by the data
-UNDETERMINED_SD = 0.5
 
 
 @dataclass
@@ -165,17 +157,6 @@ def configurations(problem, tests, method: str, f_pct: float, shape_pct: float, 
     return out
 
 
-def weak_directions(configs, p, names, free=None) -> list:
-    """The parameter directions the equations of ``configs`` (rows in noise units) at ``p`` do not
-    determine: numerically rank-deficient, or known to worse than :data:`UNDETERMINED_SD` at one sigma."""
-    (A, _), _, _ = build_equations(configs, p)
-    free = np.arange(A.shape[1]) if free is None else np.asarray(free)
-    _, s, Vt = np.linalg.svd(A[:, free], full_matrices=False)
-    rank = choose_rank(s, jump=np.inf) if s.size else 0  # rows in noise units: sizes, not jumps, decide
-    weak = [Vt[i] for i in range(s.size) if i >= rank or s[i] < 1.0 / UNDETERMINED_SD]
-    return undetermined_directions(weak, [names[j] for j in free])
-
-
 def fit(problem, measured, *, method: str = "freq", noise=(None, None), shapes: str = "auto",
         scan_start: bool = True, model_pct=None, mesh_check: bool = False, solver: str = "bounded",
         max_iter: int = 20, tol_freq_pct: float = TOL_FREQ_PCT, tol_param_pct: float = 0.5, min_mac: float = 0.5,
@@ -272,14 +253,14 @@ def fit(problem, measured, *, method: str = "freq", noise=(None, None), shapes: 
     before, after = correlation_state(check, problem.p0), correlation_state(check, res.p)
     judged = cfgs if method in ("freq", "modal") else configurations(problem, tests, "freq", f_pct, shape_pct, model,
                                                                      min_mac, model is not None, np.inf)
-    out = Fit(problem, cfgs, res.p, res, before, after, "", [], _verdict(judged, res.p, problem),
+    out = Fit(problem, cfgs, res.p, res, before, after, "", [], verdict(judged, res.p, problem),
               {"frequency_pct": f_pct, "shape_pct": shape_pct if method == "modal" else None,
                "shape_estimated": method == "modal" and not stated[1],
                "stated": list(stated), "model_error": model is not None},
               [{"start": s, "end": r.p, "objective": key[1], "unpaired": key[0], "kept": k == best}
                for k, (s, r, key) in enumerate(zip(starts, runs, keys))],
               None if sc is None else sc.to_dict(problem.names), why)
-    _judge(out, cfgs if method in ("freq", "modal") else None)
+    judge(out, cfgs if method in ("freq", "modal") else None)
     return out
 
 
@@ -308,7 +289,7 @@ def shape_noise_estimate(cfgs, p) -> float:
 def _run(problem, cfgs, p0, k, n, solver, tol, say):
     """The driver's fit from ``p0`` (start ``k`` of ``n``); ``tol``: (max_iter, tol_freq_pct, tol_param_pct)."""
     if n > 1:
-        say(f"start {k + 1} of {n}: {_values(problem, p0)}")
+        say(f"start {k + 1} of {n}: {values_text(problem, p0)}")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RankDeficiencyWarning)
         return update(cfgs, p0, solver=solver, bounds=problem.bounds, log_scale=problem.log_scale,
@@ -321,82 +302,3 @@ def _progress_line(h) -> str:
     aside = f"; set aside: {', '.join(h['set_aside'])}" if h.get("set_aside") else ""
     lost = f"{h['unpaired']} measured mode(s) unpaired, " if h["unpaired"] else ""
     return f"iteration {h['iteration']}: {err}{lost}chi^2 {h['objective']:.4g}{aside}"
-
-
-def _verdict(cfgs, p, problem) -> dict:
-    """chi^2 of the fit's objective at ``p`` against its degrees of freedom (rows less the free parameters
-    and, for shapes, one scale factor per mode)."""
-    (_, _), _, states = build_equations(cfgs, p)
-    rows = [objective_rows(c, st) for c, st in zip(cfgs, states)]
-    if any(r is None for r in rows):
-        return {"chi2": None, "dof": None, "p_value": None, "fits": None}
-    chi2 = float(sum(r @ r for r in rows))
-    scales = sum(np.size(st["used"]) for c, st in zip(cfgs, states) if c.method == "modal")
-    dof = int(sum(r.size for r in rows) - len(problem.names) - scales)
-    pv = float(chi2_dist.sf(chi2, dof)) if dof > 0 else None
-    measured = sum(np.size(c.f_x) for c in cfgs)
-    paired = measured - sum(unpaired(c, st) for c, st in zip(cfgs, states))
-    fits = None if pv is None else bool(pv >= ALPHA_FIT)
-    if paired < MIN_PAIRED * measured:
-        fits = False  # the test's modes are not the model's
-    return {"chi2": chi2, "dof": dof, "p_value": pv, "fits": fits, "paired_modes": int(paired),
-            "measured_modes": int(measured)}
-
-
-def _judge(out: Fit, cfgs) -> None:
-    """``status`` and ``details`` of a finished fit (module docstring); the directions the data leave open
-    from ``cfgs``, rows in noise units (None: from the rank of the last solve, for QMS and FBM)."""
-    prob, res = out.problem, out.result
-    lo, hi = prob.bounds
-    out.at_bounds = {n: "lower" if np.isclose(v, a, rtol=1e-6) else "upper" for n, v, a, b in
-                     zip(prob.names, out.p, lo, hi) if np.isclose(v, a, rtol=1e-6) or np.isclose(v, b, rtol=1e-6)}
-    out.worse = worse_configurations(out.before, out.after)
-    free = [j for j, n in enumerate(prob.names) if n not in out.at_bounds]
-    if cfgs is None:
-        sol = res.solution
-        out.undetermined = [] if sol is None or not sol.rank_deficient else undetermined_directions(
-            sol.null_space.T[:3], prob.names)
-    else:
-        out.undetermined = weak_directions(cfgs, out.p, prob.names, free) if free else []
-    v = out.verdict
-    noise = f"frequency noise {out.noise['frequency_pct']:g} %" + (
-        f", shape noise {out.noise['shape_pct']:g} %" if out.noise["shape_pct"] is not None else "")
-    if out.noise["shape_estimated"]:
-        noise += " (the shapes' estimated from their residual)"
-    if not out.noise["stated"][0]:
-        noise += " (the frequencies' assumed; state it with --noise)"
-    d = []
-    if v["chi2"] is not None:
-        model = ", and the model error" if out.noise["model_error"] else ""
-        chi2 = (f"chi^2 {v['chi2']:.4g} over {v['dof']} degrees of freedom (probability {v['p_value']:.2g} under the "
-                f"{noise}{model})" if v["p_value"] is not None else
-                f"chi^2 {v['chi2']:.4g} with no degree of freedom left to judge it (fewer rows than parameters)")
-        if v["paired_modes"] < MIN_PAIRED * v["measured_modes"]:
-            d.append(f"the model cannot fit the test: only {v['paired_modes']} of its {v['measured_modes']} measured "
-                     f"modes pair with a model mode (a test of another structure or configuration?); {chi2}")
-        elif v["fits"] is False:
-            d.append(f"the model cannot fit the test: {chi2}")
-        else:
-            d.append(f"{chi2}: within the noise" if v["fits"] else chi2)
-    d += [f"configuration {c}: max |df| grew from {b:.2f} % to {a:.2f} %" for c, b, a in out.worse]
-    d += [f"{n} stopped at its {side} bound" for n, side in out.at_bounds.items()]
-    d += [f"the data do not determine {c}" for c in out.undetermined]
-    if out.shapes:
-        d.append(f"mode shapes in the objective: {out.shapes}")
-    d += [f"another start ended worse: {_values(prob, s['end'])} (chi^2 {s['objective']:.4g})"
-          for s in out.starts if not s["kept"] and not np.allclose(s["end"], out.p, rtol=1e-2)]
-    if v["fits"] is False:
-        status = "cannot fit"
-    elif out.worse:
-        status = "error grew"
-    elif out.at_bounds:
-        status = "on a bound"
-    elif out.undetermined:
-        status = "not determined"
-    else:
-        status = "converged" if res.converged else "not converged"
-    out.status, out.details = status, d + [f"fit: {res.reason}"]
-
-
-def _values(problem, p) -> str:
-    return ", ".join(f"{n} {from_si(v, u):.4g} {u}" for (n, v), u in zip(problem.values(p).items(), problem.units))
