@@ -5,7 +5,7 @@ and the model's mesh correction and plate-theory gap measured on meshes finer th
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -39,15 +39,11 @@ def noise_sigmas(ob: Observation, freq_pct, shape_pct, basis_shapes):
 
 
 def observations(tests, models) -> list:
-    """An Observation per test [(configuration, Modes)], read on its configuration's built model."""
-    obs = []
-    for (c, mm), pm in zip(tests, models):
-        ob = Observation(c, mm, np.ones(mm.n_modes))
-        if mm.shapes is not None:
-            ob.read = reading(pm.model, mm.xyz, mm.directions)
-            ob.sigma_s = np.ones(mm.n_modes)  # until the noise is known
-        obs.append(ob)
-    return obs
+    """An Observation per test [(configuration, Modes)], read on its configuration's built model, in unit
+    sigmas until the noise is known (:func:`set_noise`)."""
+    return [Observation(c, mm, np.ones(mm.n_modes)) if mm.shapes is None else
+            Observation(c, mm, np.ones(mm.n_modes), reading(pm.model, mm.xyz, mm.directions), np.ones(mm.n_modes))
+            for (c, mm), pm in zip(tests, models)]
 
 
 def _requests(ob, cs, h, levels: int, carried=(), kirchhoff: bool = False) -> list:
@@ -74,14 +70,13 @@ class Form:
 
 
 def _correct(ob, cs, solved, form: Form):
-    """Sets ``ob``'s frequency correction from ``solved`` (the modes on the finer meshes,
+    """(``ob`` with its frequency correction from ``solved`` (the modes on the finer meshes,
     :func:`.model_form.discretisation`) and its frequency sigmas (measurement, the correction's
-    uncertainty and the plate theory's gap in quadrature), and ``form``'s ``plain`` and
-    ``resolved``; returns the shapes' relative error."""
-    ob.f_scale, df, ds, ok = discretisation(solved, ob, cs)
+    uncertainty and the plate theory's gap in quadrature), the shapes' relative error); sets
+    ``form``'s ``plain`` and ``resolved``."""
+    f_scale, df, ds, ok = discretisation(solved, ob, cs)
     form.plain, form.resolved = np.sqrt(form.measured**2 + df**2), ok.tolist()
-    ob.sigma_f = np.sqrt(form.plain**2 + form.shift**2)
-    return ds
+    return replace(ob, f_scale=f_scale, sigma_f=np.sqrt(form.plain**2 + form.shift**2)), ds
 
 
 def set_noise(models, h, obs, state, freq_pct, shape_pct, levels: int, runner, support=()) -> list:
@@ -89,7 +84,7 @@ def set_noise(models, h, obs, state, freq_pct, shape_pct, levels: int, runner, s
     measurement noise, what remains of the discretisation error and the plate theory's gap, in
     quadrature (:mod:`.model_form`), from ``levels`` finer meshes (solved where ``runner`` says) at the
     declared parameters of ``state`` (the paired start), carrying its ``support`` springs ([(candidate,
-    value)], :mod:`.support`). Returns a :class:`Form` per observation."""
+    value)], :mod:`.support`). Returns (the observations with them, a :class:`Form` per observation)."""
     sigmas = []
     for ob, cs in zip(obs, state.configs):
         basis = None
@@ -100,16 +95,16 @@ def set_noise(models, h, obs, state, freq_pct, shape_pct, levels: int, runner, s
     requests = [r for ob, cs in zip(obs, state.configs) for r in _requests(ob, cs, h, levels, support, kirchhoff=True)]
     at = parameter_values(models.models[0], models.names, state.p)
     solved = iter(finer.solve(runner, models.structure, at, requests))
-    forms = []
+    forms, out = [], []
     for ob, cs, (sf, ss) in zip(obs, state.configs, sigmas):
         meshes = [next(solved) for _ in range(levels)]
         forms.append(Form(kirchhoff_shift(meshes[-1], next(solved), ob, cs), sf))
-        ds = _correct(ob, cs, meshes, forms[-1])
-        ob.sigma_s = None if ss is None else np.sqrt(ss**2 + ds**2)
-    return forms
+        ob, ds = _correct(ob, cs, meshes, forms[-1])
+        out.append(replace(ob, sigma_s=None if ss is None else np.sqrt(ss**2 + ds**2)))
+    return out, forms
 
 
-def with_carried(models, res, p, carried, forms, h, levels: int, runner, kirchhoff: bool = False) -> None:
+def with_carried(models, res, p, carried, forms, h, levels: int, runner, kirchhoff: bool = False):
     """The mesh correction measured again at the fitted parameters ``p`` on the model carrying the
     masses and supports found (``carried``: [(candidate, value)], of :data:`MASS_KINDS` or between
     nodes), on its own mesh and placed on the ``levels`` finer ones: a mass changes the shapes, and
@@ -120,13 +115,15 @@ def with_carried(models, res, p, carried, forms, h, levels: int, runner, kirchho
     mesh along its line is not: :func:`_on_lines`). ``kirchhoff``: the plate theory's gap measured
     again too, on the finest mesh (a rib makes modes of other shapes, whose gap differs: 0.61 %
     against 0.13 % on the fourth mode of a card with a bar across it).
-    Sets the observations' ``f_scale`` and frequency sigmas and the ``forms``."""
+    Returns ``res`` of the observations with their new ``f_scale`` and frequency sigmas; sets the ``forms``."""
     ref = res.evaluate(p, [c for c, _ in carried], [v for _, v in carried])
     requests = [r for ob, cs in zip(res.observations, ref.configs) for r in _requests(ob, cs, h, levels, carried, kirchhoff)]
     at = parameter_values(models.models[0], models.names, p)
     solved = iter(finer.solve(runner, models.structure, at, requests))
+    obs = []
     for ob, cs, form in zip(res.observations, ref.configs, forms):
         meshes = [next(solved) for _ in range(levels)]
         if kirchhoff:
             form.shift = kirchhoff_shift(meshes[-1], next(solved), ob, cs)
-        _correct(ob, cs, meshes, form)
+        obs.append(_correct(ob, cs, meshes, form)[0])
+    return res.on(obs)

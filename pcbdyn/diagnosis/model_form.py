@@ -8,6 +8,8 @@ neither taken for an effect nor left in the error reported after."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from ..correlation.mac import mac
@@ -79,7 +81,7 @@ def kirchhoff_shift(fine, limit, ob, coarse_state) -> np.ndarray:
 
 
 def fit_plate_share(res, candidates, sel, shifts, sigma_f, bounds=None, alpha: float = ALPHA, rounds: int = 2):
-    """(``sel`` re-estimated, theta, its standard deviation): theta in [0, 1] scales each
+    """(``sel`` re-estimated, theta, its standard deviation, ``res`` as below): theta in [0, 1] scales each
     observation's Kirchhoff ``shifts`` into its frequencies (0: the declared Mindlin shells, 1: the
     Kirchhoff limit), fitted with the declared parameters and the effects of ``sel``: linearised,
     then the rest re-estimated by Gauss-Newton, in noise units ``sigma_f`` (per observation, the
@@ -87,19 +89,18 @@ def fit_plate_share(res, candidates, sel, shifts, sigma_f, bounds=None, alpha: f
     moves from 0 only where its chi^2 drop is significant (:func:`.select.worth`, the penalty of
     one more column): on data of the model's own form it stays 0. Either way the data have now
     bounded it, so the frequency sigmas keep only its uncertainty's part of the gap, and ``sel``
-    is re-estimated with them; the observations' ``f_scale`` carry theta."""
-    obs = res.observations
+    is re-estimated with them, in the residual of observations with those sigmas and with ``f_scale``
+    carrying theta."""
     chosen = [candidates[i] for i in sel.chosen]
     scale = np.array([c.spec.scale for c in chosen], float)
-    for ob, s in zip(obs, sigma_f):
-        ob.sigma_f = s
+    res = res.on([replace(ob, sigma_f=s) for ob, s in zip(res.observations, sigma_f)])
     fit = estimate(res, sel.p, chosen, sel.values, 0, bounds)
     theta, var_theta = 0.0, 1.0
     for _ in range(rounds):
         st = fit.state
         held = np.hstack([res.param_columns(st), res.effect_columns(st, chosen) * scale])
         col = np.concatenate([np.r_[cs.f_a * d / (1.0 + theta * d) / (ob.sigma_f * ob.f), np.zeros(cs.r.size - ob.f.size)]
-                              for ob, cs, d in zip(obs, st.configs, shifts)])
+                              for ob, cs, d in zip(res.observations, st.configs, shifts)])
         J = np.column_stack([held, col])
         x = np.linalg.lstsq(J, st.r, rcond=None)[0]
         var_theta = min(1.0, covariance(J, st.r)[-1, -1])
@@ -108,19 +109,19 @@ def fit_plate_share(res, candidates, sel, shifts, sigma_f, bounds=None, alpha: f
         e1, e0 = st.r - J[:, :-1] @ x[:-1] - col * step, st.r - held @ x0
         if abs(step) < 1e-3 or not worth(float(e0 @ e0), float(e1 @ e1), res.n_rows, J.shape[1], penalty(res.n_rows, 1, alpha)):
             break
-        _shift(obs, shifts, theta, theta + step)
-        trial = estimate(res, fit.p, chosen, fit.values, 8, bounds)
-        if trial.state is None or trial.chi2 >= fit.chi2:  # the linear step did not pay: undo it
-            _shift(obs, shifts, theta + step, theta)
+        moved = _shifted(res, shifts, theta, theta + step)
+        trial = estimate(moved, fit.p, chosen, fit.values, 8, bounds)
+        if trial.state is None or trial.chi2 >= fit.chi2:  # the linear step did not pay
             break
-        theta, fit = theta + step, trial
-    for ob, s, d in zip(obs, sigma_f, shifts):
-        ob.sigma_f = np.sqrt(s**2 + var_theta * d**2)
+        res, theta, fit = moved, theta + step, trial
+    res = res.on([replace(ob, sigma_f=np.sqrt(s**2 + var_theta * d**2))
+                  for ob, s, d in zip(res.observations, sigma_f, shifts)])
     fit = estimate(res, fit.p, chosen, fit.values, 8, bounds)
-    return adopt(sel, sel.chosen, fit, penalty(res.n_rows, len(candidates), alpha)), theta, float(np.sqrt(var_theta))
+    return adopt(sel, sel.chosen, fit, penalty(res.n_rows, len(candidates), alpha)), theta, float(np.sqrt(var_theta)), res
 
 
-def _shift(obs, shifts, old: float, new: float) -> None:
-    """The observations' frequency factors moved from plate theory share ``old`` to ``new``."""
-    for ob, d in zip(obs, shifts):
-        ob.f_scale = ob.f_scale * (1.0 + new * d) / (1.0 + old * d)
+def _shifted(res, shifts, old: float, new: float):
+    """``res`` of its observations with their frequency factors moved from plate theory share ``old`` to
+    ``new``."""
+    return res.on([replace(ob, f_scale=ob.f_scale * (1.0 + new * d) / (1.0 + old * d))
+                   for ob, d in zip(res.observations, shifts)])

@@ -113,7 +113,7 @@ def _on_lines(models, res, cands, sel, forms, h, levels: int, runner, alpha, say
     except StructureError as exc:
         say(f"  not meshed along them ({exc}): the stiffeners stay embedded in the model's cells")
         return None
-    with_carried(models, res, sel.p, list(zip(placed, values)), forms, h, levels, runner, kirchhoff=True)
+    res = with_carried(models, res, sel.p, list(zip(placed, values)), forms, h, levels, runner, kirchhoff=True)
     fit = estimate(res, sel.p, placed, values, conforming.STEPS, models.bounds)
     say("fitting the stiffeners' ends, directions and sections on meshes along them")
     ribs = geometry_fit.fit_ribs(*base, res.observations, placed, fit.p, fit.values, runner, say)
@@ -123,7 +123,7 @@ def _on_lines(models, res, cands, sel, forms, h, levels: int, runner, alpha, say
         models, res, placed, fit = ribs.models, ribs.res, ribs.placed, ribs.fit
         if moved > conforming.REMEASURE * h:
             say("  the mesh correction measured where the stiffeners went")
-            with_carried(models, res, fit.p, list(zip(placed, fit.values)), forms, h, levels, runner, kirchhoff=True)
+            res = with_carried(models, res, fit.p, list(zip(placed, fit.values)), forms, h, levels, runner, kirchhoff=True)
             fit = estimate(res, fit.p, placed, fit.values, conforming.STEPS, models.bounds)
     out = list(cands)
     for i, c in zip(idx, placed):
@@ -262,7 +262,8 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
     levels = 1 if quick else MESH_LEVELS
     say("  finer meshes: " + ", ".join(f"level {j} of {levels} ({1e3 * h / 2**j:.3g} mm)" for j in range(1, levels + 1)))
     seed = res.evaluate(start, [c for c, _ in support], [v for _, v in support])
-    forms = set_noise(models, h, obs, seed, freq_noise_pct, shape_noise_pct, levels, runner, support)
+    obs, forms = set_noise(models, h, obs, seed, freq_noise_pct, shape_noise_pct, levels, runner, support)
+    res = res.on(obs)
     before = res.evaluate(p0)
     say(f"fitting the {len(names)} declared parameter(s)" if names else "no declared parameters")
     # the declared parameters alone, on the modes they can pair (a support's bounce has no partner without it)
@@ -321,18 +322,17 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
         _on_lines(models, res, cands, sel, forms, h, levels, runner, alpha, say)
     if lined is not None:
         models, res, cands, sel = lined
-        obs = res.observations
     elif carried and not quick:
         say("measuring the mesh correction again with the masses (and supports) found on the finer meshes")
-        with_carried(models, res, sel.p, carried, forms, h, levels, runner)
+        res = with_carried(models, res, sel.p, carried, forms, h, levels, runner)
         sel = adopt(sel, sel.chosen, estimate(res, sel.p, [cands[i] for i in sel.chosen], sel.values, 8, models.bounds),
                     penalty(res.n_rows, len(cands), alpha))
     if lined is not None or (carried and not quick):
         stats["mesh_resolved"] = [f.resolved for f in forms]
-        stats["mesh_correction_pct"] = [np.round(100 * (o.f_scale - 1.0), 4).tolist() for o in obs]
+        stats["mesh_correction_pct"] = [np.round(100 * (o.f_scale - 1.0), 4).tolist() for o in res.observations]
         stats["plate_theory_pct"] = [np.round(100 * f.shift, 4).tolist() for f in forms]
     say("fitting the plate theory's share with the effects")
-    sel, theta, theta_sigma = fit_plate_share(res, cands, sel, [f.shift for f in forms], [f.plain for f in forms],
+    sel, theta, theta_sigma, res = fit_plate_share(res, cands, sel, [f.shift for f in forms], [f.plain for f in forms],
                                               models.bounds, alpha=alpha)
     stats.update(plate_theory_share=theta, plate_theory_share_sigma=theta_sigma)
     if sel.chosen:
@@ -361,7 +361,7 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
                 "from them (a spring to ground)")
     if any(left.values()):
         msg += f"; test modes with no model partner (MAC < 0.3), left out of the fit: {left}"
-    after = sel.state.summary(obs)
+    after = sel.state.summary(res.observations)
     po, worse = out["parameters_only"]["max_freq_error_pct"], after["max_freq_error_pct"]
     stats["after_worse_than_parameters_only"] = bool(worse > po)
     if worse > po:

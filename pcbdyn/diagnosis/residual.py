@@ -48,14 +48,15 @@ def reading(model, xyz, directions):
     return model_probe(model, xyz, directions, tol=READ_TOL).P
 
 
-@dataclass
+@dataclass(frozen=True)
 class Observation:
     """One test configuration in the residual: its measured ``modes`` (:class:`pcbdyn.testdata.MeasuredModes`:
     frequencies, and shapes that the model gives as ``read @ u``, ``read`` (n_pts, n_dof) on the full
     DOFs); relative standard deviations ``sigma_f`` (m,) of the frequencies and ``sigma_s`` (m,) of a
     shape component (per RMS of the mode's measured shape); ``f_scale`` (m,): the factor that takes the
     paired model frequency to its converged-mesh value (a discretisation correction; 1 by default).
-    Without shapes the modes pair by order."""
+    Without shapes the modes pair by order. Never changed once made: a new error budget is a new
+    observation (``dataclasses.replace``) in a new residual (:meth:`ModalResidual.on`)."""
 
     name: str | None
     modes: MeasuredModes
@@ -65,9 +66,9 @@ class Observation:
     f_scale: np.ndarray | None = None
 
     def __post_init__(self):
-        self.sigma_f = np.asarray(self.sigma_f, float)
+        object.__setattr__(self, "sigma_f", np.asarray(self.sigma_f, float))
         if self.f_scale is None:
-            self.f_scale = np.ones(self.f.size)
+            object.__setattr__(self, "f_scale", np.ones(self.f.size))
 
     @property
     def f(self) -> np.ndarray:
@@ -83,8 +84,7 @@ class Observation:
 
     def read_on(self, model) -> "Observation":
         """This observation (noise and correction kept) read on ``model``'s mesh."""
-        return replace(self, read=None if self.shapes is None else reading(model, self.modes.xyz, self.modes.directions),
-                       sigma_f=self.sigma_f.copy(), f_scale=self.f_scale.copy())
+        return replace(self, read=None if self.shapes is None else reading(model, self.modes.xyz, self.modes.directions))
 
     def subset(self, keep) -> "Observation":
         """The observation of the measured modes ``keep`` (a boolean mask or indices)."""
@@ -236,6 +236,14 @@ class ModalResidual:
         self.effects = Effects()
         self._at = (None, None)  # last p, its [(model, K, M)]
         self._seconds: dict = {}  # per configuration, how long its last solve took
+
+    def on(self, observations) -> "ModalResidual":
+        """This residual of ``observations``: the same configurations' measured modes with another error
+        budget (noise, mesh correction); the models, their assembled matrices and the effects' patterns
+        are shared."""
+        other = ModalResidual(observations, self.build, self.derivatives, self.n_params, self.matrices)
+        other.effects, other._at, other._seconds = self.effects, self._at, self._seconds
+        return other
 
     def row_groups(self) -> tuple:
         """(configuration index, mode index) of every row: the blocks cross-validation leaves out."""

@@ -46,8 +46,8 @@ def test_bounce_places_and_sizes_the_spring(at, k, mass):
     xyz = np.column_stack([xy, np.zeros(len(xy))])
     modes = solve_modes(truth, n_modes=5)
     shapes = np.asarray(model_probe(truth, xyz).P @ modes.shapes)
-    ob = Observation(None, measured(modes.frequencies, shapes, xyz), np.full(5, 1e-3))
-    ob.read, ob.sigma_s = model_probe(model, xyz).P, np.full(5, 1e-2)
+    ob = Observation(None, measured(modes.frequencies, shapes, xyz), np.full(5, 1e-3), model_probe(model, xyz).P,
+                     np.full(5, 1e-2))
     cs = ModalResidual([ob], lambda p: [model]).evaluate(np.zeros(0)).configs[0]
 
     share = rigid_share(ob, cs)
