@@ -81,7 +81,8 @@ def main() -> int:
     print(f"{FILE.name}: {len(data)} plates, one transfer mobility each, 0.5 Hz lines, LSCF to order {2 * POLES}")
     print(f"\n{'band':>12} {'method':>10} " + " ".join(f"{n.split()[1]:>9}" for n, _, _ in data))
     for (band, method), rows in table.items():
-        print(f"{band[0]:5.0f}-{band[1]:4.0f} Hz {method:>10} " + " ".join(f"{h:3d}/{n:<2d}+{x:<2d}" for n, h, x, _, _ in rows))
+        cells = " ".join(f"{h:3d}/{n:<2d}+{x:<2d}" for n, h, x, _, _ in rows)
+        print(f"{band[0]:5.0f}-{band[1]:4.0f} Hz {method:>10} {cells}")
     print("\n(found within 1 % / published, + extra modes)")
     for (band, method), rows in table.items():
         for half, idx in HALVES.items():
