@@ -106,6 +106,13 @@ def identify(frfs, band=None, max_order: int = 40, select=None) -> Identificatio
     chosen = [stability.representative(c, g) for g in groups]
     poles = c.pole[chosen]
     A = lscf.residues(poles, f, rows, frfs.kind)
+    if select is None:  # the automatic choice keeps the modes the FRFs show (stability.MIN_SHARE)
+        seen = stability.share(poles, A, f, rows, frfs.kind) >= stability.MIN_SHARE
+        if not seen.all():
+            groups = [g for g, s in zip(groups, seen) if s]
+            chosen = [k for k, s in zip(chosen, seen) if s]
+            poles = c.pole[chosen]
+            A = lscf.residues(poles, f, rows, frfs.kind)
     psi, scaling = shapes(A, pairs, frfs, poles)
     phi, mpc = real_modes(psi)
     big = np.argmax(np.abs(phi), axis=0)
