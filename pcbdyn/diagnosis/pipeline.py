@@ -187,14 +187,14 @@ def _parameter_stage(plain, own, update, models, say) -> tuple:
 
 def _supports(res, p0, before, models, kinds, say) -> tuple:
     """(support springs [(candidate, value)], the state of ``res`` with them): the springs to ground
-    that measured modes of rigid-body shape demand of a free model (:func:`.support.supports`; none
-    where the kinds searched leave springs out)."""
+    that measured modes without a partner demand (of rigid-body shape on a free model, any on a held
+    one: :func:`.support.supports`; none where the kinds searched leave springs out)."""
     if "ground_spring" not in (kinds or KINDS):
         return [], before
     layout = from_structure(models.models[0])
     found, state = supports(res, p0, before, generate(layout, ["ground_spring"]), layout)
     if found:
-        say("test modes of rigid-body shape: the model lacks a support; "
+        say("test modes without a partner: the model lacks a support; "
             + ", ".join(f"{c.name} ({v:.3g} N/m)" for c, v in found))
     return found, state
 
@@ -250,7 +250,7 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
     support, shown, left, bounce = [], {}, unmatched, [np.zeros(ob.f.size, bool) for ob in obs]
     if any(unmatched.values()):  # modes the model has no partner for (MAC < 0.3): local modes of what it lacks
         support, paired = _supports(res, start, at, models, kinds, say)
-        bounce = [cs.matched & ~c0.matched for cs, c0 in zip(paired.configs, before.configs)]
+        bounce = [cs.matched & ~c0.matched for cs, c0 in zip(paired.configs, at.configs)]
         shown = {ob.name or "base": (np.flatnonzero(b) + 1).tolist() for ob, b in zip(obs, bounce)}
         left = {ob.name or "base": (np.flatnonzero(~cs.matched) + 1).tolist() for ob, cs in zip(obs, paired.configs)}
         if any(left.values()):
@@ -357,7 +357,7 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
                 "Mindlin shells to the Kirchhoff limit (statistics.plate_theory_share): the board's transverse shear "
                 "is stiffer than declared (board.transverse_shear can be updated as a parameter)")
     if support:
-        msg += (f"; test modes of rigid-body shape {shown} show a support the free model lacks, placed and sized "
+        msg += (f"; test modes without a model partner {shown} show a support the model lacks, placed and sized "
                 "from them (a spring to ground)")
     if any(left.values()):
         msg += f"; test modes with no model partner (MAC < 0.3), left out of the fit: {left}"

@@ -15,6 +15,12 @@ stiffness is the one that puts the Rayleigh-Ritz mode most like the measured one
 points) at the measured frequency. Both are the start of the search, which then fits the spring
 with the declared parameters and whatever else the data show (and may walk it, :class:`LocalMoves`
 of :mod:`.pipeline`).
+
+A held model (on standoffs, in guides) has no rigid-body modes; a point support it lacks (an undeclared
+standoff) holds the board where its lowest modes move most, so those test modes find no partner at
+all. There any mode without a partner is tried: the spring is placed where one that holds its point
+makes a Rayleigh-Ritz mode of the model's modes most like the measured one, then sized as above, and
+kept only if the mode then pairs.
 """
 
 from __future__ import annotations
@@ -33,6 +39,10 @@ from .select import orth
 #: pcbdyn's own data, 0.65 on OpenSees', where the spring is stiff enough to bend the card; the
 #: elastic modes of the bench's cases: below 0.15)
 RIGID_SHARE_MIN = 0.5
+#: on a held model, a spring is placed where one of stiffness STIFF * lambda / |w|^2 (w: its row in
+#: the modal basis; lambda: the measured mode's eigenvalue) makes a mode most like the measured one: a
+#: spring that holds its point, as a standoff does
+STIFF = 100.0
 
 
 def rigid_share(ob, cs) -> np.ndarray:
@@ -47,8 +57,12 @@ def rigid_share(ob, cs) -> np.ndarray:
 
 
 def support_modes(ob, cs) -> np.ndarray:
-    """Mask of the measured modes of ``ob`` that show a support: no elastic partner in the state
-    ``cs`` and a rigid-body shape (:data:`RIGID_SHARE_MIN`)."""
+    """Mask of the measured modes of ``ob`` that may show a support: no elastic partner in the state
+    ``cs`` and, where the model has rigid-body modes, a rigid-body shape (:data:`RIGID_SHARE_MIN`); on
+    a held model any mode without a partner (a standoff left out of the model holds the board where
+    its first modes move most, and they find no partner)."""
+    if cs.modes.n_rigid == 0:
+        return ~cs.matched
     return ~cs.matched & (rigid_share(ob, cs) >= RIGID_SHARE_MIN)
 
 
@@ -56,31 +70,45 @@ def locate(ob, cs, i: int, springs: list, layout) -> tuple:
     """(spring candidate, stiffness [N/m]): the spring to ground that explains measured mode ``i``
     of ``ob`` in the state ``cs`` (module doc): the node of ``springs`` (``ground_spring``
     candidates on the state's mesh, ``layout``) whose rigid-body part best matches the mode's; on a
-    board, the point itself (:func:`_between_nodes`)."""
+    board, the point itself (:func:`_between_nodes`). On a held model (no rigid-body modes), the node
+    where a spring that holds it (:data:`STIFF`) makes a Rayleigh-Ritz mode most like the measured one."""
     nr = cs.modes.n_rigid
     phi = np.column_stack([cs.modes.rigid_shapes, cs.modes.shapes])
     points = cs.at_points(ob.read)
     x = ob.shapes[:, i : i + 1]
     W = _rows(cs.model, phi, springs)
-    best = springs[int(np.argmax(mac(points[:, :nr] @ W[:, :nr].T, x)[:, 0]))]
-    if layout.planar:
-        best = _between_nodes(layout, cs.modes.rigid_shapes, points, nr, x) or best
-    w = _rows(cs.model, phi, [best])[0]
     lam = np.r_[np.zeros(nr), cs.modes.omega2]
     target = (2.0 * np.pi * ob.f[i]) ** 2
+    if nr:
+        best = springs[int(np.argmax(mac(points[:, :nr] @ W[:, :nr].T, x)[:, 0]))]
+        if layout.planar:
+            best = _between_nodes(layout, cs.modes.rigid_shapes, points, nr, x) or best
+    else:
+        best = springs[int(np.argmax([_ritz_mac(lam, STIFF * target / max(w @ w, 1e-300) * np.outer(w, w), points, x)
+                                      for w in W]))]
+    w = _rows(cs.model, phi, [best])[0]
 
     def eigenvalue(k: float) -> float:  # of the Rayleigh-Ritz mode most like the measured one
         val, vec = np.linalg.eigh(np.diag(lam) + k * np.outer(w, w))
         return val[int(np.argmax(mac(points @ vec, x)[:, 0]))]
 
-    lo = target / max(w[:nr] @ w[:nr], 1e-300)  # the rigid modes alone: the elastic ones only lower it
-    hi = 1e3 * lo
+    # the rigid modes alone: the elastic ones only lower it; on a held model, from a spring too soft
+    # to move the mode to one that holds its point
+    lo = target / max(w[:nr] @ w[:nr], 1e-300) if nr else target / max(w @ w, 1e-300) / STIFF
+    hi = (1e3 if nr else STIFF**2) * lo
     if eigenvalue(hi) < target:
         return best, hi
     for _ in range(60):
         mid = np.sqrt(lo * hi)
         lo, hi = (mid, hi) if eigenvalue(mid) < target else (lo, mid)
     return best, float(np.sqrt(lo * hi))
+
+
+def _ritz_mac(lam, dK, points, x) -> float:
+    """The largest MAC with measured shape ``x`` among the Rayleigh-Ritz modes of the basis of
+    eigenvalues ``lam`` (its shapes at the points: ``points``) stiffened by ``dK``."""
+    _, vec = np.linalg.eigh(np.diag(lam) + dK)
+    return float(mac(points @ vec, x)[:, 0].max())
 
 
 def _rows(model, phi, springs) -> np.ndarray:
@@ -110,26 +138,40 @@ def _between_nodes(layout, rigid, points, nr: int, x):
         return None
 
 
-#: supports located at most (one spring per measured mode of rigid-body shape)
+#: how far the mean MAC of the other paired modes may fall when a support is added (:func:`_shapes_kept`)
+MAC_SLACK = 0.01
+#: supports located at most (one spring per measured mode without a partner)
 MAX_SUPPORTS = 3
+
+
+def _shapes_kept(before, after) -> bool:
+    """Whether the modes paired in both states resemble their partners in ``after`` on average at least
+    as well as in ``before`` (mean MAC, less :data:`MAC_SLACK`): a support the structure has makes the
+    shapes of the modes it holds more like the measured ones; a spring that only gives one mode a
+    partner (where a mass or a stiffener is what the model lacks) makes the others less so."""
+    a = np.concatenate([cb.mac[cb.matched & ca.matched] for cb, ca in zip(before.configs, after.configs)])
+    b = np.concatenate([ca.mac[cb.matched & ca.matched] for cb, ca in zip(before.configs, after.configs)])
+    return a.size == 0 or float(b.mean()) >= float(a.mean()) - MAC_SLACK
 
 
 def supports(res, p, state, springs: list, layout) -> tuple:
     """([(spring candidate, stiffness [N/m])], the state of ``res`` at parameters ``p`` with them):
     springs to ground located one after another (:func:`locate`) while some configuration of
-    ``state`` has a measured mode of rigid-body shape without a partner (:func:`support_modes`),
-    each kept only if that mode then has one. A configuration's test showing the same bounce
-    as another's is explained by the same spring."""
+    ``state`` has a measured mode without a partner that may show one (:func:`support_modes`),
+    each kept only if that mode then has one (the first of :data:`MAX_SUPPORTS` such modes for which it
+    does). A configuration's test showing the same bounce as another's is explained by the same spring."""
     found = []
     for _ in range(MAX_SUPPORTS):
         todo = [(k, i) for k, (ob, cs) in enumerate(zip(res.observations, state.configs))
                 for i in np.flatnonzero(support_modes(ob, cs))]
         if not todo:
             break
-        k, i = todo[0]
-        trial = found + [locate(res.observations[k], state.configs[k], i, springs, layout)]
-        st = res.evaluate(p, [c for c, _ in trial], [v for _, v in trial])
-        if not st.configs[k].matched[i]:
+        for k, i in todo[:MAX_SUPPORTS]:
+            trial = found + [locate(res.observations[k], state.configs[k], i, springs, layout)]
+            st = res.evaluate(p, [c for c, _ in trial], [v for _, v in trial])
+            if st.configs[k].matched[i] and _shapes_kept(state, st):
+                found, state = trial, st
+                break
+        else:
             break
-        found, state = trial, st
     return found, state
