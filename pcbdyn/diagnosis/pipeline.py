@@ -53,7 +53,7 @@ from .residual import ModalResidual
 from .fitting import estimate
 from .scan import Runner
 from .select import ALPHA, adopt, noticed, penalty, refine, search, without_vanished
-from .support import supports
+from .unpaired import partners
 from .uncertainty import jackknife_cov
 
 #: where candidates go: sides cut into 16 pieces (every run of consecutive pieces is a candidate);
@@ -186,16 +186,19 @@ def _parameter_stage(plain, own, update, models, say) -> tuple:
 
 
 def _supports(res, p0, before, models, kinds, say) -> tuple:
-    """(support springs [(candidate, value)], the state of ``res`` with them): the springs to ground
-    that measured modes without a partner demand (of rigid-body shape on a free model, any on a held
-    one: :func:`.support.supports`; none where the kinds searched leave springs out)."""
-    if "ground_spring" not in (kinds or KINDS):
-        return [], before
+    """(effects [(candidate, value)], the state of ``res`` with them): the springs to ground and point
+    masses that the measured modes without a partner show (:func:`.unpaired.partners`; only the kinds
+    searched)."""
+    searched = kinds or KINDS
     layout = from_structure(models.models[0])
-    found, state = supports(res, p0, before, generate(layout, ["ground_spring"]), layout)
+    springs = generate(layout, ["ground_spring"]) if "ground_spring" in searched else []
+    masses = generate(layout, ["point_mass"]) if "point_mass" in searched else []
+    if not springs and not masses:
+        return [], before
+    found, state = partners(res, p0, before, springs, masses, layout)
     if found:
-        say("test modes without a partner: the model lacks a support; "
-            + ", ".join(f"{c.name} ({v:.3g} N/m)" for c, v in found))
+        say("test modes without a partner: the model lacks "
+            + ", ".join(f"{c.name} ({v:.3g} {c.spec.unit})" for c, v in found))
     return found, state
 
 
@@ -357,8 +360,8 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
                 "Mindlin shells to the Kirchhoff limit (statistics.plate_theory_share): the board's transverse shear "
                 "is stiffer than declared (board.transverse_shear can be updated as a parameter)")
     if support:
-        msg += (f"; test modes without a model partner {shown} show a support the model lacks, placed and sized "
-                "from them (a spring to ground)")
+        msg += (f"; test modes without a model partner {shown} show what the model lacks ("
+                + ", ".join(c.kind for c, _ in support) + "), placed and sized from them")
     if any(left.values()):
         msg += f"; test modes with no model partner (MAC < 0.3), left out of the fit: {left}"
     after = sel.state.summary(res.observations)

@@ -84,7 +84,7 @@ def locate(ob, cs, i: int, springs: list, layout) -> tuple:
         if layout.planar:
             best = _between_nodes(layout, cs.modes.rigid_shapes, points, nr, x) or best
     else:
-        best = springs[int(np.argmax([_ritz_mac(lam, STIFF * target / max(w @ w, 1e-300) * np.outer(w, w), points, x)
+        best = springs[int(np.argmax([ritz_mac(lam, STIFF * target / max(w @ w, 1e-300) * np.outer(w, w), points, x)
                                       for w in W]))]
     w = _rows(cs.model, phi, [best])[0]
 
@@ -104,7 +104,7 @@ def locate(ob, cs, i: int, springs: list, layout) -> tuple:
     return best, float(np.sqrt(lo * hi))
 
 
-def _ritz_mac(lam, dK, points, x) -> float:
+def ritz_mac(lam, dK, points, x) -> float:
     """The largest MAC with measured shape ``x`` among the Rayleigh-Ritz modes of the basis of
     eigenvalues ``lam`` (its shapes at the points: ``points``) stiffened by ``dK``."""
     _, vec = np.linalg.eigh(np.diag(lam) + dK)
@@ -138,40 +138,17 @@ def _between_nodes(layout, rigid, points, nr: int, x):
         return None
 
 
-#: how far the mean MAC of the other paired modes may fall when a support is added (:func:`_shapes_kept`)
+#: how far the mean MAC of the other paired modes may fall when a support is added (:func:`shapes_kept`)
 MAC_SLACK = 0.01
-#: supports located at most (one spring per measured mode without a partner)
+#: effects located at most from the modes without a partner (:func:`.unpaired.partners`)
 MAX_SUPPORTS = 3
 
 
-def _shapes_kept(before, after) -> bool:
+def shapes_kept(before, after) -> bool:
     """Whether the modes paired in both states resemble their partners in ``after`` on average at least
-    as well as in ``before`` (mean MAC, less :data:`MAC_SLACK`): a support the structure has makes the
-    shapes of the modes it holds more like the measured ones; a spring that only gives one mode a
-    partner (where a mass or a stiffener is what the model lacks) makes the others less so."""
+    as well as in ``before`` (mean MAC, less :data:`MAC_SLACK`): an effect the structure has makes the
+    shapes of the modes it acts on more like the measured ones; one that only gives one mode a partner
+    (where something else is what the model lacks) makes the others less so."""
     a = np.concatenate([cb.mac[cb.matched & ca.matched] for cb, ca in zip(before.configs, after.configs)])
     b = np.concatenate([ca.mac[cb.matched & ca.matched] for cb, ca in zip(before.configs, after.configs)])
     return a.size == 0 or float(b.mean()) >= float(a.mean()) - MAC_SLACK
-
-
-def supports(res, p, state, springs: list, layout) -> tuple:
-    """([(spring candidate, stiffness [N/m])], the state of ``res`` at parameters ``p`` with them):
-    springs to ground located one after another (:func:`locate`) while some configuration of
-    ``state`` has a measured mode without a partner that may show one (:func:`support_modes`),
-    each kept only if that mode then has one (the first of :data:`MAX_SUPPORTS` such modes for which it
-    does). A configuration's test showing the same bounce as another's is explained by the same spring."""
-    found = []
-    for _ in range(MAX_SUPPORTS):
-        todo = [(k, i) for k, (ob, cs) in enumerate(zip(res.observations, state.configs))
-                for i in np.flatnonzero(support_modes(ob, cs))]
-        if not todo:
-            break
-        for k, i in todo[:MAX_SUPPORTS]:
-            trial = found + [locate(res.observations[k], state.configs[k], i, springs, layout)]
-            st = res.evaluate(p, [c for c, _ in trial], [v for _, v in trial])
-            if st.configs[k].matched[i] and _shapes_kept(state, st):
-                found, state = trial, st
-                break
-        else:
-            break
-    return found, state

@@ -1,0 +1,96 @@
+"""What a test mode without a model partner shows: a lumped effect the model lacks, placed and sized
+from that mode before the search (issue 37: the modes the pairing leaves out are the strongest
+evidence of what is missing, yet without a partner they give no residual rows).
+
+A spring to ground (:mod:`.support`: a bracket's bounce on a free board, an undeclared standoff on a
+held one) raises the modes near its point; a point mass (a relay on a housing's plate, a transducer)
+lowers them and makes new local shapes. Either changes the pencil of the model's modes by a low-rank
+term (thesis eq. 3.11: k w w^T in stiffness, m v v^T in mass per direction), so on the basis of the
+model's modes a Rayleigh-Ritz problem says, for every candidate point, how like the measured mode the
+nearest mode of the modified model is. Each kind is placed where that is greatest and sized so that
+this mode has the measured frequency; the kind whose Ritz mode is more like the measured one is tried
+first, and an effect is kept only if the mode then pairs and the other paired modes are no less like
+their partners (:func:`.support.shapes_kept`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.linalg import eigh
+
+from ..correlation.mac import mac
+from .catalogue import effect_forms
+from .support import MAX_SUPPORTS, locate, ritz_mac, shapes_kept, support_modes
+
+#: masses tried per candidate point in the placing scan, times 1 / (largest modal weight of the point)
+SCAN_MASSES = (0.1, 0.3, 1.0, 3.0)
+
+
+def _most_like(lam, dM, points, x) -> tuple:
+    """(eigenvalue, MAC) of the Rayleigh-Ritz mode most like measured shape ``x`` of the basis of
+    eigenvalues ``lam`` (unit modal masses, shapes ``points`` at the points) with mass ``dM`` added."""
+    val, vec = eigh(np.diag(lam), np.eye(lam.size) + dM)
+    m = mac(points @ vec, x)[:, 0]
+    j = int(np.argmax(m))
+    return val[j], float(m[j])
+
+
+def locate_mass(ob, cs, i: int, masses: list) -> tuple:
+    """(point-mass candidate, mass [kg], Ritz MAC): the point of ``masses`` (``point_mass`` candidates
+    on the state's mesh) where a mass makes a Rayleigh-Ritz mode of the state ``cs`` most like measured
+    mode ``i`` of ``ob``, and the mass that gives that mode the measured frequency."""
+    phi = np.column_stack([cs.modes.rigid_shapes, cs.modes.shapes])
+    lam = np.r_[np.zeros(cs.modes.n_rigid), cs.modes.omega2]
+    points, x = cs.at_points(ob.read), ob.shapes[:, i : i + 1]
+    _, BM = effect_forms(cs.model, phi, phi, masses)
+    unit = 1.0 / np.maximum(np.einsum("cii->ci", BM).max(axis=1), 1e-300)
+    scores = [max(_most_like(lam, s * u * B, points, x)[1] for s in SCAN_MASSES) for B, u in zip(BM, unit)]
+    c = int(np.argmax(scores))
+    target = (2.0 * np.pi * ob.f[i]) ** 2
+    lo, hi = 1e-3 * unit[c], 1e2 * unit[c]
+    for _ in range(50):  # the mode's eigenvalue falls as the mass grows
+        mid = np.sqrt(lo * hi)
+        lo, hi = (mid, hi) if _most_like(lam, mid * BM[c], points, x)[0] > target else (lo, mid)
+    m = float(np.sqrt(lo * hi))
+    return masses[c], m, _most_like(lam, m * BM[c], points, x)[1]
+
+
+def _spring_mac(ob, cs, i: int, spring, k: float) -> float:
+    """Ritz MAC of measured mode ``i`` with spring ``spring`` of stiffness ``k`` on the state ``cs``."""
+    phi = np.column_stack([cs.modes.rigid_shapes, cs.modes.shapes])
+    BK, _ = effect_forms(cs.model, phi, phi, [spring])
+    lam = np.r_[np.zeros(cs.modes.n_rigid), cs.modes.omega2]
+    return ritz_mac(lam, k * BK[0], cs.at_points(ob.read), ob.shapes[:, i : i + 1])
+
+
+def partners(res, p, state, springs: list, masses: list, layout) -> tuple:
+    """([(candidate, value)], the state of ``res`` at parameters ``p`` with them): effects located one
+    after another (module doc) while some configuration of ``state`` has a measured mode without a
+    partner: a spring (``springs``, where the mode may show a support: :func:`.support.support_modes`)
+    or a mass (``masses``); the first of :data:`.support.MAX_SUPPORTS` such modes for which one is kept.
+    A configuration's test showing the same mode as another's is explained by the same effect."""
+    found = []
+    for _ in range(MAX_SUPPORTS):
+        todo = [(k, i) for k, (ob, cs) in enumerate(zip(res.observations, state.configs))
+                if ob.shapes is not None for i in np.flatnonzero(~cs.matched)]
+        kept = False
+        for k, i in todo[:MAX_SUPPORTS]:
+            ob, cs = res.observations[k], state.configs[k]
+            options = []
+            if springs and support_modes(ob, cs)[i]:
+                c, v = locate(ob, cs, i, springs, layout)
+                options.append((_spring_mac(ob, cs, i, c, v), c, v))
+            if masses:
+                c, v, score = locate_mass(ob, cs, i, masses)
+                options.append((score, c, v))
+            for _, c, v in sorted(options, key=lambda o: -o[0]):
+                trial = found + [(c, v)]
+                st = res.evaluate(p, [t for t, _ in trial], [u for _, u in trial])
+                if st.configs[k].matched[i] and shapes_kept(state, st):
+                    found, state, kept = trial, st, True
+                    break
+            if kept:
+                break
+        if not kept:
+            break
+    return found, state
