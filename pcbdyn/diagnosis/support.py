@@ -26,6 +26,7 @@ kept only if the mode then pairs.
 from __future__ import annotations
 
 import numpy as np
+from scipy.linalg import eigh
 
 from ..correlation.mac import mac
 from ..fe.mesh import DOF_NAMES, NDOF
@@ -84,13 +85,12 @@ def locate(ob, cs, i: int, springs: list, layout) -> tuple:
         if layout.planar:
             best = _between_nodes(layout, cs.modes.rigid_shapes, points, nr, x) or best
     else:
-        best = springs[int(np.argmax([ritz_mac(lam, STIFF * target / max(w @ w, 1e-300) * np.outer(w, w), points, x)
+        best = springs[int(np.argmax([most_like(lam, points, x, STIFF * target / max(w @ w, 1e-300) * np.outer(w, w))[1]
                                       for w in W]))]
     w = _rows(cs.model, phi, [best])[0]
 
     def eigenvalue(k: float) -> float:  # of the Rayleigh-Ritz mode most like the measured one
-        val, vec = np.linalg.eigh(np.diag(lam) + k * np.outer(w, w))
-        return val[int(np.argmax(mac(points @ vec, x)[:, 0]))]
+        return most_like(lam, points, x, k * np.outer(w, w))[0]
 
     # the rigid modes alone: the elastic ones only lower it; on a held model, from a spring too soft
     # to move the mode to one that holds its point
@@ -104,11 +104,14 @@ def locate(ob, cs, i: int, springs: list, layout) -> tuple:
     return best, float(np.sqrt(lo * hi))
 
 
-def ritz_mac(lam, dK, points, x) -> float:
-    """The largest MAC with measured shape ``x`` among the Rayleigh-Ritz modes of the basis of
-    eigenvalues ``lam`` (its shapes at the points: ``points``) stiffened by ``dK``."""
-    _, vec = np.linalg.eigh(np.diag(lam) + dK)
-    return float(mac(points @ vec, x)[:, 0].max())
+def most_like(lam, points, x, dK=0.0, dM=0.0) -> tuple:
+    """(eigenvalue, MAC) of the Rayleigh-Ritz mode most like measured shape ``x`` on the basis of the
+    model's modes (eigenvalues ``lam``, unit modal masses, shapes ``points`` at the points) with
+    stiffness ``dK`` and mass ``dM`` added in that basis (thesis eq. 3.11's pencil)."""
+    val, vec = eigh(np.diag(lam) + dK, np.eye(lam.size) + dM)
+    m = mac(points @ vec, x)[:, 0]
+    j = int(np.argmax(m))
+    return float(val[j]), float(m[j])
 
 
 def _rows(model, phi, springs) -> np.ndarray:

@@ -16,43 +16,35 @@ their partners (:func:`.support.shapes_kept`).
 from __future__ import annotations
 
 import numpy as np
-from scipy.linalg import eigh
 
-from ..correlation.mac import mac
 from .catalogue import effect_forms
-from .support import MAX_SUPPORTS, locate, ritz_mac, shapes_kept, support_modes
+from .support import MAX_SUPPORTS, locate, most_like, shapes_kept, support_modes
 
 #: masses tried per candidate point in the placing scan, times 1 / (largest modal weight of the point)
 SCAN_MASSES = (0.1, 0.3, 1.0, 3.0)
 
 
-def _most_like(lam, dM, points, x) -> tuple:
-    """(eigenvalue, MAC) of the Rayleigh-Ritz mode most like measured shape ``x`` of the basis of
-    eigenvalues ``lam`` (unit modal masses, shapes ``points`` at the points) with mass ``dM`` added."""
-    val, vec = eigh(np.diag(lam), np.eye(lam.size) + dM)
-    m = mac(points @ vec, x)[:, 0]
-    j = int(np.argmax(m))
-    return val[j], float(m[j])
-
-
 def locate_mass(ob, cs, i: int, masses: list) -> tuple:
-    """(point-mass candidate, mass [kg], Ritz MAC): the point of ``masses`` (``point_mass`` candidates
-    on the state's mesh) where a mass makes a Rayleigh-Ritz mode of the state ``cs`` most like measured
-    mode ``i`` of ``ob``, and the mass that gives that mode the measured frequency."""
+    """(point-mass candidate, mass [kg], Ritz MAC): the point of ``masses`` (``point_mass`` candidates on
+    the state's mesh) where a mass makes a Rayleigh-Ritz mode of the state ``cs`` most like measured mode
+    ``i`` of ``ob``, and the mass that gives that mode the measured frequency; None where no mass can
+    (that mode already lies below the measured one)."""
     phi = np.column_stack([cs.modes.rigid_shapes, cs.modes.shapes])
     lam = np.r_[np.zeros(cs.modes.n_rigid), cs.modes.omega2]
     points, x = cs.at_points(ob.read), ob.shapes[:, i : i + 1]
     _, BM = effect_forms(cs.model, phi, phi, masses)
     unit = 1.0 / np.maximum(np.einsum("cii->ci", BM).max(axis=1), 1e-300)
-    scores = [max(_most_like(lam, s * u * B, points, x)[1] for s in SCAN_MASSES) for B, u in zip(BM, unit)]
+    scores = [max(most_like(lam, points, x, dM=s * u * B)[1] for s in SCAN_MASSES) for B, u in zip(BM, unit)]
     c = int(np.argmax(scores))
     target = (2.0 * np.pi * ob.f[i]) ** 2
     lo, hi = 1e-3 * unit[c], 1e2 * unit[c]
+    if most_like(lam, points, x, dM=lo * BM[c])[0] <= target:
+        return None  # the mode already lies below the measured one: a mass only lowers it
     for _ in range(50):  # the mode's eigenvalue falls as the mass grows
         mid = np.sqrt(lo * hi)
-        lo, hi = (mid, hi) if _most_like(lam, mid * BM[c], points, x)[0] > target else (lo, mid)
+        lo, hi = (mid, hi) if most_like(lam, points, x, dM=mid * BM[c])[0] > target else (lo, mid)
     m = float(np.sqrt(lo * hi))
-    return masses[c], m, _most_like(lam, m * BM[c], points, x)[1]
+    return masses[c], m, most_like(lam, points, x, dM=m * BM[c])[1]
 
 
 def _spring_mac(ob, cs, i: int, spring, k: float) -> float:
@@ -60,7 +52,7 @@ def _spring_mac(ob, cs, i: int, spring, k: float) -> float:
     phi = np.column_stack([cs.modes.rigid_shapes, cs.modes.shapes])
     BK, _ = effect_forms(cs.model, phi, phi, [spring])
     lam = np.r_[np.zeros(cs.modes.n_rigid), cs.modes.omega2]
-    return ritz_mac(lam, k * BK[0], cs.at_points(ob.read), ob.shapes[:, i : i + 1])
+    return most_like(lam, cs.at_points(ob.read), ob.shapes[:, i : i + 1], k * BK[0])[1]
 
 
 def partners(res, p, state, springs: list, masses: list, layout) -> tuple:
@@ -80,8 +72,9 @@ def partners(res, p, state, springs: list, masses: list, layout) -> tuple:
             if springs and support_modes(ob, cs)[i]:
                 c, v = locate(ob, cs, i, springs, layout)
                 options.append((_spring_mac(ob, cs, i, c, v), c, v))
-            if masses:
-                c, v, score = locate_mass(ob, cs, i, masses)
+            located = locate_mass(ob, cs, i, masses) if masses else None
+            if located is not None:
+                c, v, score = located
                 options.append((score, c, v))
             for _, c, v in sorted(options, key=lambda o: -o[0]):
                 trial = found + [(c, v)]
