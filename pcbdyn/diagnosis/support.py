@@ -68,11 +68,12 @@ def support_modes(ob, cs) -> np.ndarray:
 
 
 def locate(ob, cs, i: int, springs: list, layout) -> tuple:
-    """(spring candidate, stiffness [N/m]): the spring to ground that explains measured mode ``i``
+    """(spring candidate, stiffness [N/m], Ritz MAC): the spring to ground that explains measured mode ``i``
     of ``ob`` in the state ``cs`` (module doc): the node of ``springs`` (``ground_spring``
     candidates on the state's mesh, ``layout``) whose rigid-body part best matches the mode's; on a
     board, the point itself (:func:`_between_nodes`). On a held model (no rigid-body modes), the node
-    where a spring that holds it (:data:`STIFF`) makes a Rayleigh-Ritz mode most like the measured one."""
+    where a spring that holds it (:data:`STIFF`) makes a Rayleigh-Ritz mode most like the measured one.
+    The Ritz MAC: of that mode with the spring found."""
     nr = cs.modes.n_rigid
     phi = np.column_stack([cs.modes.rigid_shapes, cs.modes.shapes])
     points = cs.at_points(ob.read)
@@ -96,12 +97,12 @@ def locate(ob, cs, i: int, springs: list, layout) -> tuple:
     # to move the mode to one that holds its point
     lo = target / max(w[:nr] @ w[:nr], 1e-300) if nr else target / max(w @ w, 1e-300) / STIFF
     hi = (1e3 if nr else STIFF**2) * lo
-    if eigenvalue(hi) < target:
-        return best, hi
-    for _ in range(60):
-        mid = np.sqrt(lo * hi)
-        lo, hi = (mid, hi) if eigenvalue(mid) < target else (lo, mid)
-    return best, float(np.sqrt(lo * hi))
+    if eigenvalue(hi) >= target:
+        for _ in range(60):
+            mid = np.sqrt(lo * hi)
+            lo, hi = (mid, hi) if eigenvalue(mid) < target else (lo, mid)
+        hi = float(np.sqrt(lo * hi))
+    return best, hi, most_like(lam, points, x, hi * np.outer(w, w))[1]
 
 
 def most_like(lam, points, x, dK=0.0, dM=0.0) -> tuple:

@@ -47,14 +47,6 @@ def locate_mass(ob, cs, i: int, masses: list) -> tuple:
     return masses[c], m, most_like(lam, points, x, dM=m * BM[c])[1]
 
 
-def _spring_mac(ob, cs, i: int, spring, k: float) -> float:
-    """Ritz MAC of measured mode ``i`` with spring ``spring`` of stiffness ``k`` on the state ``cs``."""
-    phi = np.column_stack([cs.modes.rigid_shapes, cs.modes.shapes])
-    BK, _ = effect_forms(cs.model, phi, phi, [spring])
-    lam = np.r_[np.zeros(cs.modes.n_rigid), cs.modes.omega2]
-    return most_like(lam, cs.at_points(ob.read), ob.shapes[:, i : i + 1], k * BK[0])[1]
-
-
 def partners(res, p, state, springs: list, masses: list, layout) -> tuple:
     """([(candidate, value)], the state of ``res`` at parameters ``p`` with them): effects located one
     after another (module doc) while some configuration of ``state`` has a measured mode without a
@@ -68,15 +60,9 @@ def partners(res, p, state, springs: list, masses: list, layout) -> tuple:
         kept = False
         for k, i in todo[:MAX_SUPPORTS]:
             ob, cs = res.observations[k], state.configs[k]
-            options = []
-            if springs and support_modes(ob, cs)[i]:
-                c, v = locate(ob, cs, i, springs, layout)
-                options.append((_spring_mac(ob, cs, i, c, v), c, v))
-            located = locate_mass(ob, cs, i, masses) if masses else None
-            if located is not None:
-                c, v, score = located
-                options.append((score, c, v))
-            for _, c, v in sorted(options, key=lambda o: -o[0]):
+            options = [locate(ob, cs, i, springs, layout)] if springs and support_modes(ob, cs)[i] else []
+            options += [o for o in [locate_mass(ob, cs, i, masses) if masses else None] if o is not None]
+            for c, v, _ in sorted(options, key=lambda o: -o[2]):  # (candidate, value, Ritz MAC)
                 trial = found + [(c, v)]
                 st = res.evaluate(p, [t for t, _ in trial], [u for _, u in trial])
                 if st.configs[k].matched[i] and shapes_kept(state, st):
