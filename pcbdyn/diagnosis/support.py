@@ -97,12 +97,18 @@ def locate(ob, cs, i: int, springs: list, layout) -> tuple:
     # to move the mode to one that holds its point
     lo = target / max(w[:nr] @ w[:nr], 1e-300) if nr else target / max(w @ w, 1e-300) / STIFF
     hi = (1e3 if nr else STIFF**2) * lo
-    if eigenvalue(hi) >= target:
-        for _ in range(60):
-            mid = np.sqrt(lo * hi)
-            lo, hi = (mid, hi) if eigenvalue(mid) < target else (lo, mid)
-        hi = float(np.sqrt(lo * hi))
-    return best, hi, most_like(lam, points, x, hi * np.outer(w, w))[1]
+    k = hi if eigenvalue(hi) < target else sized(eigenvalue, target, lo, hi)
+    return best, k, most_like(lam, points, x, k * np.outer(w, w))[1]
+
+
+def sized(eigenvalue, target: float, lo: float, hi: float, steps: int = 60) -> float:
+    """The magnitude in [``lo``, ``hi``] at which ``eigenvalue(magnitude)`` (monotone: rising for a
+    stiffness, falling for a mass) equals ``target``, by bisection on a log scale."""
+    rising = eigenvalue(hi) > eigenvalue(lo)
+    for _ in range(steps):
+        mid = np.sqrt(lo * hi)
+        lo, hi = (mid, hi) if (eigenvalue(mid) < target) == rising else (lo, mid)
+    return float(np.sqrt(lo * hi))
 
 
 def most_like(lam, points, x, dK=0.0, dM=0.0) -> tuple:

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from .catalogue import effect_forms
-from .support import MAX_SUPPORTS, locate, most_like, shapes_kept, support_modes
+from .support import MAX_SUPPORTS, locate, most_like, shapes_kept, sized, support_modes
 
 #: masses tried per candidate point in the placing scan, times 1 / (largest modal weight of the point)
 SCAN_MASSES = (0.1, 0.3, 1.0, 3.0)
@@ -37,13 +37,13 @@ def locate_mass(ob, cs, i: int, masses: list) -> tuple:
     scores = [max(most_like(lam, points, x, dM=s * u * B)[1] for s in SCAN_MASSES) for B, u in zip(BM, unit)]
     c = int(np.argmax(scores))
     target = (2.0 * np.pi * ob.f[i]) ** 2
-    lo, hi = 1e-3 * unit[c], 1e2 * unit[c]
-    if most_like(lam, points, x, dM=lo * BM[c])[0] <= target:
+    def eigenvalue(m: float) -> float:  # of the Rayleigh-Ritz mode most like the measured one
+        return most_like(lam, points, x, dM=m * BM[c])[0]
+
+    lo = 1e-3 * unit[c]
+    if eigenvalue(lo) <= target:
         return None  # the mode already lies below the measured one: a mass only lowers it
-    for _ in range(50):  # the mode's eigenvalue falls as the mass grows
-        mid = np.sqrt(lo * hi)
-        lo, hi = (mid, hi) if most_like(lam, points, x, dM=mid * BM[c])[0] > target else (lo, mid)
-    m = float(np.sqrt(lo * hi))
+    m = sized(eigenvalue, target, lo, 1e2 * unit[c])
     return masses[c], m, most_like(lam, points, x, dM=m * BM[c])[1]
 
 
@@ -54,22 +54,26 @@ def partners(res, p, state, springs: list, masses: list, layout) -> tuple:
     or a mass (``masses``); the first of :data:`.support.MAX_SUPPORTS` such modes for which one is kept.
     A configuration's test showing the same mode as another's is explained by the same effect."""
     found = []
-    for _ in range(MAX_SUPPORTS):
-        todo = [(k, i) for k, (ob, cs) in enumerate(zip(res.observations, state.configs))
-                if ob.shapes is not None for i in np.flatnonzero(~cs.matched)]
-        kept = False
-        for k, i in todo[:MAX_SUPPORTS]:
-            ob, cs = res.observations[k], state.configs[k]
-            options = [locate(ob, cs, i, springs, layout)] if springs and support_modes(ob, cs)[i] else []
-            options += [o for o in [locate_mass(ob, cs, i, masses) if masses else None] if o is not None]
-            for c, v, _ in sorted(options, key=lambda o: -o[2]):  # (candidate, value, Ritz MAC)
-                trial = found + [(c, v)]
-                st = res.evaluate(p, [t for t, _ in trial], [u for _, u in trial])
-                if st.configs[k].matched[i] and shapes_kept(state, st):
-                    found, state, kept = trial, st, True
-                    break
-            if kept:
-                break
-        if not kept:
+    while len(found) < MAX_SUPPORTS:
+        more = _one_more(res, p, state, found, springs, masses, layout)
+        if more is None:
             break
+        found, state = more
     return found, state
+
+
+def _one_more(res, p, state, found, springs, masses, layout):
+    """(``found`` with one more effect, the state with them) for the first of :data:`.support.MAX_SUPPORTS`
+    modes without a partner in ``state`` that one gives a partner to (:func:`partners`), or None."""
+    todo = [(k, i) for k, (ob, cs) in enumerate(zip(res.observations, state.configs))
+            if ob.shapes is not None for i in np.flatnonzero(~cs.matched)]
+    for k, i in todo[:MAX_SUPPORTS]:
+        ob, cs = res.observations[k], state.configs[k]
+        options = [locate(ob, cs, i, springs, layout)] if springs and support_modes(ob, cs)[i] else []
+        options += [o for o in [locate_mass(ob, cs, i, masses) if masses else None] if o is not None]
+        for c, v, _ in sorted(options, key=lambda o: -o[2]):  # (candidate, value, Ritz MAC)
+            trial = found + [(c, v)]
+            st = res.evaluate(p, [t for t, _ in trial], [u for _, u in trial])
+            if st.configs[k].matched[i] and shapes_kept(state, st):
+                return trial, st
+    return None

@@ -53,8 +53,9 @@ def verdict(cfgs, p, problem) -> dict:
 
 
 def judge(out, cfgs) -> None:
-    """``status`` and ``details`` of a finished :class:`.fit.Fit` (:mod:`.fit`'s docstring, step 5); the directions the data leave open
-    from ``cfgs``, rows in noise units (None: from the rank of the last solve, for QMS and FBM)."""
+    """``status`` and ``details`` of a finished :class:`.fit.Fit` (:mod:`.fit`'s docstring, step 5); the
+    directions the data leave open from ``cfgs``, rows in noise units (None: from the rank of the last
+    solve, for QMS and FBM)."""
     prob, res = out.problem, out.result
     lo, hi = prob.bounds
     out.at_bounds = {n: "lower" if np.isclose(v, a, rtol=1e-6) else "upper" for n, v, a, b in
@@ -108,4 +109,5 @@ def judge(out, cfgs) -> None:
 
 
 def values_text(problem, p) -> str:
+    """The parameters ``p`` in the problem's units, for messages."""
     return ", ".join(f"{n} {from_si(v, u):.4g} {u}" for (n, v), u in zip(problem.values(p).items(), problem.units))
