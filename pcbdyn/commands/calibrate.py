@@ -24,7 +24,8 @@ from pathlib import Path
 
 import click
 
-from .common import checked_outputs, done, fail, input_errors, library_option, parse_extra, parse_noise, step, test_arguments, units_option
+from .common import (checked_outputs, done, echo_verdict, fail, input_errors, library_option, parse_extra, parse_noise,
+                     step, test_arguments, units_option)
 
 
 def names(text) -> list | None:
@@ -92,10 +93,7 @@ def command(board_toml, test_uff, configs, freq_csv, joint_toml, families, with_
         fams = write_library(cal, library)
         done(t0)
     click.echo(f"\n{rep.headline(cal, what['status'])}")
-    for line in what["details"]:
-        click.echo(f"  note: {line}")
-    for line in what["warnings"]:
-        click.echo(f"warning: {line}", err=True)
+    echo_verdict(what)
     click.echo(rep.format_families(fams))
     if cal.problem.names[len(cal.families):]:
         click.echo("\n" + rep.format_with(cal))

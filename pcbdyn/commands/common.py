@@ -26,6 +26,15 @@ def done(t0: float) -> None:
     click.echo(f"    done in {time.perf_counter() - t0:.1f} s", err=True)
 
 
+def echo_verdict(what: dict) -> None:
+    """A fit's notes (``details``) on stdout and its pairing warnings on stderr, as every fitting command
+    prints them."""
+    for line in what["details"]:
+        click.echo(f"  note: {line}")
+    for line in what["warnings"]:
+        click.echo(f"warning: {line}", err=True)
+
+
 def fail(message: str, code: int = 2):
     """Print ``error: message`` on stderr and leave with ``code`` (nothing else is written)."""
     click.echo(f"error: {message}", err=True)

@@ -33,8 +33,8 @@ from __future__ import annotations
 
 import click
 
-from .common import (done, fail, folder_outputs, input_errors, library_option, measured_configurations, parse_extra,
-                     parse_noise, result_path, step, test_arguments, units_option)
+from .common import (done, echo_verdict, fail, folder_outputs, input_errors, library_option, measured_configurations,
+                     parse_extra, parse_noise, result_path, step, test_arguments, units_option)
 
 def parse_frf_freqs(text) -> list:
     """'150,230 Hz' or '150,230' -> frequencies [Hz]."""
@@ -152,10 +152,7 @@ def command(board_toml, test_uff, configs, freq_csv, method, frf_freqs, damping,
                                                       (built, modes), staged.path / "iterations.png"))
                     click.echo(f"page written to {page}", err=True)
     click.echo(f"\n{board.name}: {what['status']} after {res.iterations} iteration(s) ({res.reason})")
-    for line in what["details"]:
-        click.echo(f"  note: {line}")
-    for line in what["warnings"]:
-        click.echo(f"warning: {line}", err=True)
+    echo_verdict(what)
     click.echo(rep.format_parameters(rows))
     click.echo("")
     click.echo(rep.format_correlation(before, after))
