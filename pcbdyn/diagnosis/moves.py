@@ -20,12 +20,21 @@ LINE_STEP = 0.5
 POINT_STEP = 0.25
 #: [element sizes] how far a side of a rectangular region moves in one step of the local search
 RECT_STEP = 1.0
+#: [element sizes] a point mass on a node moves to the nodes within this distance (the eight around it
+#: on a quadrilateral mesh)
+NODE_REACH = 1.5
 
 
 def movable(cand) -> bool:
     """A candidate :class:`LocalMoves` can move (a run of pieces of a side, a stiffener, a
-    rectangular region, a point between nodes)."""
-    return "run" in cand.data or cand.kind == "stiffener" or rectangle(cand) is not None or cand.between_nodes
+    rectangular region, a point between nodes, a point mass on a node)."""
+    return ("run" in cand.data or cand.kind == "stiffener" or rectangle(cand) is not None or cand.between_nodes
+            or on_node(cand))
+
+
+def on_node(cand) -> bool:
+    """A point mass on a node (not a body of :mod:`.bodies`, which keeps its centre)."""
+    return cand.kind == "point_mass" and cand.nodes.size == 1 and "radius" not in cand.data
 
 
 def rectangle(cand):
@@ -44,10 +53,14 @@ class LocalMoves:
     moved half an element (:data:`LINE_STEP`) across itself either way; for a rectangular region,
     the rectangles with one side moved by one element (:data:`RECT_STEP`) in or out; for a point
     between nodes (a support, :mod:`.support`), the points a quarter element (:data:`POINT_STEP`)
-    away along x and y. Lines, rectangles and points are made on demand and appended to ``cands``."""
+    away along x and y; for a point mass on a node, the nodes around it (:data:`NODE_REACH`: a mass
+    placed at the parameters' starting values, from a mode without a partner, sits where that model's
+    modes put it, and walks to where the fitted model's do). Lines, rectangles and points are made on
+    demand and appended to ``cands``."""
 
     def __init__(self, layout, cands: list, h: float):
         self.layout, self.cands, self.h = layout, cands, h
+        self.shell = set(layout.shell_nodes().tolist())
         plate = layout.xy[layout.shell_nodes()]
         self.lo, self.hi = plate.min(axis=0), plate.max(axis=0)
         self.index = {c.name: k for k, c in enumerate(cands)}
@@ -82,6 +95,16 @@ class LocalMoves:
                     made.append(c.spec.place(self.layout, replace(c, at=(c.at[0] + d[0], c.at[1] + d[1]))))
                 except ProbeError:  # off the board
                     continue
+            return self._add(made)
+        if on_node(c):
+            pts = self.layout.points
+            d = np.linalg.norm(pts - pts[int(c.nodes[0])], axis=1)
+            near = [int(n) for n in np.flatnonzero((d > 0) & (d <= NODE_REACH * self.h)) if n in self.shell]
+            made = []
+            for n in near:
+                data = {**c.data, "plate": self.layout.plate_of(n)} if "plate" in c.data else c.data
+                made.append(replace(c, name=f"{c.kind}@n{n}", at=tuple(pts[n]), nodes=np.array([n]), prime=False,
+                                    data=data))
             return self._add(made)
         if (box := rectangle(c)) is not None:
             lo, hi, step, made = self.lo, self.hi, RECT_STEP * self.h, []

@@ -18,8 +18,8 @@ whether what remains is noise, and otherwise find, place and size the effects th
    nothing is invented.
 4. Otherwise the catalogue's candidates are searched (:func:`.select.search`), the effects'
    magnitudes estimated together with the declared parameters, each effect kept only if it
-   also predicts data it was not fitted to; runs along the sides, stiffener lines and
-   rectangular regions are walked to where they fit best (:func:`.select.refine`,
+   also predicts data it was not fitted to; runs along the sides, stiffener lines,
+   rectangular regions and point masses are walked to where they fit best (:func:`.select.refine`,
    :class:`.moves.LocalMoves`) and a mass with an inertia beside it refitted as one body
    (:mod:`.bodies`). The masses (and supports) found are then put on the finer meshes and the mesh
    correction measured again (:func:`.budget.with_carried`: they change the shapes it depends on); where
@@ -312,7 +312,8 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
                            alpha=alpha, base=start, runner=runner, held=held))
     sel = min(sels, key=lambda s: s.criterion[-1])
     if any(movable(cands[i]) for i in sel.chosen):
-        say("refining where the effects along the sides begin and end, where stiffeners run and what regions cover")
+        say("refining where the effects along the sides begin and end, where stiffeners run, what regions cover "
+            "and where masses sit")
         sel = refine(res, cands, sel, LocalMoves(layout, cands, h), models.bounds, alpha=alpha, runner=runner)
     if {"point_mass", "point_inertia"} <= {cands[i].kind for i in sel.chosen}:
         say("fitting a part found as a mass with an inertia beside it as one body")
