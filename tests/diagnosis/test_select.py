@@ -109,6 +109,31 @@ def test_refine_moves_a_segment_found_too_short_to_the_true_run(card):
     assert sel.chi2[-1] < 1e-3
 
 
+def test_refine_walks_a_point_mass_placed_nodes_away_to_its_node(card):
+    """A 20 g mass first fitted two elements across and one along from where it sits (as a mass placed
+    from a mode without a partner at wrong starting parameters is): the local search moves it node by
+    node (:class:`LocalMoves`, the eight nodes around) to its node and recovers its mass."""
+    from pcbdyn.diagnosis.moves import LocalMoves, on_node
+    from pcbdyn.diagnosis.residual import ModalResidual, Observation
+    from pcbdyn.diagnosis.select import Selection, estimate, refine
+
+    m, cands = card
+    cands = list(cands)
+    dx, dy = 0.16 / NX, 0.18 / NY
+    truth = cands.index(nearest_candidate(cands, "point_mass", (0.11, 0.12)))
+    start = cands.index(nearest_candidate(cands, "point_mass", (0.11 - 2 * dx, 0.12 + dy)))
+    assert on_node(cands[start]) and np.hypot(*np.subtract(cands[start].at, cands[truth].at)[:2]) > 2 * dx
+    f_test = solve_modes(dg.add_effect(m, cands[truth], 0.02), n_modes=N_MODES).frequencies
+    res = ModalResidual([Observation(None, MeasuredModes.frequencies_only(f_test), np.full(N_MODES, SIGMA))], lambda p: [m])
+    fit = estimate(res, np.zeros(0), [cands[start]], [0.02], 8)
+    assert fit.chi2 > 10.0  # the wrong node cannot explain the data
+    sel = Selection(chosen=[start], values=fit.values, p=fit.p, chi2=[fit.chi2], state=fit.state)
+    sel = refine(res, cands, sel, LocalMoves(dg.from_model(m), cands, dx))
+    assert cands[sel.chosen[0]].nodes.tolist() == cands[truth].nodes.tolist()
+    assert sel.values[0] == pytest.approx(0.02, rel=1e-3)
+    assert sel.chi2[-1] < 1e-3
+
+
 def test_a_mass_with_an_inertia_beside_it_is_refitted_as_one_body(card):
     """A 40 g part of 10 mm radius of gyration centred between two nodes, first fitted as two mass
     shares on those nodes and an inertia on the cells around one of them: :func:`as_bodies` makes
