@@ -90,24 +90,40 @@ def locate(ob, cs, i: int, springs: list, layout) -> tuple:
                                       for w in W]))]
     w = _rows(cs.model, phi, [best])[0]
 
-    def eigenvalue(k: float) -> float:  # of the Rayleigh-Ritz mode most like the measured one
-        return most_like(lam, points, x, k * np.outer(w, w))[0]
+    def ritz(k: float) -> tuple:  # (eigenvalue, MAC) of the Rayleigh-Ritz mode most like the measured one
+        return most_like(lam, points, x, k * np.outer(w, w))
 
     # the rigid modes alone: the elastic ones only lower it; on a held model, from a spring too soft
     # to move the mode to one that holds its point
     lo = target / max(w[:nr] @ w[:nr], 1e-300) if nr else target / max(w @ w, 1e-300) / STIFF
     hi = (1e3 if nr else STIFF**2) * lo
-    k = hi if eigenvalue(hi) < target else sized(eigenvalue, target, lo, hi)
-    return best, k, most_like(lam, points, x, k * np.outer(w, w))[1]
+    k = hi if ritz(hi)[0] < target else sized(ritz, target, lo, hi) or lo
+    return best, k, ritz(k)[1]
 
 
-def sized(eigenvalue, target: float, lo: float, hi: float, steps: int = 60) -> float:
-    """The magnitude in [``lo``, ``hi``] at which ``eigenvalue(magnitude)`` (monotone: rising for a
-    stiffness, falling for a mass) equals ``target``, by bisection on a log scale."""
-    rising = eigenvalue(hi) > eigenvalue(lo)
+#: points of the log-spaced scan of :func:`sized` between its bounds
+SIZE_SCAN = 25
+
+
+def sized(ritz, target: float, lo: float, hi: float, steps: int = 60) -> float | None:
+    """The magnitude in [``lo``, ``hi``] at which the Rayleigh-Ritz mode most like the measured one,
+    ``ritz(magnitude)`` = (eigenvalue, MAC), has the eigenvalue ``target``; None where it has it at
+    none. The mode most like the measured one need not be one mode throughout: a mass that makes a
+    local mode brings it down through the model's lower modes, and at a small mass the mode most like
+    the measured one is a lower mode. So the range is scanned (:data:`SIZE_SCAN` points, log scale),
+    the crossing of ``target`` where that mode is most like the measured one on both sides taken, and
+    refined by bisection on a log scale."""
+    m = np.geomspace(lo, hi, SIZE_SCAN)
+    ev = np.array([ritz(v) for v in m])
+    d = ev[:, 0] - target
+    k = np.flatnonzero(d[:-1] * d[1:] <= 0.0)
+    if k.size == 0:
+        return None
+    k = int(k[np.argmax(np.minimum(ev[k, 1], ev[k + 1, 1]))])
+    lo, hi, rising = m[k], m[k + 1], d[k + 1] > d[k]
     for _ in range(steps):
         mid = np.sqrt(lo * hi)
-        lo, hi = (mid, hi) if (eigenvalue(mid) < target) == rising else (lo, mid)
+        lo, hi = (mid, hi) if (ritz(mid)[0] < target) == rising else (lo, mid)
     return float(np.sqrt(lo * hi))
 
 

@@ -22,29 +22,31 @@ from .support import MAX_SUPPORTS, locate, most_like, shapes_kept, sized, suppor
 
 #: masses tried per candidate point in the placing scan, times 1 / (largest modal weight of the point)
 SCAN_MASSES = (0.1, 0.3, 1.0, 3.0)
+#: the points best in that scan that are sized, the one whose sized mass makes the mode most like the
+#: measured one kept (the scan's masses are a coarse guess of the mass)
+SIZED = 8
 
 
 def locate_mass(ob, cs, i: int, masses: list) -> tuple:
-    """(point-mass candidate, mass [kg], Ritz MAC): the point of ``masses`` (``point_mass`` candidates on
-    the state's mesh) where a mass makes a Rayleigh-Ritz mode of the state ``cs`` most like measured mode
-    ``i`` of ``ob``, and the mass that gives that mode the measured frequency; None where no mass can
-    (that mode already lies below the measured one)."""
+    """(point-mass candidate, mass [kg], Ritz MAC): of the points of ``masses`` (``point_mass``
+    candidates on the state's mesh), the one where a mass sized to give the Rayleigh-Ritz mode of the
+    state ``cs`` most like measured mode ``i`` of ``ob`` the measured frequency (:func:`.support.sized`)
+    makes that mode most like it; None where no mass can."""
     phi = np.column_stack([cs.modes.rigid_shapes, cs.modes.shapes])
     lam = np.r_[np.zeros(cs.modes.n_rigid), cs.modes.omega2]
     points, x = cs.at_points(ob.read), ob.shapes[:, i : i + 1]
     _, BM = effect_forms(cs.model, phi, phi, masses)
     unit = 1.0 / np.maximum(np.einsum("cii->ci", BM).max(axis=1), 1e-300)
     scores = [max(most_like(lam, points, x, dM=s * u * B)[1] for s in SCAN_MASSES) for B, u in zip(BM, unit)]
-    c = int(np.argmax(scores))
-    target = (2.0 * np.pi * ob.f[i]) ** 2
-    def eigenvalue(m: float) -> float:  # of the Rayleigh-Ritz mode most like the measured one
-        return most_like(lam, points, x, dM=m * BM[c])[0]
+    best = None
+    for c in np.argsort(scores)[::-1][:SIZED]:
+        def ritz(m: float, B=BM[c]) -> tuple:  # (eigenvalue, MAC) of the Ritz mode most like the measured one
+            return most_like(lam, points, x, dM=m * B)
 
-    lo = 1e-3 * unit[c]
-    if eigenvalue(lo) <= target:
-        return None  # the mode already lies below the measured one: a mass only lowers it
-    m = sized(eigenvalue, target, lo, 1e2 * unit[c])
-    return masses[c], m, most_like(lam, points, x, dM=m * BM[c])[1]
+        m = sized(ritz, (2.0 * np.pi * ob.f[i]) ** 2, 1e-3 * unit[c], 1e2 * unit[c])
+        if m is not None and (best is None or ritz(m)[1] > best[2]):
+            best = (masses[c], m, ritz(m)[1])
+    return best
 
 
 def partners(res, p, state, springs: list, masses: list, layout) -> tuple:
