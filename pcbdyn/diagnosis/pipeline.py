@@ -52,7 +52,7 @@ from .model_form import MESH_LEVELS, fit_plate_share
 from .residual import ModalResidual
 from .fitting import estimate
 from .scan import Runner
-from .select import ALPHA, adopt, noticed, penalty, refine, search, without_vanished
+from .select import ALPHA, Selection, adopt, noticed, penalty, refine, search, without_vanished
 from .unpaired import partners
 from .uncertainty import jackknife_cov
 
@@ -202,6 +202,22 @@ def _supports(res, p0, before, models, kinds, say) -> tuple:
     return found, state
 
 
+def _walked(res, cands, held, fit, moves, bounds, alpha, runner, say) -> tuple:
+    """(fit, candidate indices) of the effects ``held`` (placed from the modes without a partner, fitted
+    with the declared parameters in ``fit``) after they walk to where they fit best
+    (:func:`.select.refine`) before the search: placed with the model's modes at the parameters'
+    starting values, they sit where that model puts them, and the search is to find what else is
+    missing, not to make up for a misplaced one."""
+    if not any(movable(cands[i]) for i in held):
+        return fit, held
+    say("walking them to where the fitted parameters put them")
+    sel = refine(res, cands, adopt(Selection(), held, fit, penalty(res.n_rows, len(cands), alpha)), moves, bounds,
+                 alpha=alpha, runner=runner)
+    if sel.chosen == list(held):
+        return fit, held
+    return estimate(res, sel.p, [cands[i] for i in sel.chosen], sel.values, 10, bounds), list(sel.chosen)
+
+
 def _range_test(res, base, n_params, alpha) -> dict:
     """Chi-square test of the parameters-only residual and the ranks of A and [A b] at the noise
     level (thesis section 5.2.3: b outside the range of A is what the parameters cannot explain)."""
@@ -302,19 +318,21 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
     say(f"searching {len(cands)} candidate effects")
     cands += [c for c, _ in support]
     held = list(range(len(cands) - len(support), len(cands)))
+    moves = LocalMoves(layout, cands, h)
     sels = []
     for origin in origins:
-        start = origin
+        start, placed = origin, held
         if held:
             say("fitting the support with the declared parameters")
             start = estimate(res, origin.p, [cands[i] for i in held], [v for _, v in support], 10, models.bounds)
+            start, placed = _walked(res, cands, held, start, moves, models.bounds, alpha, runner, say)
         sels.append(search(res, cands, p0, models.bounds, max_effects=max_effects, shortlist=1 if quick else 2,
-                           alpha=alpha, base=start, runner=runner, held=held))
+                           alpha=alpha, base=start, runner=runner, held=placed))
     sel = min(sels, key=lambda s: s.criterion[-1])
     if any(movable(cands[i]) for i in sel.chosen):
         say("refining where the effects along the sides begin and end, where stiffeners run, what regions cover "
             "and where masses sit")
-        sel = refine(res, cands, sel, LocalMoves(layout, cands, h), models.bounds, alpha=alpha, runner=runner)
+        sel = refine(res, cands, sel, moves, models.bounds, alpha=alpha, runner=runner)
     if {"point_mass", "point_inertia"} <= {cands[i].kind for i in sel.chosen}:
         say("fitting a part found as a mass with an inertia beside it as one body")
         sel = as_bodies(res, cands, sel, groups([cands[i] for i in sel.chosen], MERGE_REACH * h),
