@@ -45,7 +45,7 @@ from .catalogue import KINDS, generate, kind
 from .evidence import evidence
 from .layout import from_structure
 from .merge import MERGE_REACH, groups, mean_path, merged
-from .moves import LocalMoves, movable
+from .moves import LocalMoves, movable, on_node
 from . import conforming, geometry_fit
 from .budget import MASS_KINDS, observations, set_noise, with_carried
 from .model_form import MESH_LEVELS, fit_plate_share
@@ -204,15 +204,16 @@ def _supports(res, p0, before, models, kinds, say) -> tuple:
 
 def _walked(res, cands, held, fit, moves, bounds, alpha, runner, say) -> tuple:
     """(fit, candidate indices) of the effects ``held`` (placed from the modes without a partner, fitted
-    with the declared parameters in ``fit``) after they walk to where they fit best
-    (:func:`.select.refine`) before the search: placed with the model's modes at the parameters'
-    starting values, they sit where that model puts them, and the search is to find what else is
-    missing, not to make up for a misplaced one."""
-    if not any(movable(cands[i]) for i in held):
+    with the declared parameters in ``fit``) after their masses walk to where they fit best
+    (:func:`.select.refine`) before the search: placed with the model's elastic modes at the
+    parameters' starting values, a mass sits where that model puts it, and the search is to find what
+    else is missing, not to make up for a misplaced one. (A spring on a free board is placed between
+    nodes from its mode's rigid-body part, which the parameters do not change; it stays.)"""
+    if not any(on_node(cands[i]) for i in held):
         return fit, held
-    say("walking them to where the fitted parameters put them")
-    sel = refine(res, cands, adopt(Selection(), held, fit, penalty(res.n_rows, len(cands), alpha)), moves, bounds,
-                 alpha=alpha, runner=runner)
+    say("walking the masses to where the fitted parameters put them")
+    sel = refine(res, cands, adopt(Selection(), held, fit, penalty(res.n_rows, len(cands), alpha)),
+                 lambda i: moves(i) if on_node(cands[i]) else [], bounds, alpha=alpha, runner=runner)
     if sel.chosen == list(held):
         return fit, held
     return estimate(res, sel.p, [cands[i] for i in sel.chosen], sel.values, 10, bounds), list(sel.chosen)
