@@ -59,3 +59,22 @@ def test_bounce_places_and_sizes_the_spring(at, k, mass):
         assert 0.6 * k < value < k
     else:
         assert 0.95 * k < value <= k
+
+
+def test_a_mass_is_sized_on_the_branch_of_the_mode_it_makes():
+    """Three modes (eigenvalues 1, 4, 25, unit modal masses), a 1 kg mass at a point that moves most
+    in the third: the mode it makes lies at 5.4, between the second and third. At a small mass the
+    Rayleigh-Ritz mode most like that mode is the second, below the measured eigenvalue (the sizing
+    before refused such a mass: "a mass only lowers it"); sized over the range the crossing where the
+    mode is most like the measured one gives the mass exactly."""
+    from scipy.linalg import eigh
+
+    from pcbdyn.diagnosis.support import most_like, sized
+
+    lam, points, v, truth = np.array([1.0, 4.0, 25.0]), np.eye(3), np.array([0.3, 0.6, 3.0]), 1.0
+    val, vec = eigh(np.diag(lam), np.eye(3) + truth * np.outer(v, v))
+    x, target = vec[:, 2:3], val[2]
+    assert lam[1] < target < lam[2]
+    assert most_like(lam, points, x, dM=1e-3 * np.outer(v, v))[0] < target
+    mass = sized(lambda m: most_like(lam, points, x, dM=m * np.outer(v, v)), target, 1e-3, 1e2)
+    assert mass == pytest.approx(truth, rel=1e-9)
