@@ -15,6 +15,8 @@ their partners (:func:`.support.shapes_kept`).
 
 from __future__ import annotations
 
+from functools import partial
+
 import numpy as np
 
 from .catalogue import effect_forms
@@ -40,13 +42,18 @@ def locate_mass(ob, cs, i: int, masses: list) -> tuple:
     scores = [max(most_like(lam, points, x, dM=s * u * B)[1] for s in SCAN_MASSES) for B, u in zip(BM, unit)]
     best = None
     for c in np.argsort(scores)[::-1][:SIZED]:
-        def ritz(m: float, B=BM[c]) -> tuple:  # (eigenvalue, MAC) of the Ritz mode most like the measured one
-            return most_like(lam, points, x, dM=m * B)
-
+        ritz = partial(_ritz_mass, lam, points, x, BM[c])
         m = sized(ritz, (2.0 * np.pi * ob.f[i]) ** 2, 1e-3 * unit[c], 1e2 * unit[c])
-        if m is not None and (best is None or ritz(m)[1] > best[2]):
-            best = (masses[c], m, ritz(m)[1])
+        like = None if m is None else ritz(m)[1]
+        if like is not None and (best is None or like > best[2]):
+            best = (masses[c], m, like)
     return best
+
+
+def _ritz_mass(lam, points, x, B, m: float) -> tuple:
+    """(eigenvalue, MAC) of the Rayleigh-Ritz mode most like measured shape ``x`` with mass ``m`` of
+    modal form ``B`` added."""
+    return most_like(lam, points, x, dM=m * B)
 
 
 def partners(res, p, state, springs: list, masses: list, layout) -> tuple:
