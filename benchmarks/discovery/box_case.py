@@ -118,7 +118,10 @@ def diagnose_and_update(folder: Path) -> None:
     t_d = _cli(folder, "diagnose", folder / "diagnose.json")
     t_u = _cli(folder, "update", folder / "update.json")
     d, u = (json.loads((folder / f"{k}.json").read_text()) for k in ("diagnose", "update"))
-    relay = np.r_[truth["relay_mm"][0], 160.0, truth["relay_mm"][1]]  # the back plate: y = 160 mm, (x, z)
+    from pcbdyn.box import load_box
+
+    plate = load_box(folder / "truth.toml").plate(truth["plate"])
+    relay = 1e3 * np.asarray(plate.point(*(1e-3 * np.asarray(truth["relay_mm"]))), float)  # [mm] in the box's frame
     masses = [e for e in d["effects"] if e["type"] == "point_mass"]
     print(f"load average at the start {load:.1f} (2 cores)")
     for e in masses:
