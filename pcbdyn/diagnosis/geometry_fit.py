@@ -30,7 +30,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..domain import StructureError
-from ..updating.gauss_newton import gauss_newton
+from ..updating.gauss_newton import gauss_newton, taken
 from . import conforming
 from .catalogue import kind
 from .fitting import UPPER, Fit, estimate
@@ -169,12 +169,13 @@ def _gauss_newton(base, observations, chosen, ribs, h, fit, bounds, runner, step
         upper = np.r_[np.log(hi_p), v_hi, np.tile(np.r_[hi_xy, hi_xy, np.log(HEIGHT[1])], len(ribs))]
     scale = np.r_[np.ones(npar), [c.spec.scale for c in chosen], np.tile([h, h, h, h, 1.0], len(ribs))]
     step = np.tile(np.r_[np.full(4, STEP * h), STEP], len(ribs))
-    kept: dict = {}
+    kept: dict = {}  # the state the fit stands on, by id: a trial it does not take is let go (each holds a mesh)
 
     def evaluate(y):
         effects = _with_geometry(chosen, ribs, y[npar + ne:], h)
         out = None if effects is None else _solve(base, observations, effects, np.exp(y[:npar]), y[npar:npar + ne])
-        if out is not None:
+        if out is not None and (not kept or taken(out[3].chi2, next(iter(kept.values()))[2][3].chi2)):
+            kept.clear()
             kept[id(out[3])] = (y.copy(), effects, out)
         return None if out is None else out[3]
 

@@ -16,6 +16,7 @@ inertias) have no candidates there.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 from matplotlib.path import Path as PolyPath
@@ -193,20 +194,28 @@ class Layout:
         e = _edges([c for _, c in self.cells()])
         return float(np.median(np.linalg.norm(self.points[e[:, 0]] - self.points[e[:, 1]], axis=1)))
 
+    @cached_property
+    def _mesh_lines(self) -> _MeshLines:
+        from ..fe.probe import Locator
+
+        xy = self.xy
+        e = _edges([c for _, c in self.cells()])
+        nodes = self.shell_nodes()
+        return _MeshLines(xy[e[:, 0]], xy[e[:, 1]] - xy[e[:, 0]], xy[nodes], 1e-6 * self.element_size,
+                          float(np.mean(self.model.nodes[nodes, 2])),
+                          Locator(self.model.nodes, [(self.model.sets[nm].etype, c) for nm, c in self.cells()]))
+
     def line_cells(self, p0, p1):
         """The straight line from ``p0`` to ``p1`` cut where it crosses the shell cells' edges or
         passes a node (each piece within one cell), the pieces' ends located in the cells: (host
         nodes (n, 8), the ends' shape-function weights (n, 2, 8), end points (n, 2, 2) [m]), as
         :mod:`..fe.elements.embedded_beam` takes them. Along a row of nodes the pieces end on the
         nodes (a beam on that row). Pieces off the plate are left out."""
-        from ..fe.probe import locate
-
+        m = self._mesh_lines
         p0, p1 = np.asarray(p0, float), np.asarray(p1, float)
         d = p1 - p0
         L2 = float(d @ d)
-        xy = self.xy
-        e = _edges([c for _, c in self.cells()])
-        a, u = xy[e[:, 0]], xy[e[:, 1]] - xy[e[:, 0]]
+        a, u = m.start, m.step
         den = d[0] * u[:, 1] - d[1] * u[:, 0]
         w = a - p0
         ok = np.abs(den) > 1e-12 * np.sqrt(L2) * np.linalg.norm(u, axis=1)
@@ -214,23 +223,34 @@ class Layout:
         t = (w[:, 0] * u[:, 1] - w[:, 1] * u[:, 0]) / den
         sgm = (w[:, 0] * d[1] - w[:, 1] * d[0]) / den
         crossing = t[ok & (sgm >= 0) & (sgm <= 1)]
-        nodes = self.shell_nodes()
-        r = xy[nodes] - p0
-        on_line = np.abs(r[:, 0] * d[1] - r[:, 1] * d[0]) / np.sqrt(L2) < 1e-6 * self.element_size
+        r = m.nodes - p0
+        on_line = np.abs(r[:, 0] * d[1] - r[:, 1] * d[0]) / np.sqrt(L2) < m.on_line
         ts = np.sort(np.r_[0.0, 1.0, crossing, (r[on_line] @ d) / L2])
         ts = ts[(ts >= 0) & (ts <= 1)]
         ts = ts[np.r_[True, np.diff(ts) > 1e-9]]
         pts = p0 + ts[:, None] * d
-        z = float(np.mean(self.model.nodes[nodes, 2]))
         mids = 0.5 * (pts[:-1] + pts[1:])
-        cells = [(self.model.sets[nm].etype, c) for nm, c in self.cells()]
-        loc = locate(self.model.nodes, cells, np.column_stack([pts, np.full(len(pts), z)]))
-        inside = locate(self.model.nodes, cells, np.column_stack([mids, np.full(len(mids), z)])).found
-        keep = loc.found[:-1] & loc.found[1:] & inside
-        conn = np.hstack([loc.nodes[:-1], loc.nodes[1:]])[keep]
+        both = m.locate(np.column_stack([np.vstack([pts, mids]), np.full(len(pts) + len(mids), m.z)]))
+        n = len(pts)
+        keep = both.found[:n - 1] & both.found[1:n] & both.found[n:]
+        conn = np.hstack([both.nodes[:n - 1], both.nodes[1:n]])[keep]
         W = np.zeros((len(mids), 2, 8))
-        W[:, 0, :4], W[:, 1, 4:] = loc.weights[:-1], loc.weights[1:]
+        W[:, 0, :4], W[:, 1, 4:] = both.weights[:n - 1], both.weights[1:n]
         return conn, W[keep], np.stack([pts[:-1], pts[1:]], axis=1)[keep]
+
+
+@dataclass(frozen=True)
+class _MeshLines:
+    """What :meth:`Layout.line_cells` asks of the mesh for every line: the cells' edges (start, step
+    (n, 2) [m]), the shell nodes' x, y, the distance [m] within which a node lies on a line, the
+    plane's z and the cells' :class:`..fe.probe.Locator`."""
+
+    start: np.ndarray
+    step: np.ndarray
+    nodes: np.ndarray
+    on_line: float
+    z: float
+    locate: object
 
 
 def _edges(conns) -> np.ndarray:

@@ -146,39 +146,51 @@ def _project(nodes, conn, is_tri, cand, p):
     return w, dist
 
 
-def locate(nodes, cells, points, tol: float | None = None, k: int = 8) -> Location:
-    """Locate ``points`` (n, 3) on the shell cells ``cells`` (iterable of (etype, conn)).
+class Locator:
+    """Points located on the shell cells ``cells`` (iterable of (etype, conn)) of ``nodes``: the cells'
+    search tree built once for the many point sets a candidate generator locates on one mesh.
 
     ``tol`` [m]: the largest distance from the surface accepted (default: a tenth of the median
-    cell edge). ``k`` nearest cells (by centroid) are tried first; points not within ``tol`` of any
-    of them are tried against every cell whose centroid is close enough to possibly contain them.
-    """
-    nodes = np.asarray(nodes, dtype=float)
-    p = np.asarray(points, dtype=float).reshape(-1, 3)
-    conn, is_tri = _gather_cells(cells)
-    X = nodes[conn]
-    cent = np.where(is_tri[:, None], X[:, :3].mean(1), X.mean(1))
-    edges = np.linalg.norm(X - np.roll(X, 1, axis=1), axis=2)
-    if tol is None:
-        tol = 0.1 * float(np.median(edges.max(1)))
-    radius = np.linalg.norm(X - cent[:, None], axis=2).max(1)
-    tree = cKDTree(cent)
-    kk = min(k, len(conn))
-    _, cand = tree.query(p, k=kk)
-    cand = cand.reshape(len(p), kk)
-    w, d = _project(nodes, conn, is_tri, cand.ravel(), np.repeat(p, kk, axis=0))
-    w, d = w.reshape(len(p), kk, 4), d.reshape(len(p), kk)
-    best = np.argmin(d, axis=1)
-    rows = np.arange(len(p))
-    cell, weight, dist = cand[rows, best], w[rows, best], d[rows, best]
-    for i in np.flatnonzero(dist > tol):  # rare: big cells next to small ones, or points off the mesh
-        more = np.array(tree.query_ball_point(p[i], radius.max() + tol), dtype=np.int64)
-        if more.size:
-            wi, di = _project(nodes, conn, is_tri, more, np.repeat(p[i : i + 1], more.size, axis=0))
-            j = np.argmin(di)
-            if di[j] < dist[i]:
-                cell[i], weight[i], dist[i] = more[j], wi[j], di[j]
-    return Location(cell, conn[cell], weight, dist, dist <= tol)
+    cell edge)."""
+
+    def __init__(self, nodes, cells, tol: float | None = None):
+        self.nodes = np.asarray(nodes, dtype=float)
+        self.conn, self.is_tri = _gather_cells(cells)
+        X = self.nodes[self.conn]
+        cent = np.where(self.is_tri[:, None], X[:, :3].mean(1), X.mean(1))
+        edges = np.linalg.norm(X - np.roll(X, 1, axis=1), axis=2)
+        self.tol = 0.1 * float(np.median(edges.max(1))) if tol is None else tol
+        self.reach = float(np.linalg.norm(X - cent[:, None], axis=2).max(1).max())
+        self.tree = cKDTree(cent)
+
+    def __call__(self, points, k: int = 8) -> Location:
+        """Where ``points`` (n, 3) lie: the ``k`` nearest cells (by centroid) are tried first; points
+        not within the tolerance of any of them are tried against every cell whose centroid is close
+        enough to possibly contain them."""
+        p = np.asarray(points, dtype=float).reshape(-1, 3)
+        nodes, conn, is_tri, tol = self.nodes, self.conn, self.is_tri, self.tol
+        kk = min(k, len(conn))
+        _, cand = self.tree.query(p, k=kk)
+        cand = cand.reshape(len(p), kk)
+        w, d = _project(nodes, conn, is_tri, cand.ravel(), np.repeat(p, kk, axis=0))
+        w, d = w.reshape(len(p), kk, 4), d.reshape(len(p), kk)
+        best = np.argmin(d, axis=1)
+        rows = np.arange(len(p))
+        cell, weight, dist = cand[rows, best], w[rows, best], d[rows, best]
+        for i in np.flatnonzero(dist > tol):  # rare: big cells next to small ones, or points off the mesh
+            more = np.array(self.tree.query_ball_point(p[i], self.reach + tol), dtype=np.int64)
+            if more.size:
+                wi, di = _project(nodes, conn, is_tri, more, np.repeat(p[i : i + 1], more.size, axis=0))
+                j = np.argmin(di)
+                if di[j] < dist[i]:
+                    cell[i], weight[i], dist[i] = more[j], wi[j], di[j]
+        return Location(cell, conn[cell], weight, dist, dist <= tol)
+
+
+def locate(nodes, cells, points, tol: float | None = None, k: int = 8) -> Location:
+    """Locate ``points`` (n, 3) on the shell cells ``cells`` (iterable of (etype, conn)) once
+    (:class:`Locator`)."""
+    return Locator(nodes, cells, tol)(points, k)
 
 
 def _directions(directions, n):

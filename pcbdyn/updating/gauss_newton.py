@@ -14,6 +14,13 @@ from .solvers import bounded_lsq, covariance
 
 #: how many times a step that raises chi^2 is halved before the fit stops
 HALVINGS = 4
+#: relative rise of chi^2 a step may make and still be taken (round-off)
+RISE_TOL = 1e-9
+
+
+def taken(chi2_new: float, chi2_now: float) -> bool:
+    """Whether a trial of ``chi2_new`` replaces the state of ``chi2_now`` (:func:`gauss_newton`'s rule)."""
+    return chi2_new <= chi2_now * (1 + RISE_TOL)
 
 
 @dataclass
@@ -53,7 +60,7 @@ def gauss_newton(evaluate, jacobian, y0, lower, upper, scale, steps: int, step_t
         for _half in range(HALVINGS):
             y_new = np.clip(y + dy, lower, upper)
             trial = evaluate(y_new)
-            if trial is not None and float(trial.r @ trial.r) <= chi2 * (1 + 1e-9):
+            if trial is not None and taken(float(trial.r @ trial.r), chi2):
                 break
             dy = 0.5 * dy
         else:
