@@ -26,6 +26,11 @@ from ..fe.model import SHELL_TYPES
 
 #: direction change [deg] above which a boundary node is a corner that ends a straight side
 CORNER_DEG = 15.0
+#: [element sizes] how far from the cells a line's point may lie and count as on the plate: the points
+#: are in the plate's plane, so any distance means beyond the outline (the locator's default, a tenth
+#: of a cell, took a rib end 0.02 mm past an edge as on it and made a piece of no length there: a beam
+#: of unbounded stiffness that left the finer meshes indefinite)
+ON_PLATE = 1e-6
 
 
 @dataclass
@@ -201,16 +206,18 @@ class Layout:
         xy = self.xy
         e = _edges([c for _, c in self.cells()])
         nodes = self.shell_nodes()
-        return _MeshLines(xy[e[:, 0]], xy[e[:, 1]] - xy[e[:, 0]], xy[nodes], 1e-6 * self.element_size,
+        size = self.element_size
+        return _MeshLines(xy[e[:, 0]], xy[e[:, 1]] - xy[e[:, 0]], xy[nodes], 1e-6 * size,
                           float(np.mean(self.model.nodes[nodes, 2])),
-                          Locator(self.model.nodes, [(self.model.sets[nm].etype, c) for nm, c in self.cells()]))
+                          Locator(self.model.nodes, [(self.model.sets[nm].etype, c) for nm, c in self.cells()],
+                                  tol=ON_PLATE * size))
 
     def line_cells(self, p0, p1):
         """The straight line from ``p0`` to ``p1`` cut where it crosses the shell cells' edges or
         passes a node (each piece within one cell), the pieces' ends located in the cells: (host
         nodes (n, 8), the ends' shape-function weights (n, 2, 8), end points (n, 2, 2) [m]), as
         :mod:`..fe.elements.embedded_beam` takes them. Along a row of nodes the pieces end on the
-        nodes (a beam on that row). Pieces off the plate are left out."""
+        nodes (a beam on that row). Pieces off the plate (beyond :data:`ON_PLATE`) are left out."""
         m = self._mesh_lines
         p0, p1 = np.asarray(p0, float), np.asarray(p1, float)
         d = p1 - p0

@@ -171,6 +171,31 @@ def test_unknown_generation_option_is_named(plate):
         dg.generate(layout, kinds=["point_mass"], spacng=0.01)
 
 
+@pytest.mark.parametrize("past", [2e-5, 3e-4, 3e-3])
+def test_a_rib_reaching_past_the_edge_stops_at_it(plate, past):
+    """A rib whose fitted end lies ``past`` [m] beyond the plate's edge x = A is the rib up to the edge:
+    every piece as long where the cells hold it as drawn, none of no length (a piece of no length is a
+    beam of unbounded stiffness: report case s1009 went indefinite that way), the rib's length the
+    part on the plate, and the plate with it positive definite."""
+    from pcbdyn.fe.assembly import assemble
+    from pcbdyn.fe.modal import reduced_system
+    from pcbdyn.fe.linsolve import lower_csc, cholmod_factor
+
+    m, layout, *_ = plate
+    rib = dg.kind("stiffener")
+    c = rib.candidate(layout, "past", np.array([0.03, 0.031]), np.array([A + past, 0.037]))
+    W, conn = c.data["weights"], c.data["conn"]
+    located = np.einsum("nab,nbk->nak", W, m.nodes[conn][:, :, :2])
+    lengths = np.linalg.norm(located[:, 1] - located[:, 0], axis=1)
+    assert lengths.min() > 1e-3 * lengths.max()
+    on_plate = (A - 0.03) * np.hypot(1.0, 0.006 / (A + past - 0.03))
+    assert c.data["length"] == pytest.approx(on_plate, rel=1e-9)
+    assert lengths.sum() == pytest.approx(on_plate, rel=1e-9)
+    K, M = assemble(dg.add_effect(m, c, 50.0))
+    _, Kr, _ = reduced_system(m, K, M)
+    cholmod_factor(lower_csc(Kr))  # raises if not positive definite
+
+
 def test_stiffener_across_an_unstructured_mesh_converges():
     """A rib across the six-part card's unstructured mesh at y = 112 mm (no node row there): what it
     does to the first six frequencies at the card's 6.75 mm mesh is within 0.5 % of what it does
