@@ -174,7 +174,7 @@ def _gauss_newton(base, observations, chosen, ribs, h, fit, bounds, runner, step
     def evaluate(y):
         effects = _with_geometry(chosen, ribs, y[npar + ne:], h)
         out = None if effects is None else _solve(base, observations, effects, np.exp(y[:npar]), y[npar:npar + ne])
-        if out is not None and (not kept or taken(out[3].chi2, next(iter(kept.values()))[2][3].chi2)):
+        if out is not None and all(taken(out[3].chi2, now[2][3].chi2) for now in kept.values()):
             kept.clear()
             kept[id(out[3])] = (y.copy(), effects, out)
         return None if out is None else out[3]
