@@ -169,18 +169,17 @@ def _gauss_newton(base, observations, chosen, ribs, h, fit, bounds, runner, step
         upper = np.r_[np.log(hi_p), v_hi, np.tile(np.r_[hi_xy, hi_xy, np.log(HEIGHT[1])], len(ribs))]
     scale = np.r_[np.ones(npar), [c.spec.scale for c in chosen], np.tile([h, h, h, h, 1.0], len(ribs))]
     step = np.tile(np.r_[np.full(4, STEP * h), STEP], len(ribs))
-    kept: dict = {}  # the state the fit stands on, by id: a trial it does not take is let go (each holds a mesh)
+    standing: list = []  # [(y, effects, solved)] of the state the fit stands on: trials it does not take are let go
 
     def evaluate(y):
         effects = _with_geometry(chosen, ribs, y[npar + ne:], h)
         out = None if effects is None else _solve(base, observations, effects, np.exp(y[:npar]), y[npar:npar + ne])
-        if out is not None and all(taken(out[3].chi2, now[2][3].chi2) for now in kept.values()):
-            kept.clear()
-            kept[id(out[3])] = (y.copy(), effects, out)
+        if out is not None and all(taken(out[3].chi2, now[2][3].chi2) for now in standing):
+            standing[:] = [(y.copy(), effects, out)]  # each re-meshed model holds its mesh, residual and caches
         return None if out is None else out[3]
 
     def jacobian(st):
-        y, _, (_, res, placed, _) = kept[id(st)]
+        y, _, (_, res, placed, _) = standing[0]
         jobs = [(y[npar + ne:] + step[j] * np.eye(step.size)[j],) for j in range(step.size)]
         rows = runner.map(_difference, jobs, (base, observations, chosen, ribs, h, np.exp(y[:npar]), y[npar:npar + ne]),
                           "re-meshed trials of the ribs' ends")
@@ -193,7 +192,7 @@ def _gauss_newton(base, observations, chosen, ribs, h, fit, bounds, runner, step
                       lambda y: np.r_[1e-4 * np.ones(npar), 1e-4 * scale[npar:npar + ne], 0.05 * step])
     if gn.state is None:
         return None
-    y, effects, (models, res, placed, st) = kept[id(gn.state)]
+    y, effects, (models, res, placed, st) = standing[0]
     n = npar + ne
     return effects, (models, res, placed, Fit(np.exp(y[:npar]), y[npar:n], st, gn.cov[:n, :n]))
 

@@ -23,6 +23,7 @@ from matplotlib.path import Path as PolyPath
 from scipy.spatial import cKDTree
 
 from ..fe.model import SHELL_TYPES
+from ..fe.probe import Locator
 
 #: direction change [deg] above which a boundary node is a corner that ends a straight side
 CORNER_DEG = 15.0
@@ -201,8 +202,6 @@ class Layout:
 
     @cached_property
     def _mesh_lines(self) -> _MeshLines:
-        from ..fe.probe import Locator
-
         xy = self.xy
         e = _edges([c for _, c in self.cells()])
         nodes = self.shell_nodes()
