@@ -62,6 +62,13 @@ def read_fixture(r, f, where, board, i) -> Fixture:
         fx.diameter = r.q(f.get("diameter", "6 mm"), "mm", f"{where}.diameter", positive=True)
         if not board.outline.contains(circle(fx.at, fx.diameter)).all():
             r.fail(f"{where}.diameter", "the standoff's pad reaches off the board; move it or make it smaller")
+        for other in board.fixtures:
+            gap = float(np.linalg.norm(np.subtract(fx.at, other.at))) if other.type == "standoff" else np.inf
+            if gap < 0.5 * (fx.diameter + other.diameter):
+                r.fail(f"{where}.at", f"the standoff's pad overlaps that of standoff '{other.name}' (centres "
+                                      f"{gap * 1e3:.3g} mm apart, pads {fx.diameter * 1e3:.3g} and "
+                                      f"{other.diameter * 1e3:.3g} mm): move them apart, make the pads smaller "
+                                      "or declare one standoff")
     elif typ == "point_spring":
         fx.at = _point_on_board(r, board, f, where, "point spring")
         if "k" not in f:

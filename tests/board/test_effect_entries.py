@@ -298,6 +298,10 @@ BAD = {
                              '["110 mm", "30 mm"]]\nstiffness_factor = 1.2\n', r"regions\[0\]: the region reaches off"),
     "region without unit": ('[[regions]]\nname = "r"\nrect = [10, 10, 30, 30]\nstiffness_factor = 1.2\n',
                             r"regions\[0\]\.rect\[0\]: 10 has no unit"),
+    "standoff pads overlapping": ('[[fixtures]]\nname = "a"\ntype = "standoff"\nat = ["50 mm", "40 mm"]\n'
+                                  '[[fixtures]]\nname = "b"\ntype = "standoff"\nat = ["54.3 mm", "40 mm"]\n',
+                                  r"fixtures\[2\]\.at: the standoff's pad overlaps that of standoff 'a' \(centres "
+                                  r"4\.3 mm apart, pads 6 and 6 mm\)"),
     "mass and inertia zero": ('[[masses]]\nname = "m"\nat = ["50 mm", "40 mm"]\nmass = "0 g"\n',
                               r"masses\[0\]\.mass: must be positive"),
 }
