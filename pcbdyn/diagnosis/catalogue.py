@@ -18,6 +18,9 @@ plugin module of this package that registers an object (:func:`register`, into :
   mesh's layout (a finer mesh, as a test bench's truth model is);
 - ``whole(candidates, i) -> int`` (optional): the candidate of which candidate ``i`` is a piece (a
   stiffener's whole line), tried beside it by the search (:mod:`.select`).
+- ``saturates`` (optional, False by default): True when the effect stiffens the modes near it up to a
+  pin or a clamp (a support), so that the search screens more of its candidates at large magnitudes
+  (:func:`.scan.saturated`).
 
 Every effect enters K and M linearly in its parameter, so dK/dp and dM/dp are exact and the
 same at every value, and the first-order eigenvalue sensitivity (thesis eq. 3.11 with k = i)

@@ -22,6 +22,7 @@ class _EdgeStiffness(AlongSides):
     unit = "N*m/rad/m"
     scale = 1e3
     lower = 0.0
+    saturates = True  # stiffens the modes near it up to a pin (a clamp): :func:`.scan.saturated`
 
     def blocks(self, model, candidates) -> list:
         edges = [c.data["edges"] for c in candidates]

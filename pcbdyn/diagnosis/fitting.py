@@ -58,9 +58,11 @@ def estimate(res, p0, cands, v0, steps: int, bounds=None, tol: float = 1e-5, par
 
     def evaluate(y):
         try:
-            return run.evaluate(np.exp(y[:npar]), cands, y[npar:])
+            st = run.evaluate(np.exp(y[:npar]), cands, y[npar:])
         except (ValueError, ArithmeticError, np.linalg.LinAlgError):  # e.g. overlapping regions softened below zero
             return None
+        # a paired model mode that does not move at the points has no shape to compare
+        return st if np.isfinite(st.r).all() else None
 
     def step_tol(y):
         return tol * np.r_[np.ones(npar), np.maximum(np.abs(y[npar:]), scale[npar:])]

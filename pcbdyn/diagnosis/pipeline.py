@@ -16,11 +16,13 @@ whether what remains is noise, and otherwise find, place and size the effects th
 3. The declared parameters alone are fitted; if chi^2 is within what noise gives (chi-square
    test, probability ``alpha``) the data lie in the range of the model (thesis section 5.2.3) and
    nothing is invented.
-4. Otherwise the catalogue's candidates are searched (:func:`.select.search`), the effects'
-   magnitudes estimated together with the declared parameters, each effect kept only if it
-   also predicts data it was not fitted to; runs along the sides, stiffener lines,
-   rectangular regions and point masses are walked to where they fit best (:func:`.select.refine`,
-   :class:`.moves.LocalMoves`) and a mass with an inertia beside it refitted as one body
+4. Otherwise the catalogue's candidates are searched (:func:`.select.search`) from the fitted
+   parameters (and from the declared values where that fit pairs the frequencies worse than they do:
+   :func:`.parameter_stage.declared_origin`), the effects' magnitudes estimated together with the
+   declared parameters, each effect kept only if it also predicts data it was not fitted to; runs
+   along the sides, stiffener lines, rectangular regions and point masses are walked to where they fit
+   best (:func:`.select.refine`, :class:`.moves.LocalMoves`) and a mass with an inertia beside it
+   refitted as one body
    (:mod:`.bodies`). The masses (and supports) found are then put on the finer meshes and the mesh
    correction measured again (:func:`.budget.with_carried`: they change the shapes it depends on); where
    stiffeners were found, the structure is meshed along their lines first, every effect carried,
@@ -35,7 +37,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.stats import chi2 as chi2_dist
 
 from ..domain import StructureError
 from ..parallel import spare_cores
@@ -49,6 +50,7 @@ from .moves import LocalMoves, movable, on_node
 from . import conforming, geometry_fit
 from .budget import MASS_KINDS, observations, set_noise, with_carried
 from .model_form import MESH_LEVELS, fit_plate_share
+from .parameter_stage import declared_origin, paired_start, parameter_stage, range_test, update_start
 from .residual import ModalResidual
 from .fitting import estimate
 from .scan import Runner
@@ -131,60 +133,6 @@ def _on_lines(models, res, cands, sel, forms, h, levels: int, runner, alpha, say
     return models, res, out, adopt(sel, idx, fit, penalty(res.n_rows, len(cands), alpha))
 
 
-def _paired_start(models, obs, p0, before, say, rounds: int = 2) -> tuple:
-    """(declared parameter values, the state of all test modes there) from which the diagnosis pairs
-    its modes: ``p0`` where the model pairs every test mode; else the declared parameters fitted to the
-    modes they pair, and again to those paired then, while that pairs more (a housing declared 30 %
-    off has its modes out of order: the first test mode found no partner until E and rho moved)."""
-    p, at = p0, before
-    for _ in range(rounds if models.names else 0):
-        matched = [cs.matched for cs in at.configs]
-        if all(m.all() for m in matched):
-            break
-        part = ModalResidual.of_models(models, [ob.subset(m) for ob, m in zip(obs, matched)])
-        fit = estimate(part, p, [], [], 6, models.bounds)
-        now = ModalResidual.of_models(models, obs).evaluate(fit.p)
-        if sum(cs.matched.sum() for cs in now.configs) <= sum(m.sum() for m in matched):
-            break
-        say(f"  the declared parameters fitted to the modes they pair pair {sum(cs.matched.sum() for cs in now.configs)} "
-            f"test modes instead of {sum(m.sum() for m in matched)}: the diagnosis starts there")
-        p, at = fit.p, now
-    return p, at
-
-
-def _update_start(structure, res, noise, h, say):
-    """``pcbdyn update``'s fit of the declared parameters to ``res``'s observations
-    (:func:`pcbdyn.problems.fit.fit`: the one fitting engine of update, calibrate and wedgelock, with its
-    scanned starts and trust region), the mesh correction the diagnosis measured taken as the model's
-    error; None where it cannot run. The parameter stage keeps whichever of it and its own fit leaves
-    the lower chi^2 (issue 37: never worse than update)."""
-    from ..problems import UpdateProblem
-    from ..problems.fit import fit
-
-    say("fitting the declared parameters as pcbdyn update does")
-    try:
-        return fit(UpdateProblem(structure, mesh_size=h), [(ob.name, ob.modes) for ob in res.observations],
-                   noise=noise, model_pct=[100.0 * (1.0 / ob.f_scale - 1.0) for ob in res.observations])
-    except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
-        say(f"  update's fit did not run ({exc}); the diagnosis goes on from its own")
-        return None
-
-
-def _parameter_stage(plain, own, update, models, say) -> tuple:
-    """(the parameters-only fit reported, [the fits the effect search starts from]). Reported: the lower
-    chi^2 of the diagnosis's own fit ``own`` and update's (never worse than ``pcbdyn update``). Where
-    update's is lower, the search runs from both: a lower chi^2 of the declared parameters alone can be
-    another compromise with the missing effect, one that hides it from the linearised search (a 15 g
-    line mass on the six-part card: chi^2 2.6 % lower from update's fit, nothing found from there)."""
-    if update is None:
-        return own, [own]
-    alt = estimate(plain, np.array([update.values[n] for n in models.names]), [], [], 4, models.bounds)
-    if not alt.chi2 < own.chi2:
-        return own, [own]
-    say(f"  update's fit leaves the lower chi^2 ({alt.chi2:.5g} against {own.chi2:.5g}): the search starts from both")
-    return alt, [alt, own]
-
-
 def _supports(res, p0, before, models, kinds, say) -> tuple:
     """(effects [(candidate, value)], the state of ``res`` with them): the springs to ground and point
     masses that the measured modes without a partner show (:func:`.unpaired.partners`; only the kinds
@@ -217,18 +165,6 @@ def _walked(res, cands, held, fit, moves, bounds, alpha, runner, say) -> tuple:
     if sel.chosen == list(held):
         return fit, held
     return estimate(res, sel.p, [cands[i] for i in sel.chosen], sel.values, 10, bounds), list(sel.chosen)
-
-
-def _range_test(res, base, n_params, alpha) -> dict:
-    """Chi-square test of the parameters-only residual and the ranks of A and [A b] at the noise
-    level (thesis section 5.2.3: b outside the range of A is what the parameters cannot explain)."""
-    dof = max(res.n_rows - n_params, 1)
-    A = res.param_columns(base.state)
-    level = np.sqrt(chi2_dist.isf(alpha, dof))
-    return {"rows": res.n_rows, "dof": dof, "chi2_parameters_only": base.chi2,
-            "p_value_noise": float(chi2_dist.sf(base.chi2, dof)), "alpha": alpha,
-            "rank_A": int(np.sum(np.linalg.svd(A, compute_uv=False) > level)) if A.size else 0,
-            "rank_Ab": int(np.sum(np.linalg.svd(np.column_stack([A, base.state.r]), compute_uv=False) > level))}
 
 
 def diagnose(structure, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_size=None, kinds=None,
@@ -265,7 +201,7 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
     say("solving the model as given")
     before = res.evaluate(p0)
     record["before"] = before.summary(obs)
-    start, at = _paired_start(models, obs, p0, before, say)
+    start, at = paired_start(models, obs, p0, before, say)
     unmatched = {ob.name or "base": (np.flatnonzero(~cs.matched) + 1).tolist() for ob, cs in zip(obs, at.configs)}
     support, shown, left, bounce = [], {}, unmatched, [np.zeros(ob.f.size, bool) for ob in obs]
     if any(unmatched.values()):  # modes the model has no partner for (MAC < 0.3): local modes of what it lacks
@@ -289,12 +225,12 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
     # the declared parameters alone, on the modes they can pair (a support's bounce has no partner without it)
     plain = ModalResidual.of_models(models, [ob.subset(~b) for ob, b in zip(obs, bounce)]) if support else res
     own = estimate(plain, start, [], [], 10, models.bounds)
-    update = _update_start(structure, plain, (freq_noise_pct, shape_noise_pct), h, say) if names else None
-    base, origins = _parameter_stage(plain, own, update, models, say)
+    update = update_start(structure, plain, (freq_noise_pct, shape_noise_pct), h, say) if names else None
+    base, origins = parameter_stage(plain, own, update, models, say)
     stats = {"quick": quick, "unpaired_test_modes": unmatched, "support_test_modes": shown, "chi2_before": before.chi2,
              "update": None if update is None else {"status": update.status, "parameters": update.values,
                                                     "parameters_only_from_update": base is not own},
-             **_range_test(plain, base, len(names), alpha),
+             **range_test(plain, base, len(names), alpha),
              "mesh_correction_pct": [np.round(100 * (o.f_scale - 1.0), 4).tolist() for o in obs],
              "mesh_resolved": [f.resolved for f in forms],
              "plate_theory_pct": [np.round(100 * f.shift, 4).tolist() for f in forms],
@@ -322,13 +258,18 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
     moves = LocalMoves(layout, cands, h)
     sels = []
     for origin in origins:
-        start, placed = origin, held
+        begin, placed = origin, held
         if held:
             say("fitting the support with the declared parameters")
-            start = estimate(res, origin.p, [cands[i] for i in held], [v for _, v in support], 10, models.bounds)
-            start, placed = _walked(res, cands, held, start, moves, models.bounds, alpha, runner, say)
+            begin = estimate(res, origin.p, [cands[i] for i in held], [v for _, v in support], 10, models.bounds)
+            begin, placed = _walked(res, cands, held, begin, moves, models.bounds, alpha, runner, say)
         sels.append(search(res, cands, p0, models.bounds, max_effects=max_effects, shortlist=1 if quick else 2,
-                           alpha=alpha, base=start, runner=runner, held=placed))
+                           alpha=alpha, base=begin, runner=runner, held=placed))
+    declared = None if held else declared_origin(res, base, start, models, say)
+    stats["searched_from_declared"] = declared is not None
+    if declared is not None:
+        sels.append(search(res, cands, p0, models.bounds, max_effects=max_effects, shortlist=1 if quick else 2,
+                           alpha=alpha, base=declared, runner=runner, without=base.chi2))
     sel = min(sels, key=lambda s: s.criterion[-1])
     if any(movable(cands[i]) for i in sel.chosen):
         say("refining where the effects along the sides begin and end, where stiffeners run, what regions cover "

@@ -196,7 +196,8 @@ def paired_state(ob: Observation, model, K, M, modes, U, points=None) -> ConfigS
             pairs[i] = k
             free.remove(k)
         u = U[:, pairs]
-        s = np.sum(u * ob.shapes, axis=0) / np.sum(u * u, axis=0)
+        with np.errstate(divide="ignore", invalid="ignore"):  # a paired mode the points miss: rows not finite,
+            s = np.sum(u * ob.shapes, axis=0) / np.sum(u * u, axis=0)  # a state the fits refuse (.fitting)
         macs = paired_mac(u, ob.shapes)
     f_a = f_all[pairs] * ob.f_scale
     rows = [(ob.f - f_a) / (ob.sigma_f * ob.f)]

@@ -28,6 +28,11 @@ from .reanalysis import Reanalysis
 PROGRESS_EVERY = 0.5
 #: the quick fits' best this many are fitted again with full re-solves
 FULL_RANK = 3
+#: of a kind whose effect saturates (``saturates = True``), this many candidates best by their linear
+#: score are evaluated at :data:`SATURATED_VALUES` on the reanalysis (:func:`saturated`)
+SATURATED_SCREEN = 40
+#: the magnitudes of that screen, in multiples of the kind's ``scale``
+SATURATED_VALUES = (10.0, 100.0)
 #: a quick fit's chi^2 is trusted to this share of the solved state's (a reanalysis is first order
 #: in the parameters; measured within 0.1 % on the bench's kinds but ribs)
 SCREEN_MARGIN = 0.05
@@ -109,6 +114,39 @@ def _quick_fit(k, cands, v0, shared):
     """One trial fit on the reanalysis (a job): its chi^2."""
     res, rx, p, bounds, P, steps = shared
     return estimate(res, p, cands, v0, steps, bounds, param_columns=P, reduced=rx).chi2
+
+
+def saturated(res, state, effects, values, candidates, gain, per_kind: int) -> dict:
+    """{candidate index: magnitude} of the ``per_kind`` candidates of each kind whose effect saturates
+    (a support stiffens the modes near it up to a pin) that leave the least chi^2 on the reanalysis of
+    ``state`` (its parameters, ``effects`` at ``values``), each at the best of
+    :data:`SATURATED_VALUES`, among the :data:`SATURATED_SCREEN` best by their linear score ``gain``.
+    Near its saturation every place of such an effect has about the same linear score (a stiff
+    spring at the edge of a large thin card: the true place's was 106th of 1730), while its
+    saturated effect differs from place to place."""
+    kinds = np.array([c.kind for c in candidates])
+    todo = [k for k in np.unique(kinds) if getattr(kind(k), "saturates", False) and getattr(kind(k), "reanalysed", True)]
+    if not todo:
+        return {}
+    rx = Reanalysis(res, state)
+    out = {}
+    for k in todo:
+        idx = np.flatnonzero((kinds == k) & np.isfinite(gain))
+        idx = idx[np.argsort(-gain[idx], kind="stable")[:SATURATED_SCREEN]]
+        best = []
+        for j in idx:
+            tried = [(_reduced_chi2(rx, state.p, list(effects) + [candidates[j]], np.r_[values, v]), v)
+                     for v in kind(k).scale * np.asarray(SATURATED_VALUES)]
+            best.append((*min(tried), int(j)))
+        out.update({j: v for _, v, j in sorted(best)[:per_kind]})
+    return out
+
+
+def _reduced_chi2(rx, p, cands, values) -> float:
+    try:
+        return rx.evaluate(p, cands, values).chi2
+    except (ValueError, ArithmeticError, np.linalg.LinAlgError):
+        return np.inf
 
 
 def rank(res, state, trials: list, p, bounds, P, runner: Runner | None = None) -> list:

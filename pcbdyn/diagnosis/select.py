@@ -9,7 +9,9 @@ every candidate by the chi^2 its column removes (the cos^2 criterion of thesis e
 applied to the residual), among those whose estimated value is physical (``lower`` of its kind).
 The best ``shortlist`` of every kind are re-estimated nonlinearly (a spring's effect on the
 frequencies saturates, so the linear score alone under-rates large ones; :func:`.scan.rank`: quick
-fits on a reanalysis of the state, the best of them with full re-solves) and the least chi^2 wins.
+fits on a reanalysis of the state, the best of them with full re-solves) and the least chi^2 wins;
+of the kinds that saturate, so do the ``shortlist`` best at large magnitudes among more of their
+candidates (:func:`.scan.saturated`).
 Magnitudes stay within [lower, UPPER * scale], declared parameters within their bounds.
 
 A new effect is kept only if its chi^2 drop exceeds the penalty
@@ -19,8 +21,10 @@ A new effect is kept only if its chi^2 drop exceeds the penalty
 variance left after the fit, chi^2 / (n - k): noise or model error larger than stated must not
 turn into effects; and it must predict data it was not fitted to (:func:`held_out_share`: left-out
 configurations, or modes), so that a model error confined to one configuration or mode is not
-taken for an effect. After each addition an earlier effect that the others make redundant is
-dropped (backward check).
+taken for an effect. Where the trial that fits best is one that only the screen of saturating kinds
+brought in and it is refused, the next best is weighed: that screen must not hide what the linear
+shortlist found (a bar on a card in guides, behind a guide's stiffness refused). After each
+addition an earlier effect that the others make redundant is dropped (backward check).
 """
 
 from __future__ import annotations
@@ -31,7 +35,7 @@ import numpy as np
 from scipy.stats import chi2 as chi2_dist
 
 from .fitting import RANK_STEPS, UPPER, Fit, estimate  # noqa: F401  (re-exported)
-from .scan import Runner, rank, worth_full
+from .scan import Runner, rank, saturated, worth_full
 
 #: probability that noise alone makes one of the candidates look like an effect (family-wise)
 ALPHA = 0.01
@@ -65,18 +69,23 @@ def penalty(n_obs: int, n_candidates: int, alpha: float = ALPHA) -> float:
 
 
 def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_steps: int = 8, shortlist: int = 3,
-           alpha: float = ALPHA, base: Fit | None = None, runner: Runner | None = None, held=()) -> Selection:
+           alpha: float = ALPHA, base: Fit | None = None, runner: Runner | None = None, held=(),
+           without: float | None = None) -> Selection:
     """Effects among ``candidates`` that explain the residual ``res`` (:class:`.residual.ModalResidual`)
     beyond the declared parameters (initial values ``p0``, ``bounds``) and the effects ``held``
     (candidate indices the data demand before any search: a support, :mod:`.support`); ``base``:
-    the fit of the declared parameters and the held effects when already made; ``runner``: where
-    the shortlist's trial fits run (:mod:`.scan`). ``max_effects`` counts the held effects."""
+    the fit of the declared parameters and the held effects when already made, or the state the search
+    starts from; ``without``: the least chi^2 without a new effect where ``base`` is not that fit (a
+    search from the declared values), which every addition must then beat; ``runner``: where the
+    shortlist's trial fits run (:mod:`.scan`). ``max_effects`` counts the held effects."""
     p0 = np.asarray(p0, float)
     n = res.n_rows
     pen = penalty(n, len(candidates), alpha)
     held = list(held)
     fit = base or estimate(res, p0, [candidates[i] for i in held], np.zeros(len(held)), newton_steps, bounds)
     sel = adopt(Selection(), held, fit, pen)
+    if without is not None and without < sel.chi2[0]:
+        sel.chi2[0], sel.criterion[0] = without, without + len(held) * pen
     kinds = np.array([c.kind for c in candidates])
     scale = np.array([c.spec.scale for c in candidates])
     lower = np.array([c.spec.lower for c in candidates])
@@ -96,18 +105,26 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
         gain[value < lower] = -np.inf  # an effect of unphysical sign cannot be the answer
         gain[sel.chosen] = -np.inf
         short = _shortlist(gain, kinds, shortlist)
-        order = np.setdiff1d(np.union1d(np.union1d(short, _companions(candidates, sel.chosen)),
+        stiff = saturated(res, st, [candidates[i] for i in sel.chosen], sel.values, candidates, gain, shortlist)
+        order = np.union1d(short, np.array(list(stiff), dtype=np.int64))
+        order = np.setdiff1d(np.union1d(np.union1d(order, _companions(candidates, sel.chosen)),
                                         _whole(candidates, short)), sel.chosen)
         if not order.size:
             break
-        trials = [([candidates[i] for i in sel.chosen + [j]], np.r_[sel.values, max(value[j], 0.0)]) for j in order]
+        start = {j: v for j, v in stiff.items() if j not in short}
+        trials = [([candidates[i] for i in sel.chosen + [j]], np.r_[sel.values, start.get(j, max(value[j], 0.0))])
+                  for j in order]
         fits = rank(res, st, trials, fit.p, bounds, P, runner)
-        best = int(np.argmin([np.inf if f is None else f.chi2 for f in fits]))
-        if not np.isfinite(fits[best].chi2):
-            break
-        idx = sel.chosen + [int(order[best])]
-        new = _kept(res, candidates, sel, fit, idx, fits[best], held, A[:, idx[-1]], scale[idx], newton_steps,
-                    bounds, pen, p0.size)
+        chi2 = np.array([np.inf if f is None else f.chi2 for f in fits])
+        new = None
+        for best in np.argsort(chi2, kind="stable"):
+            if not np.isfinite(chi2[best]):
+                break
+            idx = sel.chosen + [int(order[best])]
+            new = _kept(res, candidates, sel, fit, idx, fits[best], held, A[:, idx[-1]], scale[idx], newton_steps,
+                        bounds, pen, p0.size)
+            if new is not None or idx[-1] not in start:  # a screened support refused does not end the step
+                break
         if new is None:
             break
         idx, fit = _prune(res, candidates, idx, new, newton_steps, bounds, pen, p0.size, runner)

@@ -79,6 +79,21 @@ def test_hidden_effect_is_found_with_its_kind_place_and_magnitude(card, kind, xy
     assert sel.chi2[-1] < 3 * N_MODES  # what remains is noise
 
 
+@pytest.mark.parametrize("xy, k", [((0.05, 0.17), 3e6), ((0.13, 0.12), 1e6), ((0.03, 0.02), 1e6)])
+def test_a_near_rigid_spring_is_found_at_its_node(card, xy, k):
+    """A spring of 1-3e6 N/m (a screw the model lacks; the card's first mode needs ~1e4 N/m to move)
+    pins its node: found at that node, its stiffness within 30 %, what remains noise. Near saturation
+    the linear scores of many places are alike, so the search also screens the supports at large
+    stiffness (:func:`pcbdyn.diagnosis.scan.saturated`); without that screen these three come out
+    as a region 20 mm away, a spring on the next node at its bound of 1e7 N/m, two springs beside it."""
+    m, cands = card
+    hidden = nearest_candidate(cands, "ground_spring", xy)
+    sel = forward_select(m, cands, measured(m, hidden, k, seed=3), SIGMA)
+    assert [cands[i].name for i in sel.chosen] == [hidden.name]
+    assert sel.values[0] == pytest.approx(k, rel=0.3)
+    assert sel.chi2[-1] < 3 * N_MODES
+
+
 @pytest.mark.parametrize("seed", [4, 5, 6])
 def test_noise_alone_gives_no_effect(card, seed):
     m, cands = card
