@@ -98,15 +98,15 @@ def worth_full(res, state, trials: list, p, bounds, limit: float, steps: int = R
     return out
 
 
-def _screen(res, state, trials: list, p, bounds, P, steps: int, runner: Runner | None = None) -> list:
-    """chi^2 of each of ``trials`` fitted on the reanalysis of ``state`` (``P``: the declared
-    parameters' columns, held: a reanalysed state has no full modes). The quick fits are
+def _screen(res, state, trials: list, p, bounds, P, steps: int, runner: Runner | None = None, reduced=None) -> list:
+    """chi^2 of each of ``trials`` fitted on the reanalysis of ``state`` (``reduced``, made here where not
+    given; ``P``: the declared parameters' columns, held: a reanalysed state has no full modes). The quick fits are
     independent jobs too, run in ``runner``'s local processes even where it names a cluster: each
     takes ~40 ms, and what they share is the whole solved state."""
     if not trials:
         return []
     local = Runner() if runner is None else Runner(runner.workers, None, runner.progress)
-    shared = (res, Reanalysis(res, state), p, bounds, P, steps)
+    shared = (res, reduced or Reanalysis(res, state), p, bounds, P, steps)
     return local.map(_quick_fit, trials, shared, "trials screened on the reanalysis")
 
 
@@ -116,26 +116,23 @@ def _quick_fit(k, cands, v0, shared):
     return estimate(res, p, cands, v0, steps, bounds, param_columns=P, reduced=rx).chi2
 
 
-def saturated(res, state, effects, values, candidates, gain, per_kind: int) -> dict:
+def saturated(rx, effects, values, candidates, gain, per_kind: int) -> dict:
     """{candidate index: magnitude} of the ``per_kind`` candidates of each kind whose effect saturates
-    (a support stiffens the modes near it up to a pin) that leave the least chi^2 on the reanalysis of
-    ``state`` (its parameters, ``effects`` at ``values``), each at the best of
+    (a support stiffens the modes near it up to a pin) that leave the least chi^2 on the reanalysis
+    ``rx`` of a state (its parameters, ``effects`` at ``values``), each at the best of
     :data:`SATURATED_VALUES`, among the :data:`SATURATED_SCREEN` best by their linear score ``gain``.
     Near its saturation every place of such an effect has about the same linear score (a stiff
     spring at the edge of a large thin card: the true place's was 106th of 1730), while its
     saturated effect differs from place to place."""
     kinds = np.array([c.kind for c in candidates])
     todo = [k for k in np.unique(kinds) if getattr(kind(k), "saturates", False) and getattr(kind(k), "reanalysed", True)]
-    if not todo:
-        return {}
-    rx = Reanalysis(res, state)
     out = {}
     for k in todo:
         idx = np.flatnonzero((kinds == k) & np.isfinite(gain))
         idx = idx[np.argsort(-gain[idx], kind="stable")[:SATURATED_SCREEN]]
         best = []
         for j in idx:
-            tried = [(_reduced_chi2(rx, state.p, list(effects) + [candidates[j]], np.r_[values, v]), v)
+            tried = [(_reduced_chi2(rx, rx.st.p, list(effects) + [candidates[j]], np.r_[values, v]), v)
                      for v in kind(k).scale * np.asarray(SATURATED_VALUES)]
             best.append((*min(tried), int(j)))
         out.update({j: v for _, v, j in sorted(best)[:per_kind]})
@@ -149,15 +146,15 @@ def _reduced_chi2(rx, p, cands, values) -> float:
         return np.inf
 
 
-def rank(res, state, trials: list, p, bounds, P, runner: Runner | None = None) -> list:
+def rank(res, state, trials: list, p, bounds, P, runner: Runner | None = None, reduced=None) -> list:
     """Fits of ``trials`` = [(candidates, initial magnitudes)] from the solved ``state`` (declared
-    parameters from ``p``, their columns ``P`` held): a :class:`.select.Fit` with full re-solves
-    for the trials that decide (module doc), None for the others."""
+    parameters from ``p``, their columns ``P`` held; ``reduced``: its reanalysis where already made): a
+    :class:`.select.Fit` with full re-solves for the trials that decide (module doc), None for the others."""
     runner = runner or Runner()
     quick = [k for k, (cands, _) in enumerate(trials) if _followed(state, cands)]
     full = [k for k in range(len(trials)) if k not in quick]
     if len(quick) > FULL_RANK:
-        chi2 = _screen(res, state, [trials[k] for k in quick], p, bounds, P, RANK_STEPS, runner)
+        chi2 = _screen(res, state, [trials[k] for k in quick], p, bounds, P, RANK_STEPS, runner, reduced)
         quick = [quick[i] for i in np.argsort(chi2, kind="stable")[:FULL_RANK]]
     chosen = sorted(quick + full)
     done = runner.map(_full_fit, [(trials[k][0], trials[k][1], p) for k in chosen], (res, bounds, P), "trial fits")

@@ -35,6 +35,7 @@ import numpy as np
 from scipy.stats import chi2 as chi2_dist
 
 from .fitting import RANK_STEPS, UPPER, Fit, estimate  # noqa: F401  (re-exported)
+from .reanalysis import Reanalysis
 from .scan import Runner, rank, saturated, worth_full
 
 #: probability that noise alone makes one of the candidates look like an effect (family-wise)
@@ -105,7 +106,8 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
         gain[value < lower] = -np.inf  # an effect of unphysical sign cannot be the answer
         gain[sel.chosen] = -np.inf
         short = _shortlist(gain, kinds, shortlist)
-        stiff = saturated(res, st, [candidates[i] for i in sel.chosen], sel.values, candidates, gain, shortlist)
+        rx = Reanalysis(res, st)  # made once for the screen of saturating kinds and the trials' quick fits
+        stiff = saturated(rx, [candidates[i] for i in sel.chosen], sel.values, candidates, gain, shortlist)
         order = np.union1d(short, np.array(list(stiff), dtype=np.int64))
         order = np.setdiff1d(np.union1d(np.union1d(order, _companions(candidates, sel.chosen)),
                                         _whole(candidates, short)), sel.chosen)
@@ -114,7 +116,7 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
         start = {j: v for j, v in stiff.items() if j not in short}
         trials = [([candidates[i] for i in sel.chosen + [j]], np.r_[sel.values, start.get(j, max(value[j], 0.0))])
                   for j in order]
-        fits = rank(res, st, trials, fit.p, bounds, P, runner)
+        fits = rank(res, st, trials, fit.p, bounds, P, runner, rx)
         chi2 = np.array([np.inf if f is None else f.chi2 for f in fits])
         new = None
         for best in np.argsort(chi2, kind="stable"):
