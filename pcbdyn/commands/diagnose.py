@@ -76,7 +76,7 @@ def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size,
                          progress=lambda msg: click.echo(f"    {msg}", err=True), quick=quick, workers=workers,
                          scheduler=scheduler, record=record)
         except Exception as exc:
-            if json_path is not None and not isinstance(exc, (KeyError, ValueError)):  # a bug: keep what was computed
+            if json_path is not None:  # a bug, or a state no model can take: keep what was computed
                 write_json(json_path, {"complete": False, "error": f"{type(exc).__name__}: {exc}",
                                        **{k: rep.summary(v) if k in STATES else v for k, v in record.items()}})
             raise

@@ -129,6 +129,15 @@ def _by_kind(candidates):
     return groups
 
 
+def jointly(candidates):
+    """A test ``ok(values)`` that the magnitudes of ``candidates`` stay physical taken together, as
+    the kinds with a ``joint`` test state it (overlapping regions' stiffness changes add up); each
+    magnitude's own bound is the kind's ``lower``."""
+    tests = [(idx, kind(name).joint([candidates[i] for i in idx]))
+             for name, idx in _by_kind(candidates).items() if hasattr(kind(name), "joint")]
+    return lambda values: all(ok(np.asarray(values, float)[idx]) for idx, ok in tests)
+
+
 class BlockCache:
     """Candidates' element blocks kept by (kind, candidate names) for the kinds that depend on the
     mesh only (not ``uses_properties``): every fit of a diagnosis asks for the same candidates on

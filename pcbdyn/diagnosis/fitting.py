@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..updating.gauss_newton import gauss_newton
+from .catalogue import jointly
 
 #: magnitudes are bounded by this many times their kind's typical ``scale`` (a 1 kg mass or a
 #: 1e7 N/m spring is no longer an effect a test setup hides; unbounded, a huge mass pins a node)
@@ -55,11 +56,14 @@ def estimate(res, p0, cands, v0, steps: int, bounds=None, tol: float = 1e-5, par
         lower, upper = np.r_[np.log(lo_p), lo_v], np.r_[np.log(hi_p), hi_v]
 
     run = res if reduced is None else reduced
+    admissible = jointly(cands)
 
     def evaluate(y):
+        if not admissible(y[npar:]):
+            return None
         try:
             st = run.evaluate(np.exp(y[:npar]), cands, y[npar:])
-        except (ValueError, ArithmeticError, np.linalg.LinAlgError):  # e.g. overlapping regions softened below zero
+        except (ValueError, ArithmeticError, np.linalg.LinAlgError):
             return None
         # a paired model mode that does not move at the points has no shape to compare
         return st if np.isfinite(st.r).all() else None

@@ -18,6 +18,7 @@ softer than declared as a whole (its E, its thickness), reported with the plate'
 from __future__ import annotations
 
 import numpy as np
+import shapely
 
 from ..board.effects import ScaledShell
 from ..fe.elements import kernel
@@ -122,6 +123,19 @@ class _RegionStiffness:
         polys += list(layout.footprints.items())
         return [c for label, poly in polys if (c := _candidate(layout, label, poly)) is not None]
 
+    def joint(self, candidates):
+        """A test ``ok(values)`` of the changes taken together: where regions overlap their changes
+        add, so each region's change plus every softening of a region over it must stay at or above
+        ``lower`` (overlap by area, not by this mesh's cells: two regions that share no cell here may
+        share cells of a finer mesh, where a summed factor <= 0 made K indefinite)."""
+        over = [[j for j, b in enumerate(candidates) if j != i and _overlap(a, b)] for i, a in enumerate(candidates)]
+
+        def ok(values) -> bool:
+            v = np.asarray(values, float)
+            return all(v[i] + np.minimum(v[o], 0.0).sum() >= self.lower for i, o in enumerate(over))
+
+        return ok
+
     def candidate(self, layout, label: str, polygon):
         """The region over ``polygon`` [[x, y], ...] [m] (None where it holds no cell centroid)."""
         return _candidate(layout, label, polygon)
@@ -170,6 +184,15 @@ class _RegionStiffness:
                     m.sets[name] = type(es)(es.name, es.etype, es.conn[~in_set], es.prop)
                 m.add(_fresh(m, f"effects.{candidate.name}.{name}"), etype, es.conn[in_set], ScaledShell(base, f + value))
         return m
+
+
+def _overlap(a, b) -> bool:
+    """Whether regions ``a`` and ``b`` share area: a box's plates when they are one plate, a board's
+    regions by their polygons."""
+    if a.data.get("plate") or b.data.get("plate"):
+        return a.data.get("plate") == b.data.get("plate")
+    pa, pb = (shapely.Polygon(c.geometry["polygon"]) for c in (a, b))
+    return pa.intersection(pb).area > 1e-9 * min(pa.area, pb.area)
 
 
 def _fresh(model, name: str) -> str:

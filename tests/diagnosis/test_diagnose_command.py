@@ -29,12 +29,14 @@ def test_bad_options_and_configurations(tmp_path):
 def test_an_internal_error_still_writes_what_was_computed(tmp_path, monkeypatch):
     """A bug in a later step (here: the candidates cannot be generated) ends the command with the
     one-line internal error, and the JSON holds what was computed before it (the correlation as given
-    and with the declared parameters fitted), marked incomplete, with the error."""
+    and with the declared parameters fitted), marked incomplete, with the error; so does a model error
+    met on the way (discovery report seed 1001 had stopped on an indefinite stiffness with no JSON)."""
     import json
 
     from pcbdyn.board import load_board
     from pcbdyn.diagnosis import pipeline
     from pcbdyn.fe.modal import solve_modes
+    from pcbdyn.fe.model import ModelError
     from pcbdyn.testdata import read_points_csv, write_uff
     from pcbdyn.testdata.noise import Noise
     from pcbdyn.testdata.simulate import simulate_on_model
@@ -47,13 +49,15 @@ def test_an_internal_error_still_writes_what_was_computed(tmp_path, monkeypatch)
     write_uff(tmp_path / "t.uff", simulate_on_model(truth, solve_modes(truth, n_modes=7), points, dofs,
                                                    noise=Noise(frequency_pct=0.2, shape_pct=2.0), seed=3))
 
-    def broken(*args, **kwargs):
-        raise RuntimeError("a bug in the candidates")
+    for error, code in ((RuntimeError("a bug in the candidates"), 3),
+                        (ModelError("negative eigenvalue -2.3e+08: the stiffness matrix is not positive"), 2)):
+        def broken(*args, **kwargs):
+            raise error
 
-    monkeypatch.setattr(pipeline, "generate", broken)
-    js = tmp_path / "d.json"
-    r = run(CARD / "board.toml", tmp_path / "t.uff", "--quick", "--workers", "1", "--json", js)
-    assert r.exit_code == 3 and "internal error" in r.output and "a bug in the candidates" in r.output
-    data = json.loads(js.read_text())
-    assert data["complete"] is False and "RuntimeError" in data["error"]
-    assert data["before"]["max_freq_error_pct"] > data["parameters_only"]["max_freq_error_pct"] > 0.5
+        monkeypatch.setattr(pipeline, "generate", broken)
+        js = tmp_path / f"d{code}.json"
+        r = run(CARD / "board.toml", tmp_path / "t.uff", "--quick", "--workers", "1", "--json", js)
+        assert r.exit_code == code and str(error) in r.output
+        data = json.loads(js.read_text())
+        assert data["complete"] is False and type(error).__name__ in data["error"]
+        assert data["before"]["max_freq_error_pct"] > data["parameters_only"]["max_freq_error_pct"] > 0.5
