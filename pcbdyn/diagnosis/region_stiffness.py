@@ -142,7 +142,8 @@ class _RegionStiffness:
 
     def place(self, layout, candidate):
         """Over ``candidate``'s polygon (ValueError where it holds no cell centroid)."""
-        c = _candidate(layout, candidate.name.partition("@")[2] if candidate.data.get("plate") else "placed",
+        plate = candidate.data.get("plate")
+        c = _candidate(layout, f"plates.{plate}" if plate else "placed",
                        candidate.geometry["polygon"])
         if c is None:
             raise ValueError(f"{candidate.name}: its polygon holds no cell")
