@@ -79,6 +79,7 @@ KINDS = {(k.collection, k.attribute): k for k in (
     Kind("line_masses", "mass", "g", "mass of a line mass"),
     Kind("stiffeners", "EI", "N*m^2", "bending stiffness of a stiffener"),
     Kind("regions", "stiffness_factor", "1", "stiffness factor of a region", number=True),
+    Kind("regions", "mass", "g", "mass spread over a region"),
     Kind("plates", "E", "Pa", "Young's modulus of an isotropic box plate (overrides its material's)"),
     Kind("plates", "rho", "kg/m^3", "density of a box plate (overrides its material's)"),
     Kind("plates", "thickness", "mm", "thickness of a box plate"),

@@ -2,7 +2,8 @@
 
 Each hidden effect is one or two *atoms*, each a kind diagnose reports (its JSON ``type``), a place
 and a magnitude: a bracket is a point mass and a ground spring at one point, a heat sink a region
-whose stiffness changes by E_sink / E_board - 1 and a point mass at its centre, an undeclared
+whose stiffness changes by E_sink / E_board - 1 and a point mass at its centre (a mass reported over a
+region is judged as a point mass, :func:`judged_as`), an undeclared
 standoff a ground spring (rigid: its stiffness is not judged). An atom is found when a reported
 effect of its type lies within :data:`PLACE_MM` (points, regions: from the region's centre, 0 inside
 the reported polygon) or :data:`LINE_MM` (stiffeners, line masses, edge stiffness: the farther of
@@ -45,6 +46,12 @@ def atoms(case: dict, E_board: float) -> list:
         if k == "region":
             out.append((i, "region_stiffness", {"rect": e["rect"]}, e["factor"] - 1.0))
     return out
+
+
+def judged_as(r: dict) -> str:
+    """The atom type a reported effect is judged as: a mass spread over a region (``region_mass``) is a
+    mass at its place, judged as a ``point_mass`` (its distance: 0 where its polygon holds the atom)."""
+    return "point_mass" if r.get("type") == "region_mass" else r.get("type")
 
 
 def to_polyline(p, pts) -> float:
@@ -94,7 +101,7 @@ def judge(truth: dict, result: dict, detectable_chi2: float) -> dict:
     rows = []
     for i, typ, geom, mag in atoms(case, E_board):
         tol = LINE_MM if typ in LINES else PLACE_MM
-        same = [(distance(r, geom), j) for j, r in enumerate(reported) if r.get("type") == typ]
+        same = [(distance(r, geom), j) for j, r in enumerate(reported) if judged_as(r) == typ]
         d, j = min(same) if same else (np.inf, None)
         row = {"effect": i, "kind": case["effects"][i]["kind"], "type": typ, "magnitude": mag,
                "detectable": truth["signal_chi2"][i] >= detectable_chi2, "chi2": truth["signal_chi2"][i],
@@ -112,7 +119,7 @@ def judge(truth: dict, result: dict, detectable_chi2: float) -> dict:
         row["found"] = bool(row["placed"] and row.get("sized", False))
         rows.append(row)
     invented = [r for j, r in enumerate(reported) if j not in used and not any(
-        r.get("type") == typ and distance(r, g) <= 2 * (LINE_MM if typ in LINES else PLACE_MM)
+        judged_as(r) == typ and distance(r, g) <= 2 * (LINE_MM if typ in LINES else PLACE_MM)
         for _, typ, g, _ in atoms(case, E_board))]
     out = {"atoms": rows, "invented": [(r.get("type"), r.get("at_mm")) for r in invented],
            "n_reported": len(reported), "noise_only_case": not case["effects"]}

@@ -2,7 +2,8 @@
 edge springs to ground, line masses, stiffeners and regions of scaled stiffness.
 
 Each builds exactly what the diagnosis kind of the same effect adds to an FE model
-(``pcbdyn.diagnosis``: ground_spring, edge_stiffness, line_mass, stiffener, region_stiffness), so
+(``pcbdyn.diagnosis``: ground_spring, edge_stiffness, line_mass, stiffener, region_stiffness,
+region_mass), so
 that a board declaring a diagnosed effect has the same matrices as the diagnosed model:
 
 - point spring: a spring to ground on the node's z translation, k (N/m);
@@ -12,7 +13,8 @@ that a board declaring a diagnosed effect has the same matrices as the diagnosed
 - stiffener: a beam of fixed material and height h whose width b follows from EI = E b h^3 / 12,
   A = b h, Iy = Iz = b h^3 / 12, J = b h^3 / 3, axis offset (t + h) / 2 above the mid-surface;
 - region: the shells whose centroid lies inside the polygon get their stiffness (membrane,
-  bending, shear) multiplied by the factor, mass unchanged (overlapping regions multiply).
+  bending, shear) multiplied by the factor (overlapping regions multiply), and its mass, if any,
+  lumped at their nodes by tributary area on x, y and z.
 """
 
 from __future__ import annotations
@@ -49,6 +51,17 @@ def tributary_weights(xy: np.ndarray) -> np.ndarray:
     L = np.linalg.norm(np.diff(xy, axis=0), axis=1)
     w = np.r_[L, 0.0] + np.r_[0.0, L]
     return w / w.sum()
+
+
+def area_weights(xy: np.ndarray, conns, nodes: np.ndarray) -> np.ndarray:
+    """Tributary-area fractions (sum 1) of ``nodes`` over the cells ``conns`` (arrays of node rows,
+    polygons in the plane of ``xy`` (n, 2)): each cell's area shared equally by its corners."""
+    w = np.zeros(len(xy))
+    for conn in conns:
+        p, q = xy[conn], xy[np.roll(conn, -1, axis=1)]
+        area = 0.5 * np.abs(np.sum(p[..., 0] * q[..., 1] - q[..., 0] * p[..., 1], axis=1))
+        np.add.at(w, conn, np.repeat(area / conn.shape[1], conn.shape[1]).reshape(conn.shape))
+    return w[nodes] / w[nodes].sum()
 
 
 @dataclass(frozen=True)
@@ -125,6 +138,7 @@ def effect_sets(board, mesh, q: dict, makers: dict) -> list:
         key = targets.target("regions", e.name, "stiffness_factor")
         q.setdefault(key, e.stiffness_factor)
         path = PolyPath(e.polygon)
+        cells = []
         for name in list(makers):
             mk = makers[name]
             if mk.etype not in SHELL_TYPES or not len(mk.conn):
@@ -132,6 +146,7 @@ def effect_sets(board, mesh, q: dict, makers: dict) -> list:
             inside = path.contains_points(mesh.nodes[mk.conn][:, :, :2].mean(axis=1))
             if not inside.any():
                 continue
+            cells.append(mk.conn[inside])
             new = targets.member(targets.entry("regions", e.name), name)
             makers[new] = type(mk)(mk.etype, mk.conn[inside], mk.deps + (key,),
                                    lambda q, key=key, make=mk.make: ScaledShell(make(q), q[key]))
@@ -139,4 +154,11 @@ def effect_sets(board, mesh, q: dict, makers: dict) -> list:
                 del makers[name]
             else:
                 makers[name] = type(mk)(mk.etype, mk.conn[~inside], mk.deps, mk.make)
+        if e.mass is not None and cells:
+            mkey, entry = targets.target("regions", e.name, "mass"), targets.entry("regions", e.name)
+            q.setdefault(mkey, e.mass)
+            nodes = np.unique(np.concatenate([c.ravel() for c in cells]))
+            for k, (n, w) in enumerate(zip(nodes, area_weights(mesh.nodes[:, :2], cells, nodes))):
+                out.append((targets.member(entry, f"mass{k}"), "mass", [[int(n)]], (mkey,),
+                            lambda q, key=mkey, w=w: MassProperty(q[key] * w)))
     return out

@@ -5,12 +5,12 @@ diagnosed model.
 An effect is a dict (the shape of ``pcbdyn.diagnosis.Candidate`` kind/name/at/geometry + a value)::
 
     {"type": "point_mass" | "point_inertia" | "ground_spring" | "edge_stiffness" | "line_mass"
-             | "stiffener" | "region_stiffness",
+             | "stiffener" | "region_stiffness" | "region_mass",
      "name": str, "value": float (SI: kg, kg m^2, N/m, N m/rad/m, kg, N m^2, or the relative
-     stiffness change s of a region, whose stiffness factor is 1 + s),
+     stiffness change s of a region, whose stiffness factor is 1 + s, or a region's mass in kg),
      "at": (x, y) [m], "segment": [[x, y], [x, y]] (edge_stiffness, line_mass),
      "path": [[x, y], ...] (stiffener; "height" [m]: its section's, default aluminium 4 mm),
-     "polygon": [[x, y], ...] (region_stiffness)}
+     "polygon": [[x, y], ...] (region_stiffness, region_mass)}
 
 A point_mass and a point_inertia at the same point become one ``[[masses]]`` entry.
 """
@@ -29,8 +29,9 @@ from ..inputs import entry_name, new_entry_name
 from .entries import MIN_SEGMENT, BoardError, RibSection
 
 TYPES = ("point_mass", "point_inertia", "ground_spring", "edge_stiffness", "line_mass", "stiffener",
-         "region_stiffness")
-_GEOMETRY = {"edge_stiffness": "segment", "line_mass": "segment", "stiffener": "path", "region_stiffness": "polygon"}
+         "region_stiffness", "region_mass")
+_GEOMETRY = {"edge_stiffness": "segment", "line_mass": "segment", "stiffener": "path", "region_stiffness": "polygon",
+             "region_mass": "polygon"}
 
 
 def enriched_path(board_toml) -> Path:
@@ -120,6 +121,10 @@ def _entries(effects, names) -> list:
             out.append(("regions", f"{name}: stiffness changed by {100 * v:.4g} %", {
                 "name": names("regions", name), "polygon": [_point(p) for p in _outline(e["polygon"])],
                 "stiffness_factor": targets.formatted(kind["regions", "stiffness_factor"], 1.0 + v)}))
+        elif typ == "region_mass":
+            out.append(("regions", f"{name}: mass spread over the region", {
+                "name": names("regions", name), "polygon": [_point(p) for p in _outline(e["polygon"])],
+                "mass": targets.formatted(kind["regions", "mass"], v)}))
     return out
 
 

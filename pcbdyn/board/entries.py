@@ -140,11 +140,13 @@ class Stiffener:
 
 @dataclass
 class Region:
-    """Shells inside ``polygon`` (m, 2) [m] get ``stiffness_factor`` times their stiffness."""
+    """Shells inside ``polygon`` (m, 2) [m] get ``stiffness_factor`` times their stiffness, and ``mass``
+    [kg] (None: none declared) spread uniformly over their area (a heat sink, a shield can, potting)."""
 
     name: str
     polygon: np.ndarray
-    stiffness_factor: float
+    stiffness_factor: float = 1.0
+    mass: float | None = None
 
 
 @dataclass

@@ -63,7 +63,9 @@ def read_stiffener(r, e, where, board) -> Stiffener:
 
 
 def read_region(r, e, where, board) -> Region:
-    r.table(e, where, ["name", "polygon", "rect", "stiffness_factor"], required=["stiffness_factor"])
+    r.table(e, where, ["name", "polygon", "rect", "stiffness_factor", "mass"])
+    if "stiffness_factor" not in e and "mass" not in e:
+        r.fail(where, "give stiffness_factor (1 leaves the stiffness unchanged), mass (spread over the region) or both")
     name = entry_name(r, "regions", e, where)
     if ("polygon" in e) == ("rect" in e):
         r.fail(where, "give polygon = [[\"x mm\", \"y mm\"], ...] or rect = [x0, y0, x1, y1] (one of them)")
@@ -87,5 +89,7 @@ def read_region(r, e, where, board) -> Region:
         r.fail(f"{where}.polygon", why)
     if not all(on_board(board.outline, a, b) for a, b in zip(poly, np.roll(poly, -1, axis=0))):
         r.fail(f"{where}", "the region reaches off the board (or over a hole); keep it inside the outline")
-    factor = r.number(e["stiffness_factor"], f"{where}.stiffness_factor", lo=0, note="1 leaves the stiffness unchanged")
-    return Region(name, poly, factor)
+    factor = (r.number(e["stiffness_factor"], f"{where}.stiffness_factor", lo=0, note="1 leaves the stiffness unchanged")
+              if "stiffness_factor" in e else 1.0)
+    mass = r.q(e["mass"], "g", f"{where}.mass", nonneg=True) if "mass" in e else None
+    return Region(name, poly, factor, mass)

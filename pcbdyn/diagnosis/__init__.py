@@ -11,6 +11,7 @@ from . import edge_stiffness  # noqa: F401
 from . import region_stiffness  # noqa: F401
 from . import stiffener  # noqa: F401
 from . import line_mass  # noqa: F401
+from . import region_mass  # noqa: F401
 from .catalogue import (
     KINDS,
     Candidate,

@@ -17,7 +17,7 @@ from .model_form import discretisation, kirchhoff_shift
 from .residual import Observation, reading
 
 #: kinds whose effects :func:`with_carried` carries onto the finer meshes
-MASS_KINDS = ("point_mass", "point_inertia", "line_mass")
+MASS_KINDS = ("point_mass", "point_inertia", "line_mass", "region_mass")
 
 
 def noise_sigmas(ob: Observation, freq_pct, shape_pct, basis_shapes):

@@ -2,7 +2,7 @@
 nominal value is zero (issue 7, step 4).
 
 A candidate is a catalogue kind (``point_mass``, ``ground_spring``, ``edge_stiffness``,
-``region_stiffness``, ``stiffener``, ``line_mass``), a place and a parameter. Every kind is a
+``region_stiffness``, ``stiffener``, ``line_mass``, ``region_mass``), a place and a parameter. Every kind is a
 plugin module of this package that registers an object (:func:`register`, into :data:`KINDS`) with
 
 - ``name``, ``report_as`` (the catalogue type reported), ``param`` (what the parameter is),
@@ -18,6 +18,9 @@ plugin module of this package that registers an object (:func:`register`, into :
   mesh's layout (a finer mesh, as a test bench's truth model is);
 - ``whole(candidates, i) -> int`` (optional): the candidate of which candidate ``i`` is a piece (a
   stiffener's whole line), tried beside it by the search (:mod:`.select`).
+- ``together`` (optional): kinds that the same body brings to the same nodes (a heat sink's mass
+  beside its stiffness, a bracket's spring beside its mass), each tried with it as one addition of two
+  effects by the search (:mod:`.halves`);
 - ``saturates`` (optional, False by default): True when the effect stiffens the modes near it up to a
   pin or a clamp (a support), so that the search screens more of its candidates at large magnitudes
   (:func:`.scan.saturated`).
@@ -37,6 +40,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 import scipy.sparse as sp
 
+from ..fe import MassProperty
 from ..fe.assembly import scatter
 from ..fe.mesh import element_dofs
 from ..updating.sensitivity import eigen_derivatives
@@ -112,6 +116,24 @@ class Blocks:
     Ke: np.ndarray
     Me: np.ndarray
     owner: np.ndarray
+
+
+def spread_mass_blocks(candidates, weights) -> list:
+    """Blocks of dM/dm for masses spread over each candidate's nodes by ``weights`` (one array per
+    candidate, summing to one) on the three translations; dK = 0."""
+    nodes = np.concatenate([c.nodes for c in candidates])
+    Me = np.zeros((nodes.size, 6, 6))
+    Me[:, [0, 1, 2], [0, 1, 2]] = np.concatenate(weights)[:, None]
+    owner = np.repeat(np.arange(len(candidates)), [c.nodes.size for c in candidates])
+    return [Blocks(nodes[:, None], np.zeros_like(Me), Me, owner)]
+
+
+def with_spread_mass(model, candidate, weights, value: float):
+    """A copy of ``model`` with mass ``value`` spread over the candidate's nodes by ``weights``."""
+    m = model.copy()
+    for k, (n, w) in enumerate(zip(candidate.nodes, weights)):
+        m.add(f"effects.{candidate.name}.{k}", "mass", [[int(n)]], MassProperty(value * w))
+    return m
 
 
 def kind(name: str):

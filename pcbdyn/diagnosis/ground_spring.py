@@ -24,6 +24,7 @@ class _GroundSpring:
     unit = "N/m"
     scale = 1e5
     lower = 0.0
+    together = ("point_mass",)  # a bracket: a mass held by a spring at one point
     saturates = True  # stiffens the modes near it up to a pin (a clamp): :func:`.scan.saturated`
     options = ("spacing",)
 

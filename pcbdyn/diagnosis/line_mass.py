@@ -4,11 +4,8 @@ translations. M is linear in m (weights summing to one), K does not depend on it
 
 from __future__ import annotations
 
-import numpy as np
-
 from ..board.effects import tributary_weights
-from ..fe import MassProperty
-from .catalogue import register, AlongSides, Blocks
+from .catalogue import register, AlongSides, spread_mass_blocks, with_spread_mass
 
 
 class _LineMass(AlongSides):
@@ -19,18 +16,10 @@ class _LineMass(AlongSides):
     lower = 0.0
 
     def blocks(self, model, candidates) -> list:
-        nodes = np.concatenate([c.nodes for c in candidates])
-        w = np.concatenate([tributary_weights(model.nodes[c.nodes, :2]) for c in candidates])
-        Me = np.zeros((nodes.size, 6, 6))
-        Me[:, [0, 1, 2], [0, 1, 2]] = w[:, None]
-        owner = np.repeat(np.arange(len(candidates)), [c.nodes.size for c in candidates])
-        return [Blocks(nodes[:, None], np.zeros_like(Me), Me, owner)]
+        return spread_mass_blocks(candidates, [tributary_weights(model.nodes[c.nodes, :2]) for c in candidates])
 
     def apply(self, model, candidate, value: float):
-        m = model.copy()
-        for k, (n, w) in enumerate(zip(candidate.nodes, tributary_weights(model.nodes[candidate.nodes, :2]))):
-            m.add(f"effects.{candidate.name}.{k}", "mass", [[int(n)]], MassProperty(value * w))
-        return m
+        return with_spread_mass(model, candidate, tributary_weights(model.nodes[candidate.nodes, :2]), value)
 
 
 KIND = _LineMass()

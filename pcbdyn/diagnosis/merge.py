@@ -12,7 +12,7 @@ import shapely
 
 from ..fe.probe import segment_parameter
 from .catalogue import weighted_centre
-from .moves import rectangle
+from .moves import REGION_KINDS, rectangle
 from .uncertainty import parts
 
 #: kinds that act at one node: an effect between nodes is shared by its neighbours
@@ -28,10 +28,10 @@ def linked(a, b, reach: float) -> bool:
     ``reach`` of a line mass (a mass spread over part of an edge is fitted as a line plus points),
     line masses whose segments overlap or lie within ``reach``, parallel stiffeners within
     ``reach`` (a rib between two lines is fitted as shares on both), or overlapping rectangular
-    regions (a region between two is fitted as both)."""
+    regions of one kind (a region between two is fitted as both)."""
     if a.kind == b.kind and a.kind in POINT_KINDS:
         return math.dist(a.at, b.at) <= reach
-    if a.kind == b.kind == "region_stiffness" and None not in (ra := rectangle(a), rb := rectangle(b)):
+    if a.kind == b.kind and a.kind in REGION_KINDS and None not in (ra := rectangle(a), rb := rectangle(b)):
         return min(ra[2], rb[2]) > max(ra[0], rb[0]) and min(ra[3], rb[3]) > max(ra[1], rb[1])  # they overlap
     if a.kind == b.kind == "stiffener":
         da, db = (np.diff(np.asarray(c.geometry["path"], float)[[0, -1]], axis=0)[0] for c in (a, b))
@@ -80,8 +80,8 @@ def groups(chosen, reach: float) -> list:
 def merged(chosen, values, cov, cov_jack, group) -> dict:
     """One effect entry (JSON-ready) for a group: the magnitudes summed at their weighted centre (on
     line masses: the place and extent of the largest; parallel stiffeners: their weighted mean
-    path; overlapping regions: the mean change over the area they cover, their union, which keeps
-    the change's integral over the board), the uncertainty of that combination from the fit's
+    path; overlapping regions: the mean stiffness change over the area they cover, their union, which
+    keeps the change's integral over the board, or their masses summed over it), the uncertainty of that combination from the fit's
     covariance ``cov``, the jackknife's ``cov_jack`` and the model-form budget
     (:func:`.uncertainty.parts`)."""
     lines = [k for k in group if chosen[k].kind == "line_mass"]
@@ -92,10 +92,11 @@ def merged(chosen, values, cov, cov_jack, group) -> dict:
     if len(group) > 1:
         d["name"] = "+".join(chosen[k].name for k in group)
         d["merged_at_mm"] = np.round(1e3 * np.array([chosen[k].at for k in group]), 3).tolist()
-        if c.kind == "region_stiffness":
+        if c.kind in REGION_KINDS:
             boxes = [shapely.box(*rectangle(chosen[k])) for k in group]
             union = shapely.union_all(boxes)
-            w = np.array([b.area for b in boxes]) / union.area
+            if c.kind == "region_stiffness":
+                w = np.array([b.area for b in boxes]) / union.area
             d["polygon_mm"] = np.round(1e3 * np.asarray(union.exterior.coords)[:-1], 3).tolist()
             d["at_mm"] = np.round(1e3 * np.asarray(union.centroid.coords)[0], 3).tolist()
         elif not lines:

@@ -23,6 +23,8 @@ RECT_STEP = 1.0
 #: [element sizes] a point mass on a node moves to the nodes within this distance (the eight around it
 #: on a quadrilateral mesh)
 NODE_REACH = 1.5
+#: kinds acting over a region (:mod:`.region_stiffness`), whose rectangles move
+REGION_KINDS = ("region_stiffness", "region_mass")
 
 
 def movable(cand) -> bool:
@@ -39,7 +41,7 @@ def on_node(cand) -> bool:
 
 def rectangle(cand):
     """(x0, y0, x1, y1) [m] of a region candidate whose polygon is an axis-aligned rectangle, else None."""
-    if cand.kind != "region_stiffness" or np.shape(cand.geometry["polygon"])[1] != 2:
+    if cand.kind not in REGION_KINDS or np.shape(cand.geometry["polygon"])[1] != 2:
         return None
     poly = np.asarray(cand.geometry["polygon"], float)
     lo, hi = poly.min(axis=0), poly.max(axis=0)
@@ -79,6 +81,19 @@ class LocalMoves:
             out.append(self.index[c.name])
         return out
 
+    def half(self, k, other: str) -> int | None:
+        """The candidate of kind ``other`` on the very nodes of candidate ``k`` (the other half of a
+        body, :mod:`.halves`), made on demand; None where it cannot be placed so (a region that is not
+        a rectangle, a support between nodes, a body of :mod:`.bodies`)."""
+        c = self.cands[k]
+        if (box := rectangle(c)) is not None:
+            made = kind(other).rectangle(self.layout, *box)
+        elif c.nodes.size == 1 and not c.between_nodes and "radius" not in c.data:
+            made = replace(c, kind=other, name=f"{other}@{c.name.partition('@')[2]}")
+        else:
+            return None
+        return None if made is None else self._add([made])[0]
+
     def __call__(self, k) -> list:
         c = self.cands[k]
         if "run" in c.data:
@@ -113,6 +128,6 @@ class LocalMoves:
                     b = np.array(box)
                     b[side] = np.clip(b[side] + d, lo[side % 2], hi[side % 2])
                     if b[2] - b[0] >= step and b[3] - b[1] >= step and not np.allclose(b, box):
-                        made.append(kind("region_stiffness").rectangle(self.layout, *b))
+                        made.append(c.spec.rectangle(self.layout, *b))
             return self._add([r for r in made if r is not None])
         return []

@@ -87,4 +87,6 @@ class _Lumped:
 
 MASS = _Lumped("point_mass", "mass", "kg", 1e-2)
 INERTIA = _Lumped("point_inertia", "inertia", "kg*m^2", 1e-6)
+MASS.together = ("ground_spring", "point_inertia")  # a bracket: a mass held by a spring; a part: its inertia
+INERTIA.together = ("point_mass",)
 register(MASS, INERTIA)

@@ -46,8 +46,9 @@ def _centroid(conns, xy) -> np.ndarray:
     return moment / area
 
 
-def _candidate(layout, label: str, polygon) -> Candidate | None:
-    """The shell cells whose centroid is in ``polygon``, as {etype: conn}."""
+def _candidate(layout, label: str, polygon, name: str = "region_stiffness") -> Candidate | None:
+    """A candidate of kind ``name`` on the shell cells whose centroid is in ``polygon`` (``data["cells"]``:
+    {etype: conn})."""
     sets = layout.model.sets
     found: dict = {}
     for n, i in layout.cells_in(polygon):
@@ -58,7 +59,7 @@ def _candidate(layout, label: str, polygon) -> Candidate | None:
     nodes = np.unique(np.concatenate([c.ravel() for c in cells.values()]))
     plate = label.removeprefix("plates.") if label.startswith("plates.") and layout.plates else None
     centroid = tuple(_centroid(list(cells.values()), layout.points))
-    return Candidate("region_stiffness", f"region_stiffness@{label}", centroid, nodes,
+    return Candidate(name, f"{name}@{label}", centroid, nodes,
                      {"polygon": np.asarray(polygon, dtype=float)},
                      {"cells": cells, **({"plate": plate} if plate else {})})
 
@@ -101,12 +102,13 @@ class _RegionStiffness:
     scale = 0.3
     lower = -0.9
     options = ("patch",)
+    together = ("region_mass",)  # a body glued over the region (a heat sink) brings both
 
     def generate(self, layout, patch: float = 0.02) -> list:
         if not patch > 0:
             raise ValueError(f"patch must be > 0 m, got {patch}")
         if not layout.planar:  # a box: its plates
-            found = (_candidate(layout, label, poly) for label, poly in layout.footprints.items())
+            found = (_candidate(layout, label, poly, self.name) for label, poly in layout.footprints.items())
             return [c for c in found if c is not None]
         xy = layout.xy[layout.shell_nodes()]
         lo, hi = xy.min(axis=0), xy.max(axis=0)
@@ -121,7 +123,7 @@ class _RegionStiffness:
                                                 [gx[i], gy[j + 1]]])
                       for j in range(gy.size - 1) for i in range(gx.size - 1)]
         polys += list(layout.footprints.items())
-        return [c for label, poly in polys if (c := _candidate(layout, label, poly)) is not None]
+        return [c for label, poly in polys if (c := _candidate(layout, label, poly, self.name)) is not None]
 
     def joint(self, candidates):
         """A test ``ok(values)`` of the changes taken together: where regions overlap their changes
@@ -138,13 +140,13 @@ class _RegionStiffness:
 
     def candidate(self, layout, label: str, polygon):
         """The region over ``polygon`` [[x, y], ...] [m] (None where it holds no cell centroid)."""
-        return _candidate(layout, label, polygon)
+        return _candidate(layout, label, polygon, self.name)
 
     def place(self, layout, candidate):
         """Over ``candidate``'s polygon (ValueError where it holds no cell centroid)."""
         plate = candidate.data.get("plate")
         c = _candidate(layout, f"plates.{plate}" if plate else "placed",
-                       candidate.geometry["polygon"])
+                       candidate.geometry["polygon"], self.name)
         if c is None:
             raise ValueError(f"{candidate.name}: its polygon holds no cell")
         return c
@@ -152,7 +154,7 @@ class _RegionStiffness:
     def rectangle(self, layout, x0: float, y0: float, x1: float, y1: float):
         """The region over the rectangle [x0, x1] x [y0, y1] [m], named by its corners in mm."""
         label = "rect[" + ",".join(f"{1e3 * v:.4g}" for v in (x0, y0, x1, y1)) + "]mm"
-        return _candidate(layout, label, [[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
+        return _candidate(layout, label, [[x0, y0], [x1, y0], [x1, y1], [x0, y1]], self.name)
 
     def blocks(self, model, candidates) -> list:
         """Element stiffness of the regions' cells with their base properties in ``model``; one

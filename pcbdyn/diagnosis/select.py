@@ -9,10 +9,12 @@ every candidate by the chi^2 its column removes (the cos^2 criterion of thesis e
 applied to the residual), among those whose estimated value is physical (``lower`` of its kind).
 The best ``shortlist`` of every kind are re-estimated nonlinearly (a spring's effect on the
 frequencies saturates, so the linear score alone under-rates large ones; :func:`.scan.rank`: quick
-fits on a reanalysis of the state, the best of them with full re-solves) and the least chi^2 wins;
-of the kinds that saturate, so do the ``shortlist`` best at large magnitudes among more of their
-candidates (:func:`.scan.saturated`).
-Magnitudes stay within [lower, UPPER * scale], declared parameters within their bounds.
+fits on a reanalysis of the state, the best of them with full re-solves) and the least criterion
+(below) wins; of the kinds that saturate, so do the ``shortlist`` best at large magnitudes among more
+of their candidates (:func:`.scan.saturated`). The two halves of a body at one place (a heat sink's
+stiffness and mass, a bracket's mass and spring: :mod:`.halves`) are also tried as one addition,
+which pays two penalties. Magnitudes stay within [lower, UPPER * scale], declared parameters within
+their bounds.
 
 A new effect is kept only if its chi^2 drop exceeds the penalty
     q = max(ln n, chi^2_1 quantile exceeded with probability ALPHA / P)
@@ -22,8 +24,8 @@ variance left after the fit, chi^2 / (n - k): noise or model error larger than s
 turn into effects; and it must predict data it was not fitted to (:func:`held_out_share`: left-out
 configurations, or modes), so that a model error confined to one configuration or mode is not
 taken for an effect. Where the trial that fits best is one that only the screen of saturating kinds
-brought in and it is refused, the next best is weighed: that screen must not hide what the linear
-shortlist found (a bar on a card in guides, behind a guide's stiffness refused). After each
+or the bodies brought in and it is refused, the next best is weighed: they must not hide what the
+linear shortlist found (a bar on a card in guides, behind a guide's stiffness or a heat sink refused). After each
 addition an earlier effect that the others make redundant is dropped (backward check).
 """
 
@@ -35,6 +37,7 @@ import numpy as np
 from scipy.stats import chi2 as chi2_dist
 
 from .fitting import RANK_STEPS, UPPER, Fit, estimate  # noqa: F401  (re-exported)
+from .halves import Halves, bodies, body_moves, per_kind
 from .reanalysis import Reanalysis
 from .scan import Runner, rank, saturated, worth_full
 
@@ -88,6 +91,7 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
     if without is not None and without < sel.chi2[0]:
         sel.chi2[0], sel.criterion[0] = without, without + len(held) * pen
     kinds = np.array([c.kind for c in candidates])
+    halves = Halves(candidates)
     scale = np.array([c.spec.scale for c in candidates])
     lower = np.array([c.spec.lower for c in candidates])
     for _ in range(max_effects - len(held)):
@@ -105,7 +109,7 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
         gain = np.where(ok, value**2 * norm2 / scale**2, -np.inf)
         gain[value < lower] = -np.inf  # an effect of unphysical sign cannot be the answer
         gain[sel.chosen] = -np.inf
-        short = _shortlist(gain, kinds, shortlist)
+        short = per_kind(gain, kinds, shortlist)
         rx = Reanalysis(res, st)  # made once for the screen of saturating kinds and the trials' quick fits
         stiff = saturated(rx, [candidates[i] for i in sel.chosen], sel.values, candidates, gain, shortlist)
         order = np.union1d(short, np.array(list(stiff), dtype=np.int64))
@@ -114,19 +118,22 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
         if not order.size:
             break
         start = {j: v for j, v in stiff.items() if j not in short}
-        trials = [([candidates[i] for i in sel.chosen + [j]], np.r_[sel.values, start.get(j, max(value[j], 0.0))])
-                  for j in order]
+        adds = [(int(j),) for j in order] + halves.shortlist(A_p, r_p, scale, lower, sel.chosen, shortlist)
+        trials = [([candidates[i] for i in sel.chosen + list(add)],
+                   np.r_[sel.values, [start.get(j, max(value[j], 0.0)) for j in add]]) for add in adds]
         fits = rank(res, st, trials, fit.p, bounds, P, runner, rx)
-        chi2 = np.array([np.inf if f is None else f.chi2 for f in fits])
+        # ranked by the criterion: a pair pays for its second effect
+        crit = np.array([np.inf if f is None else f.chi2 + len(add) * pen for f, add in zip(fits, adds)])
         new = None
-        for best in np.argsort(chi2, kind="stable"):
-            if not np.isfinite(chi2[best]):
+        for best in np.argsort(crit, kind="stable"):
+            if not np.isfinite(crit[best]):
                 break
-            idx = sel.chosen + [int(order[best])]
-            new = _kept(res, candidates, sel, fit, idx, fits[best], held, A[:, idx[-1]], scale[idx], newton_steps,
-                        bounds, pen, p0.size)
-            if new is not None or idx[-1] not in start:  # a screened support refused does not end the step
-                break
+            add = list(adds[best])
+            idx = sel.chosen + add
+            new = _kept(res, candidates, sel, fit, idx, fits[best], held, A[:, add], scale[idx], newton_steps,
+                        bounds, pen, p0.size, len(add))
+            if new is not None or (len(add) == 1 and add[0] not in start):  # a screened support or a body
+                break  # refused does not end the step
         if new is None:
             break
         idx, fit = _prune(res, candidates, idx, new, newton_steps, bounds, pen, p0.size, runner)
@@ -134,16 +141,17 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
     return sel
 
 
-def _kept(res, candidates, sel, fit, idx, trial, held, column, scale, newton_steps, bounds, pen, n_params):
-    """The estimate of effects ``idx`` (the chosen ones and an addition, whose trial fit is ``trial``
-    and column at the state without it ``column``) when the addition is kept: its chi^2 drop is
-    worth its penalty ``pen`` (:func:`worth`) and it predicts the held-out folds to first order
+def _kept(res, candidates, sel, fit, idx, trial, held, column, scale, newton_steps, bounds, pen, n_params,
+          n_added: int = 1):
+    """The estimate of effects ``idx`` (the chosen ones and an addition of its last ``n_added``, whose
+    trial fit is ``trial`` and columns at the state without it ``column``) when the addition is kept: its
+    chi^2 drop is worth ``n_added`` penalties ``pen`` (:func:`worth`) and it predicts the held-out folds to first order
     (:func:`held_out_share`) from the state without it or along the secant to the state with it
     (:func:`_secant`); else None. Either first-order model can fail a real effect where the modes
     respond nonlinearly (a share of a mass beside another: the secant; a bar across the card: the
     state without it); a model error taken for an effect fails both."""
     new = estimate(res, fit.p, [candidates[i] for i in idx], trial.values, newton_steps, bounds)
-    if not worth(sel.chi2[-1], new.chi2, res.n_rows, n_params + len(idx), pen):
+    if not worth(sel.chi2[-1], new.chi2, res.n_rows, n_params + len(idx), n_added * pen):
         return None
     r = fit.state.r
     if held_out_share(res, r, held, column) >= HELD_OUT_SHARE:
@@ -153,13 +161,14 @@ def _kept(res, candidates, sel, fit, idx, trial, held, column, scale, newton_ste
 
 
 def _secant(res, held, column, fit: Fit, effects: list, scale: np.ndarray) -> tuple:
-    """(held, column) for :func:`held_out_share` on the secant from the state without the new effect
-    (the columns ``held`` and its ``column``; it is the last of ``effects``) to the fitted state of
+    """(held, column) for :func:`held_out_share` on the secant from the state without the new effects
+    (the columns ``held`` and theirs, ``column``; they are the last of ``effects``) to the fitted state of
     ``fit``: the mean of the columns at both ends. A large addition (a bar across a card) moves the
     modes so far that a first-order prediction from the state without it misses the data; the mean of
     the two slopes follows the whole step, as the trapezoidal rule does."""
     E = res.effect_columns(fit.state, effects) * scale
-    return 0.5 * (held + np.hstack([res.param_columns(fit.state), E[:, :-1]])), 0.5 * (column + E[:, -1])
+    k = column.shape[1]
+    return 0.5 * (held + np.hstack([res.param_columns(fit.state), E[:, :-k]])), 0.5 * (column + E[:, -k:])
 
 
 def adopt(sel: Selection, idx: list, fit: Fit, pen: float) -> Selection:
@@ -216,7 +225,8 @@ def refine(res, candidates, sel: Selection, neighbours, bounds=None, newton_step
     one piece longer or shorter), all magnitudes and the declared parameters re-estimated; the
     best swap is kept while it lowers chi^2, then effects the others now explain are pruned.
     Forward selection adds effects greedily on a coarse set of places; this lets a place found
-    early move to where the effects found later leave it best. The swaps are ranked by
+    early move to where the effects found later leave it best; the two halves of a body move
+    together (:func:`.halves.body_moves`). The swaps are ranked by
     :func:`.scan.rank` (``runner``: where their full fits run)."""
     pen = penalty(res.n_rows, len(candidates), alpha)
     n_par = np.size(sel.p)
@@ -227,7 +237,11 @@ def refine(res, candidates, sel: Selection, neighbours, bounds=None, newton_step
         improved = False
         best = None
         P = res.param_columns(fit.state)  # held while ranking the swaps, as in :func:`search`
-        swaps = [idx[:k] + [j] + idx[k + 1:] for k, i in enumerate(idx) for j in neighbours(i) if j not in idx]
+        found = bodies(candidates, idx) if hasattr(neighbours, "half") else []
+        halves = {k for pair in found for k in pair}
+        swaps = [idx[:k] + [j] + idx[k + 1:] for k, i in enumerate(idx) if k not in halves
+                 for j in neighbours(i) if j not in idx]
+        swaps += body_moves(candidates, idx, found, neighbours)
         trials = rank(res, fit.state, [([candidates[t] for t in sw], fit.values) for sw in swaps], fit.p, bounds, P,
                       runner)
         for trial_idx, trial in zip(swaps, trials):
@@ -318,15 +332,6 @@ def _whole(candidates, idx) -> np.ndarray:
     the effect spans the whole."""
     return np.unique(np.array([candidates[i].spec.whole(candidates, i) for i in idx
                                if hasattr(candidates[i].spec, "whole")], dtype=np.int64))
-
-
-def _shortlist(gain, kinds, per_kind: int) -> np.ndarray:
-    """The ``per_kind`` best finite-gain columns of every kind."""
-    out = []
-    for k in np.unique(kinds):
-        idx = np.flatnonzero((kinds == k) & np.isfinite(gain))
-        out.append(idx[np.argsort(-gain[idx])[:per_kind]])
-    return np.concatenate(out) if out else np.zeros(0, dtype=np.int64)
 
 
 def _prune(res, candidates, idx, fit, steps, bounds, pen, n_params, runner: Runner | None = None):

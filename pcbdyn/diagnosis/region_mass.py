@@ -1,0 +1,46 @@
+"""``region_mass``: a mass m [kg] spread uniformly over a region of the board (a heat sink, a shield
+can, a potted block: a body glued over an area, whose mass moves with the plate under it and whose
+stiffness is the region's stiffness change, :mod:`.region_stiffness`). The mass is lumped at the
+region's nodes by their tributary area (each cell's area shared equally by its corners) on the three
+translations, as a board's ``[[regions]]`` entry with a ``mass`` builds it; M is linear in m (weights
+summing to one), K does not depend on it.
+
+Candidates: the regions of :mod:`.region_stiffness` (patches of two sizes and the parts' footprints),
+on a board only: on a housing those regions are whole plates, whose mass is a declared density.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..board.effects import area_weights
+from .catalogue import register, spread_mass_blocks, with_spread_mass
+from .region_stiffness import _RegionStiffness
+
+
+class _RegionMass(_RegionStiffness):
+    name = report_as = "region_mass"
+    uses_properties = False
+    param = "mass"
+    unit = "kg"
+    scale = 1e-2
+    lower = 0.0
+    together = ("region_stiffness",)
+
+    def generate(self, layout, patch: float = 0.02) -> list:
+        return super().generate(layout, patch) if layout.planar else []
+
+    @staticmethod
+    def weights(model, candidate) -> np.ndarray:
+        """The share of the mass at each of ``candidate.nodes`` (sum 1)."""
+        return area_weights(model.nodes[:, :2], list(candidate.data["cells"].values()), candidate.nodes)
+
+    def blocks(self, model, candidates) -> list:
+        return spread_mass_blocks(candidates, [self.weights(model, c) for c in candidates])
+
+    def apply(self, model, candidate, value: float):
+        return with_spread_mass(model, candidate, self.weights(model, candidate), value)
+
+
+KIND = _RegionMass()
+register(KIND)
