@@ -145,8 +145,8 @@ def _kept(res, candidates, sel, fit, idx, trial, held, column, scale, newton_ste
           n_added: int = 1):
     """The estimate of effects ``idx`` (the chosen ones and an addition of its last ``n_added``, whose
     trial fit is ``trial`` and columns at the state without it ``column``) when the addition is kept: its
-    chi^2 drop is worth ``n_added`` penalties ``pen`` (:func:`worth`) and it predicts the held-out folds to first order
-    (:func:`held_out_share`) from the state without it or along the secant to the state with it
+    chi^2 drop is worth ``n_added`` penalties ``pen`` (:func:`worth`) and it predicts the held-out folds to
+    first order (:func:`_predicts`) from the state without it or along the secant to the state with it
     (:func:`_secant`); else None. Either first-order model can fail a real effect where the modes
     respond nonlinearly (a share of a mass beside another: the secant; a bar across the card: the
     state without it); a model error taken for an effect fails both."""
@@ -154,10 +154,20 @@ def _kept(res, candidates, sel, fit, idx, trial, held, column, scale, newton_ste
     if not worth(sel.chi2[-1], new.chi2, res.n_rows, n_params + len(idx), n_added * pen):
         return None
     r = fit.state.r
-    if held_out_share(res, r, held, column) >= HELD_OUT_SHARE:
+    if _predicts(res, r, held, column):
         return new
-    share = held_out_share(res, r, *_secant(res, held, column, new, [candidates[i] for i in idx], scale))
-    return new if share >= HELD_OUT_SHARE else None
+    return new if _predicts(res, r, *_secant(res, held, column, new, [candidates[i] for i in idx], scale)) else None
+
+
+def _predicts(res, r, held, column) -> bool:
+    """The addition of the columns ``column`` predicts the held-out folds (:func:`held_out_share`); for
+    the two halves of a body, each half too beside the other: a half that only rides along with the
+    other (a spring beside a mass that explains it all) is not kept."""
+    if held_out_share(res, r, held, column) < HELD_OUT_SHARE:
+        return False
+    k = column.shape[1]
+    return k == 1 or all(held_out_share(res, r, np.hstack([held, np.delete(column, h, axis=1)]), column[:, [h]])
+                         >= HELD_OUT_SHARE for h in range(k))
 
 
 def _secant(res, held, column, fit: Fit, effects: list, scale: np.ndarray) -> tuple:
