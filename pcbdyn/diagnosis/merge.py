@@ -81,9 +81,9 @@ def merged(chosen, values, cov, cov_jack, group) -> dict:
     """One effect entry (JSON-ready) for a group: the magnitudes summed at their weighted centre (on
     line masses: the place and extent of the largest; parallel stiffeners: their weighted mean
     path; overlapping regions: the mean stiffness change over the area they cover, their union, which
-    keeps the change's integral over the board, or their masses summed over it), the uncertainty of that combination from the fit's
-    covariance ``cov``, the jackknife's ``cov_jack`` and the model-form budget
-    (:func:`.uncertainty.parts`)."""
+    keeps the change's integral over the board, or their masses summed over it), the uncertainty of
+    that combination from the fit's covariance ``cov``, the jackknife's ``cov_jack`` and the
+    model-form budget (:func:`.uncertainty.parts`)."""
     lines = [k for k in group if chosen[k].kind == "line_mass"]
     c = chosen[max(lines, key=lambda k: values[k]) if lines else group[0]]
     d = c.describe()
