@@ -20,6 +20,7 @@ from __future__ import annotations
 import numpy as np
 import shapely
 
+from .. import targets
 from ..board.effects import ScaledShell
 from ..fe.elements import kernel
 from .catalogue import register, Blocks, Candidate
@@ -145,7 +146,7 @@ class _RegionStiffness:
     def place(self, layout, candidate):
         """Over ``candidate``'s polygon (ValueError where it holds no cell centroid)."""
         plate = candidate.data.get("plate")
-        c = _candidate(layout, f"plates.{plate}" if plate else "placed",
+        c = _candidate(layout, targets.entry("plates", plate) if plate else "placed",
                        candidate.geometry["polygon"], self.name)
         if c is None:
             raise ValueError(f"{candidate.name}: its polygon holds no cell")
