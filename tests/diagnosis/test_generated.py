@@ -28,7 +28,11 @@ HERE = Path(__file__).resolve().parent / "generated"
 AFTER_MAX_PCT = 0.5
 #: generated cases the diagnosis does not yet pass, and what it does instead (strict: a pass is news)
 MISSED = {"s0012": "a 19 x 28 mm region 2.3 x stiffer near the free end of a narrow board clamped on one edge "
-                   "(chi^2 12600 beyond the parameters) is not reported: 2.0 % is left after"}
+                   "(chi^2 12600 beyond the parameters) is not reported: 2.0 % is left after",
+          "s0033": "the bracket (a 12 g mass on a 16 N/mm spring near the edge x = 0) is found, 0.32 % after, but a "
+                   "0.14 +- 0.04 g line mass along that edge is reported beside it (the removal check keeps it); "
+                   "the same case run by the benchmark (its cached test file, --workers 1) reports the bracket "
+                   "alone: the two runs differ in the test file's digits or the workers (not traced)"}
 
 
 def _cases():
