@@ -44,7 +44,8 @@ def estimate(res, p0, cands, v0, steps: int, bounds=None, tol: float = 1e-5, par
     magnitudes). ``param_columns``: the parameters' columns held from an earlier state (a quick fit
     that ranks candidates need not re-derive the board's matrices at every step); ``reduced``: a
     :class:`.reanalysis.Reanalysis` that evaluates the states instead of full re-solves (quick fits
-    that rank candidates)."""
+    that rank candidates). Magnitudes that break their kinds' joint test (:func:`.catalogue.jointly`:
+    overlapping regions softened to no stiffness) are refused as a failed solve is."""
     p = np.asarray(p0, float)
     npar = p.size
     lo_v = np.array([c.spec.lower for c in cands], float)
