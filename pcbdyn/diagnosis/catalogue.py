@@ -156,7 +156,7 @@ def jointly(candidates):
     the kinds with a ``joint`` test state it (overlapping regions' stiffness changes add up); each
     magnitude's own bound is the kind's ``lower``."""
     tests = [(idx, kind(name).joint([candidates[i] for i in idx]))
-             for name, idx in _by_kind(candidates).items() if hasattr(kind(name), "joint")]
+             for name, idx in _by_kind(candidates).items() if getattr(kind(name), "joint", None)]
     return lambda values: all(ok(np.asarray(values, float)[idx]) for idx, ok in tests)
 
 

@@ -26,6 +26,7 @@ class _RegionMass(_RegionStiffness):
     scale = 1e-2
     lower = 0.0
     together = ("region_stiffness",)
+    joint = None  # masses over one area add and stay >= 0: no test taken together
 
     def generate(self, layout, patch: float = 0.02) -> list:
         return super().generate(layout, patch) if layout.planar else []
