@@ -13,9 +13,10 @@ whether what remains is noise, and otherwise find, place and size the effects th
    neither mistaken for an effect nor left in the error reported after; so is the plate theory's
    gap on the finest mesh (Mindlin against Kirchhoff: the board's transverse shear stiffness is a
    guess; :mod:`.model_form`).
-3. The declared parameters alone are fitted; if chi^2 is within what noise gives (chi-square
-   test, probability ``alpha``) the data lie in the range of the model (thesis section 5.2.3) and
-   nothing is invented.
+3. The declared parameters alone are fitted, by the diagnosis and as ``pcbdyn update`` fits them
+   (:mod:`.parameter_stage`; reported: the fit that pairs the frequencies better); if chi^2 is within
+   what noise gives (chi-square test, probability ``alpha``) the data lie in the range of the model
+   (thesis section 5.2.3) and nothing is invented.
 4. Otherwise the catalogue's candidates are searched (:func:`.select.search`) from the fitted
    parameters (and from the declared values where that fit pairs the frequencies worse than they do:
    :func:`.parameter_stage.declared_origin`), the effects' magnitudes estimated together with the
@@ -225,22 +226,24 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
     # the declared parameters alone, on the modes they can pair (a support's bounce has no partner without it)
     plain = ModalResidual.of_models(models, [ob.subset(~b) for ob, b in zip(obs, bounce)]) if support else res
     own = estimate(plain, start, [], [], 10, models.bounds)
-    update = update_start(structure, plain, (freq_noise_pct, shape_noise_pct), h, say) if names else None
-    base, origins = parameter_stage(plain, own, update, models, say)
+    update = update_start(structure, tests, (freq_noise_pct, shape_noise_pct), h, say) if names else None
+    base, origins, told = parameter_stage(plain, own, update, models, say)
     stats = {"quick": quick, "unpaired_test_modes": unmatched, "support_test_modes": shown, "chi2_before": before.chi2,
-             "update": None if update is None else {"status": update.status, "parameters": update.values,
-                                                    "parameters_only_from_update": base is not own},
              **range_test(plain, base, len(names), alpha),
              "mesh_correction_pct": [np.round(100 * (o.f_scale - 1.0), 4).tolist() for o in obs],
              "mesh_resolved": [f.resolved for f in forms],
              "plate_theory_pct": [np.round(100 * f.shift, 4).tolist() for f in forms],
              "sigma_f_pct": [np.round(100 * o.sigma_f, 4).tolist() for o in obs],
              "sigma_shape_pct": [None if o.sigma_s is None else np.round(100 * o.sigma_s, 4).tolist() for o in obs]}
-    out = dict(before=before.summary(obs), parameters_only=(res.evaluate(base.p) if support else base.state).summary(obs),
-               parameters={n: {"initial": float(a), "parameters_only": float(b)} for n, a, b in zip(names, p0, base.p)},
+    noise_only = stats["p_value_noise"] > alpha and not any(unmatched.values())
+    told = base if noise_only else told
+    stats["update"] = None if update is None else {"status": update.status, "parameters": update.values,
+                                                   "parameters_only_from_update": told is not own}
+    out = dict(before=before.summary(obs), parameters_only=(res.evaluate(told.p) if support else told.state).summary(obs),
+               parameters={n: {"initial": float(a), "parameters_only": float(b)} for n, a, b in zip(names, p0, told.p)},
                statistics=stats)
     record.update(out)
-    if stats["p_value_noise"] > alpha and not any(unmatched.values()):
+    if noise_only:
         for n, v in zip(names, base.p):
             out["parameters"][n]["final"] = float(v)
         return Diagnosis([], True, "what remains after fitting the declared parameters is within the noise "

@@ -3,7 +3,8 @@ never modelled (random outline, laminate, parts and fixtures, declared values of
 OpenSees on a mesh twice as fine as the model's, kept in ``generated/`` with their truth
 (:mod:`fixtures`). Each is judged as the benchmark judges (:mod:`score`): every hidden effect of
 detectable size found (kind, place, magnitude), none invented, and where effects were found the error
-after at most 0.5 %; a case without effects reports none."""
+after at most 0.5 %; a case without effects reports none; and the parameters-only error is no worse
+than `pcbdyn update`'s on the same files."""
 
 from __future__ import annotations
 
@@ -35,25 +36,28 @@ MISSED = {"s0012": "a 19 x 28 mm region 2.3 x stiffer near the free end of a nar
                    "alone: the two runs differ in the test file's digits or the workers (not traced)"}
 
 
-def _cases():
-    return [pytest.param(p, id=p.stem, marks=[pytest.mark.xdist_group(p.stem)] + (
-        [pytest.mark.xfail(reason=MISSED[p.stem], strict=True)] if p.stem in MISSED else []))
-            for p in sorted(HERE.glob("s*.json"))]
+@pytest.fixture(scope="module", params=[pytest.param(p, id=p.stem, marks=pytest.mark.xdist_group(p.stem))
+                                        for p in sorted(HERE.glob("s*.json"))])
+def diagnosed(request, tmp_path_factory):
+    """(the fixture's path, its case data, the folder of its files, diagnose's JSON on them)."""
+    fixture = request.param
+    data = json.loads(fixture.read_text())
+    case = Case.from_json(data["case"])
+    tmp = tmp_path_factory.mktemp(fixture.stem)
+    (tmp / "board.toml").write_text(data["board_toml"])
+    write_uff(tmp / "test.uff", noisy_test(case, data["frequencies_hz"], data["shapes_z"]))
+    r = CliRunner().invoke(main, ["diagnose", str(tmp / "board.toml"), str(tmp / "test.uff"), "--noise",
+                                  "f={:g},shape={:g}".format(*case.noise), "--json", str(tmp / "d.json")])
+    assert r.exit_code == 0, r.output
+    return fixture, data, tmp, json.loads((tmp / "d.json").read_text())
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("fixture", _cases())
-def test_generated_case(fixture, tmp_path):
-    data = json.loads(fixture.read_text())
+def test_generated_case(diagnosed, request):
+    fixture, data, _, result = diagnosed
+    if fixture.stem in MISSED:
+        request.applymarker(pytest.mark.xfail(reason=MISSED[fixture.stem], strict=True))
     case = Case.from_json(data["case"])
-    board = tmp_path / "board.toml"
-    board.write_text(data["board_toml"])
-    write_uff(tmp_path / "test.uff", noisy_test(case, data["frequencies_hz"], data["shapes_z"]))
-    js = tmp_path / "d.json"
-    r = CliRunner().invoke(main, ["diagnose", str(board), str(tmp_path / "test.uff"), "--noise",
-                                  "f={:g},shape={:g}".format(*case.noise), "--json", str(js)])
-    assert r.exit_code == 0, r.output
-    result = json.loads(js.read_text())
     v = judge({"case": data["case"], "signal_chi2": data["signal_chi2"]}, result, DETECTABLE_CHI2)
     missed = [a for a in v["atoms"] if a["detectable"] and not a["found"]]
     assert not missed, f"{fixture.stem}: not found {missed}; reported {result['effects']}"
@@ -62,3 +66,23 @@ def test_generated_case(fixture, tmp_path):
         assert result["after"]["max_freq_error_pct"] <= AFTER_MAX_PCT
     else:
         assert result["effects"] == []
+
+
+@pytest.mark.slow
+def test_parameters_only_no_worse_than_update(diagnosed):
+    """Diagnose's parameters-only error is never worse than ``pcbdyn update``'s on the same files (issue 37
+    item 2), on the test modes both pair, within the mesh correction diagnose measures (it extrapolates
+    three finer meshes, update checks one, and the two take slightly different corrections out). Before
+    diagnose reported update's state where it pairs the frequencies better, s0033's was 8.97 % against
+    update's 5.29 %: its own fit had given up the frequencies for the shapes."""
+    _, data, tmp, result = diagnosed
+    js = tmp / "u.json"
+    r = CliRunner().invoke(main, ["update", str(tmp / "board.toml"), str(tmp / "test.uff"), "--noise",
+                                  "f={:g},shape={:g}".format(*data["case"]["noise"]), "--json", str(js),
+                                  "--out", str(tmp / "u")])
+    assert r.exit_code == 0, r.output
+    update = {q["test_mode"]: abs(q["df_pct"]) for q in json.loads(js.read_text())["after"]["configurations"][0]["pairs"]}
+    ours = {m["test_mode"]: abs(m["df_pct"]) for m in result["parameters_only"]["configurations"][0]["modes"]
+            if m["paired"] and m["test_mode"] in update}
+    slack = max(abs(c) for c in result["statistics"]["mesh_correction_pct"][0])
+    assert max(ours.values()) <= max(update[n] for n in ours) + slack, (ours, update, slack)
