@@ -22,9 +22,9 @@ whether what remains is noise, and otherwise find, place and size the effects th
    :func:`.parameter_stage.declared_origin`), the effects' magnitudes estimated together with the
    declared parameters, each effect kept only if it also predicts data it was not fitted to; runs
    along the sides, stiffener lines, rectangular regions and point masses are walked to where they fit
-   best (:func:`.select.refine`, :class:`.moves.LocalMoves`) and a mass with an inertia beside it
-   refitted as one body
-   (:mod:`.bodies`). The masses (and supports) found are then put on the finer meshes and the mesh
+   best (:func:`.select.refine`, :class:`.moves.LocalMoves`), a mass with an inertia beside it
+   refitted as one body (:mod:`.bodies`) and two masses apart as one mass along a line
+   (:mod:`.mass_lines`). The masses (and supports) found are then put on the finer meshes and the mesh
    correction measured again (:func:`.budget.with_carried`: they change the shapes it depends on); where
    stiffeners were found, the structure is meshed along their lines first, every effect carried,
    and the ribs' ends and sections fitted there (:func:`_on_lines`, :mod:`.conforming`,
@@ -46,6 +46,7 @@ from .bodies import as_bodies
 from .catalogue import KINDS, generate, kind
 from .evidence import evidence
 from .layout import from_structure
+from .mass_lines import as_lines
 from .merge import MERGE_REACH, groups, mean_path, merged
 from .moves import LocalMoves, movable, on_node
 from . import conforming, geometry_fit
@@ -282,6 +283,10 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
         say("fitting a part found as a mass with an inertia beside it as one body")
         sel = as_bodies(res, cands, sel, groups([cands[i] for i in sel.chosen], MERGE_REACH * h),
                         MERGE_REACH * h, models.bounds, alpha=alpha)
+    if sum(cands[i].kind == "point_mass" for i in sel.chosen) >= 2:
+        say("fitting masses found apart as one mass along a line")
+        sel = as_lines(res, cands, sel, groups([cands[i] for i in sel.chosen], MERGE_REACH * h), layout, h / 2,
+                       models.bounds, alpha=alpha)
     sel = without_vanished(res, cands, sel, models.bounds, alpha=alpha)
     carried = [(cands[i], v) for i, v in zip(sel.chosen, sel.values) if cands[i].kind in MASS_KINDS or cands[i].between_nodes]
     searched = cands  # the candidates on the model's own mesh (the evidence map is drawn on it)

@@ -1,0 +1,98 @@
+"""A mass spread along a line across the plate (:mod:`pcbdyn.diagnosis.line_mass`'s lines across the
+plate) and two point masses found in its place refitted as that line (:mod:`pcbdyn.diagnosis.mass_lines`)."""
+
+import numpy as np
+import pytest
+
+from pcbdyn import diagnosis as dg
+from pcbdyn.diagnosis.line_mass import KIND
+from pcbdyn.diagnosis.mass_lines import as_lines
+from pcbdyn.diagnosis.merge import groups
+from pcbdyn.diagnosis.residual import ModalResidual, Observation
+from pcbdyn.diagnosis.select import Selection, estimate, penalty
+from pcbdyn.fe import EdgeSpringProperty, MassProperty, Model, ShellProperty
+from pcbdyn.fe.assembly import assemble
+from pcbdyn.fe.generate import nodes_where, rectangle
+from pcbdyn.fe.modal import solve_modes
+from pcbdyn.testdata import MeasuredModes
+
+N_MODES, SIGMA = 8, 0.002
+ENDS = np.array([[0.031, 0.047], [0.118, 0.139]])  # a 127 mm line at 47 degrees, ends between nodes
+
+
+@pytest.fixture(scope="module")
+def card():
+    """The 160 x 180 x 2.8 mm card in two guides of :mod:`test_select` (13 mm elements), a 30 g
+    mass declared off-centre, and its layout."""
+    nodes, conn = rectangle(0.16, 0.18, 12, 14)
+    m = Model(nodes)
+    m.add("plate", "quad4", conn, ShellProperty(26e9, 0.3, 2640.0, 2.8e-3))
+    for x in (0.0, 0.16):
+        e = nodes_where(nodes, x=x)
+        m.fix(e, ("ux", "uy", "uz", "rx", "rz"))
+        m.add(f"guide{x}", "edge_spring", np.c_[e[:-1], e[1:]], EdgeSpringProperty(k=(0, 0, 0, 300.0, 0, 0)))
+    m.add("declared", "mass", [[int(np.linalg.norm(nodes[:, :2] - [0.12, 0.05], axis=1).argmin())]], MassProperty(0.03))
+    return m, dg.from_model(m)
+
+
+def test_a_line_across_the_plate_keeps_its_mass_and_centre(card):
+    """Spread to the nodes of the cells it crosses, a 12 g line adds 12 g in each direction and its
+    centre of mass lies at the segment's midpoint (the shape functions reproduce linear fields), and
+    it is rebuilt along the same segment on another mesh."""
+    m, layout = card
+    line = KIND.across(layout, *ENDS)
+    assert line.data["length"] == pytest.approx(np.linalg.norm(ENDS[1] - ENDS[0]), rel=1e-9)
+    _, M0 = assemble(m)
+    _, M1 = assemble(dg.add_effect(m, line, 0.012))
+    dM = (M1 - M0).diagonal()
+    for d in (0, 1, 2):
+        assert dM[d::6].sum() == pytest.approx(0.012, rel=1e-9)
+    centre = dM[2::6] @ m.nodes[:, :2] / dM[2::6].sum()
+    assert centre == pytest.approx(ENDS.mean(axis=0), abs=1e-9)
+    nodes, conn = rectangle(0.16, 0.18, 20, 24)
+    fine = Model(nodes)
+    fine.add("plate", "quad4", conn, ShellProperty(26e9, 0.3, 2640.0, 2.8e-3))
+    moved = dg.place(dg.from_model(fine), line)
+    assert moved.name == line.name and np.allclose(moved.geometry["segment"], ENDS)
+
+
+def _as_pair(m, layout, f_test, masses):
+    """The selection of two point masses on the nodes nearest ``masses`` ((x, y) [m], kg) fitted to
+    ``f_test``, then :func:`as_lines` on it: (candidates, selection, chi^2 of the pair)."""
+    cands = [c for c in dg.generate(layout, kinds=["point_mass"])]
+    by_node = {int(c.nodes[0]): i for i, c in enumerate(cands)}
+    start = [by_node[int(np.linalg.norm(m.nodes[:, :2] - xy, axis=1).argmin())] for xy, _ in masses]
+    res = ModalResidual([Observation(None, MeasuredModes.frequencies_only(f_test), np.full(N_MODES, SIGMA))],
+                        lambda p: [m])
+    fit = estimate(res, np.zeros(0), [cands[i] for i in start], [v for _, v in masses], 8)
+    sel = Selection(chosen=start, values=fit.values, p=fit.p, chi2=[fit.chi2],
+                    criterion=[fit.chi2 + 2 * penalty(res.n_rows, len(cands))], state=fit.state)
+    return cands, as_lines(res, cands, sel, groups([cands[i] for i in start], 0.02), layout, 0.0065), fit.chi2
+
+
+def test_two_point_masses_standing_in_for_a_line_become_the_line(card):
+    """A 12 g line across the card, first fitted as two point masses on the nodes nearest its
+    two-point Gauss points: refitted as one line, its ends walked to within 3 mm of the truth's and its mass
+    within 3 %, the frequencies fitted better than by the pair."""
+    m, layout = card
+    f_test = solve_modes(dg.add_effect(m, KIND.across(layout, *ENDS), 0.012), n_modes=N_MODES).frequencies
+    mid, half = ENDS.mean(axis=0), 0.5 * (ENDS[1] - ENDS[0]) / np.sqrt(3.0)
+    cands, sel, pair = _as_pair(m, layout, f_test, [(mid - half, 0.006), (mid + half, 0.006)])
+    assert [cands[i].kind for i in sel.chosen] == ["line_mass"]
+    seg = cands[sel.chosen[0]].geometry["segment"]
+    assert np.linalg.norm(seg - ENDS, axis=1).max() < 0.003
+    assert sel.values[0] == pytest.approx(0.012, rel=0.03)
+    assert sel.chi2[-1] < pair
+
+
+def test_two_unequal_masses_apart_stay_two(card):
+    """A 20 g and a 5 g mass 95 mm apart are no line: the pair fits them, a line through them does
+    not, and both stay point masses."""
+    m, layout = card
+    at = [np.array([0.04, 0.05]), np.array([0.11, 0.115])]
+    truth = m.copy()
+    for k, (xy, v) in enumerate(zip(at, (0.020, 0.005))):
+        truth.add(f"hidden{k}", "mass", [[int(np.linalg.norm(m.nodes[:, :2] - xy, axis=1).argmin())]], MassProperty(v))
+    cands, sel, _ = _as_pair(m, layout, solve_modes(truth, n_modes=N_MODES).frequencies, [(at[0], 0.02), (at[1], 0.005)])
+    assert [cands[i].kind for i in sel.chosen] == ["point_mass", "point_mass"]
+    assert sorted(sel.values) == pytest.approx([0.005, 0.020], rel=1e-3)
