@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from pcbdyn.fe import Model, ShellProperty
+from pcbdyn.fe import EdgeSpringProperty, MassProperty, Model, ShellProperty
 from pcbdyn.fe.generate import nodes_where, rectangle
 from pcbdyn.fe.modal import solve_modes
 
@@ -17,6 +17,21 @@ def cantilever(nx=10, ny=8):
     m = Model(nodes)
     m.add("plate", "quad4", conn, PLATE)
     m.fix(nodes_where(nodes, x=0.0))
+    return m
+
+
+def guided_card(nx=12, ny=14):
+    """A 160 x 180 x 2.8 mm card in two guides (x = 0 and x = 160 mm, kr = 300 N m/rad/m), about 13
+    mm elements, carrying a declared 30 g mass off-centre (it breaks the mirror symmetries that
+    frequencies alone cannot resolve)."""
+    nodes, conn = rectangle(0.16, 0.18, nx, ny)
+    m = Model(nodes)
+    m.add("plate", "quad4", conn, ShellProperty(26e9, 0.3, 2640.0, 2.8e-3))
+    for x in (0.0, 0.16):
+        e = nodes_where(nodes, x=x)
+        m.fix(e, ("ux", "uy", "uz", "rx", "rz"))
+        m.add(f"guide{x}", "edge_spring", np.c_[e[:-1], e[1:]], EdgeSpringProperty(k=(0, 0, 0, 300.0, 0, 0)))
+    m.add("declared", "mass", [[node_at(m, 0.12, 0.05)]], MassProperty(0.03))
     return m
 
 

@@ -10,11 +10,13 @@ from pcbdyn.diagnosis.mass_lines import as_lines
 from pcbdyn.diagnosis.merge import groups
 from pcbdyn.diagnosis.residual import ModalResidual, Observation
 from pcbdyn.diagnosis.select import Selection, estimate, penalty
-from pcbdyn.fe import EdgeSpringProperty, MassProperty, Model, ShellProperty
+from pcbdyn.fe import MassProperty, Model, ShellProperty
 from pcbdyn.fe.assembly import assemble
-from pcbdyn.fe.generate import nodes_where, rectangle
+from pcbdyn.fe.generate import rectangle
 from pcbdyn.fe.modal import solve_modes
 from pcbdyn.testdata import MeasuredModes
+
+from diagnosis_plates import guided_card
 
 N_MODES, SIGMA = 8, 0.002
 ENDS = np.array([[0.031, 0.047], [0.118, 0.139]])  # a 127 mm line at 47 degrees, ends between nodes
@@ -22,16 +24,8 @@ ENDS = np.array([[0.031, 0.047], [0.118, 0.139]])  # a 127 mm line at 47 degrees
 
 @pytest.fixture(scope="module")
 def card():
-    """The 160 x 180 x 2.8 mm card in two guides of :mod:`test_select` (13 mm elements), a 30 g
-    mass declared off-centre, and its layout."""
-    nodes, conn = rectangle(0.16, 0.18, 12, 14)
-    m = Model(nodes)
-    m.add("plate", "quad4", conn, ShellProperty(26e9, 0.3, 2640.0, 2.8e-3))
-    for x in (0.0, 0.16):
-        e = nodes_where(nodes, x=x)
-        m.fix(e, ("ux", "uy", "uz", "rx", "rz"))
-        m.add(f"guide{x}", "edge_spring", np.c_[e[:-1], e[1:]], EdgeSpringProperty(k=(0, 0, 0, 300.0, 0, 0)))
-    m.add("declared", "mass", [[int(np.linalg.norm(nodes[:, :2] - [0.12, 0.05], axis=1).argmin())]], MassProperty(0.03))
+    """The guided card of :func:`diagnosis_plates.guided_card` (13 mm elements) and its layout."""
+    m = guided_card()
     return m, dg.from_model(m)
 
 

@@ -7,11 +7,12 @@ import shapely
 
 from pcbdyn import diagnosis as dg
 from pcbdyn.diagnosis.select import forward_select
-from pcbdyn.fe import EdgeSpringProperty, MassProperty, Model, ShellProperty
-from pcbdyn.fe.generate import nodes_where, rectangle
+from pcbdyn.fe import MassProperty
 from pcbdyn.fe.modal import solve_modes
 
 from pcbdyn.testdata import MeasuredModes
+
+from diagnosis_plates import guided_card
 
 N_MODES, SIGMA = 8, 0.002  # 8 paired modes, 0.2 % frequency noise
 NX, NY = 12, 14  # elements of the 160 x 180 mm card: about 13 mm
@@ -24,17 +25,9 @@ def nearest(model, x, y):
 
 @pytest.fixture(scope="module")
 def card():
-    """A 160 x 180 x 2.8 mm card in two guides (x = 0 and x = 160 mm, kr = 300 N m/rad/m) carrying
-    a declared 30 g mass off-centre (it breaks the mirror symmetries that frequencies alone cannot
-    resolve), with candidates of every kind."""
-    nodes, conn = rectangle(0.16, 0.18, NX, NY)
-    m = Model(nodes)
-    m.add("plate", "quad4", conn, ShellProperty(26e9, 0.3, 2640.0, 2.8e-3))
-    for x in (0.0, 0.16):
-        e = nodes_where(nodes, x=x)
-        m.fix(e, ("ux", "uy", "uz", "rx", "rz"))
-        m.add(f"guide{x}", "edge_spring", np.c_[e[:-1], e[1:]], EdgeSpringProperty(k=(0, 0, 0, 300.0, 0, 0)))
-    m.add("declared", "mass", [[nearest(m, 0.12, 0.05)]], MassProperty(0.03))
+    """The guided 160 x 180 mm card of :func:`diagnosis_plates.guided_card` (12 x 14 elements) with
+    candidates of every kind."""
+    m = guided_card(NX, NY)
     layout = dg.from_model(m, suspects={"points.exc": nearest(m, 0.04, 0.13)})
     return m, dg.generate(layout, segments=3, patch=0.04, path_spacing=0.04)
 
