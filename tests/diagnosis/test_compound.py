@@ -114,7 +114,10 @@ def test_bracket_found_as_a_mass_on_a_spring(bracket):
         assert e["magnitude"] == pytest.approx(t["magnitude"], rel=0.30), (t["type"], e)
         if t["type"] == "ground_spring":
             assert d <= 1.0
-    assert data["parameters_only"]["max_freq_error_pct"] > 2.0
+    # the parameters alone leave what the noise cannot give (their frequencies within 1.5 % since the fit
+    # reported is update's where it pairs them better), and the bracket takes the error below that
+    assert data["statistics"]["p_value_noise"] < data["statistics"]["alpha"]
+    assert data["after"]["max_freq_error_pct"] < data["parameters_only"]["max_freq_error_pct"]
     assert data["statistics"]["support_test_modes"] == {"base": [1]}
     before, after = (data[k]["configurations"][0] for k in ("before", "after"))
     assert before["unpaired_test_modes"] == [1] and "unpaired_test_modes" not in after
