@@ -72,8 +72,8 @@ def parameter_stage(plain, own, update, models, say) -> tuple:
 
 def reported(plain, fits):
     """Of ``fits`` of the declared parameters alone, the one that pairs the most test modes with the
-    smallest largest frequency error: the parameters-only error diagnose reports is no worse than
-    ``pcbdyn update``'s fit evaluated on the diagnosis's residual (issue 37). Not the lowest chi^2: the shape rows outnumber the frequencies
+    smallest largest frequency error: where update's fit pairs as many modes on the diagnosis's residual,
+    the parameters-only error diagnose reports is no worse than its (issue 37). Not the lowest chi^2: the shape rows outnumber the frequencies
     fifty to one, and with an effect missing their model error lets a fit give up every frequency for
     the shapes (a card lacking a stiff region: E 38 % down, every mode 20 % low, chi^2 halved)."""
     def key(fit):
