@@ -26,13 +26,13 @@ SPREAD = np.sqrt(3.0)
 
 def _masses(chosen, groups) -> list:
     """[(positions in ``chosen`` of one mass found: a group of point-mass shares, or a body of
-    :mod:`.bodies` with its inertia, positions of its mass)]."""
+    :mod:`.bodies` with its inertia (the two share the body's ``centre``), positions of its mass)]."""
     out = []
     for g in groups:
         if not all(chosen[k].kind == "point_mass" for k in g):
             continue
-        bodies = {chosen[k].name.rsplit(":", 1)[0] for k in g if "radius" in chosen[k].data}
-        inertias = [k for k, c in enumerate(chosen) if c.kind == "point_inertia" and c.name.rsplit(":", 1)[0] in bodies]
+        bodies = {chosen[k].data["centre"] for k in g if "radius" in chosen[k].data}
+        inertias = [k for k, c in enumerate(chosen) if c.kind == "point_inertia" and c.data.get("centre") in bodies]
         out.append((g + inertias, g))
     return out
 

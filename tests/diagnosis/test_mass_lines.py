@@ -90,3 +90,25 @@ def test_two_unequal_masses_apart_stay_two(card):
     cands, sel, _ = _as_pair(m, layout, solve_modes(truth, n_modes=N_MODES).frequencies, [(at[0], 0.02), (at[1], 0.005)])
     assert [cands[i].kind for i in sel.chosen] == ["point_mass", "point_mass"]
     assert sorted(sel.values) == pytest.approx([0.005, 0.020], rel=1e-3)
+
+
+def test_a_body_standing_in_for_half_a_line_goes_with_its_inertia(card):
+    """One of the two masses found as a body of :mod:`pcbdyn.diagnosis.bodies` (a mass and an inertia
+    at one centre, as on dev seed 40): the line replaces the mass and the inertia with it."""
+    from pcbdyn.diagnosis.bodies import _body
+
+    m, layout = card
+    f_test = solve_modes(dg.add_effect(m, KIND.across(layout, *ENDS), 0.012), n_modes=N_MODES).frequencies
+    mid, half = ENDS.mean(axis=0), 0.5 * (ENDS[1] - ENDS[0]) / np.sqrt(3.0)
+    cands = list(dg.generate(layout, kinds=["point_mass"]))
+    near = min(range(len(cands)), key=lambda i: np.linalg.norm(np.subtract(cands[i].at[:2], mid - half)))
+    cands += list(_body(cands[near], np.r_[mid + half, 0.0], 0.004))
+    start = [near, len(cands) - 2, len(cands) - 1]
+    res = ModalResidual([Observation(None, MeasuredModes.frequencies_only(f_test), np.full(N_MODES, SIGMA))],
+                        lambda p: [m])
+    fit = estimate(res, np.zeros(0), [cands[i] for i in start], [0.006, 0.006, 1e-7], 8)
+    sel = Selection(chosen=start, values=fit.values, p=fit.p, chi2=[fit.chi2],
+                    criterion=[fit.chi2 + 3 * penalty(res.n_rows, len(cands))], state=fit.state)
+    sel = as_lines(res, cands, sel, groups([cands[i] for i in start], 0.02), layout, 0.0065)
+    assert [cands[i].kind for i in sel.chosen] == ["line_mass"]
+    assert sel.values[0] == pytest.approx(0.012, rel=0.03)
