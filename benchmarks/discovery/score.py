@@ -123,8 +123,7 @@ def judge(truth: dict, result: dict, detectable_chi2: float) -> dict:
         for _, typ, g, _ in atoms(case, E_board))]
     out = {"atoms": rows, "invented": [(r.get("type"), r.get("at_mm")) for r in invented],
            "n_reported": len(reported), "noise_only_case": not case["effects"]}
-    if result:
-        out.update(before=result["before"]["max_freq_error_pct"],
-                   parameters_only=result["parameters_only"]["max_freq_error_pct"],
-                   after=result["after"]["max_freq_error_pct"], noise_only=result.get("noise_only"))
+    if result:  # a diagnosis stopped by an error keeps what it had computed: no "after"
+        out.update({k: result[k]["max_freq_error_pct"] for k in ("before", "parameters_only", "after") if k in result},
+                   noise_only=result.get("noise_only"))
     return out

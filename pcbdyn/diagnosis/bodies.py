@@ -19,7 +19,7 @@ from dataclasses import replace
 import numpy as np
 
 from .catalogue import weighted_centre
-from .fitting import RANK_STEPS, estimate
+from .fitting import estimate, pattern_search
 from .select import ALPHA, adopt, penalty
 
 #: fixed-point iterations on the radius of gyration, and the relative change that ends them
@@ -73,37 +73,21 @@ def _settle(res, p, others, home, centre, values, bounds, steps):
     return fit, body
 
 
-def _place(res, others, home, centre, fit, step: float, bounds):
-    """The centre moved by a pattern search (steps of ``step`` along x and y while chi^2 drops,
-    then halved, down to ``step`` / 8; quick fits at the radius found): the shares' centre is only
-    as good as the mesh they were found on, and a part beside a steep slope of a mode shape is
-    felt millimetres away."""
-    radius = np.sqrt(fit.values[-1] / fit.values[-2])
-    best, c = fit, np.asarray(centre, float)
-    for s in step / 2.0 ** np.arange(4):
-        moved = True
-        while moved:
-            moved = False
-            for d in ((s, 0.0), (-s, 0.0), (0.0, s), (0.0, -s)):
-                trial_c = c + (d[0], d[1], 0.0)
-                trial = estimate(res, best.p, others + list(_body(home, trial_c, radius)), best.values, RANK_STEPS,
-                                 bounds)
-                if trial.chi2 < best.chi2 * (1.0 - 1e-6):
-                    best, c, moved = trial, trial_c, True
-                    break
-    return c, best
-
-
 def _fit_body(res, candidates, sel, others, home, centre, m: float, J: float, step: float, bounds, newton_steps):
     """(fit, body candidates) of ``others`` (candidate indices) and a body starting at ``centre``
-    with (m, J): radius settled, centre placed (:func:`_place`), radius settled again; or None."""
+    with (m, J): radius settled, centre placed by a pattern search from ``step`` down to ``step`` / 8
+    (the shares' centre is only as good as the mesh they were found on, and a part beside a steep
+    slope of a mode shape is felt millimetres away), radius settled again; or None."""
     pos = {i: k for k, i in enumerate(sel.chosen)}
     rest = [candidates[i] for i in others]
     out = _settle(res, sel.p, rest, home, centre, np.r_[[sel.values[pos[i]] for i in others], m, J], bounds,
                   newton_steps)
     if out is None:
         return None
-    centre, quick = _place(res, rest, home, centre, out[0], step, bounds)
+    radius = np.sqrt(out[0].values[-1] / out[0].values[-2])
+    xy, quick = pattern_search(res, rest, centre[:2], lambda xy: list(_body(home, np.r_[xy, 0.0], radius)), out[0],
+                               step, 4, bounds)
+    centre = np.r_[xy, 0.0]
     return _settle(res, quick.p, rest, home, centre, quick.values, bounds, newton_steps)
 
 

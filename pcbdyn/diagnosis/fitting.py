@@ -83,3 +83,31 @@ def _jacobian(res, st, cands, npar, param_columns=None, run=None):
     if cands:
         cols.append((run or res).effect_columns(st, cands))
     return np.hstack(cols) if cols else np.zeros((res.n_rows, 0))
+
+
+def pattern_search(res, others: list, x, build, fit: Fit, step: float, levels: int, bounds=None, reduced=None,
+                   param_columns=None):
+    """(x, fit) of effects whose geometry is the coordinates ``x`` [m] (a centre, a line's ends), moved
+    one coordinate at a time by ``step`` either way while chi^2 drops, then by half that, ``levels``
+    step sizes in all; ``build(x)``: the candidates at ``x`` (None off the structure), fitted with
+    ``others`` by quick fits from ``fit`` (on ``reduced``, a :class:`.reanalysis.Reanalysis`, where
+    given, with the parameters' columns ``param_columns`` of its state: the fit returned is then that
+    reduced one). A mass's place is a geometric parameter the
+    linear fit of magnitudes cannot move (what :mod:`.bodies` and :mod:`.mass_lines` walk)."""
+    x = np.asarray(x, float).copy()
+    for s in step / 2.0 ** np.arange(levels):
+        moved = True
+        while moved:
+            moved = False
+            for k, d in ((k, d) for k in range(x.size) for d in (s, -s)):
+                trial_x = x.copy()
+                trial_x[k] += d
+                made = build(trial_x)
+                if made is None:
+                    continue
+                trial = estimate(res, fit.p, others + made, fit.values, RANK_STEPS, bounds, param_columns=param_columns,
+                                 reduced=reduced)
+                if trial.state is not None and trial.chi2 < fit.chi2 * (1.0 - 1e-6):
+                    x, fit, moved = trial_x, trial, True
+                    break
+    return x, fit

@@ -1,5 +1,5 @@
-"""Two point masses found apart that are one mass spread along a line (a cable, a harness, a bar's
-mass across the board; issue 37). A uniform line of mass m and length L has the mass, the centre and
+"""Point masses found that are one mass spread along a line (a cable, a harness, a bar's mass across
+the board; issue 37). A uniform line of mass m and length L has the mass, the centre and
 the second moments about its centre of two masses m / 2 at L / (2 sqrt 3) either side of the centre
 (the two-point Gauss rule of the line), so the low modes hardly tell the two apart, and forward
 selection, which adds one point at a time, finds the pair (or one of them as a body with an inertia,
@@ -7,7 +7,10 @@ selection, which adds one point at a time, finds the pair (or one of them as a b
 they are apart, carrying their summed mass; its ends are then walked to where the data put them (the
 pair stood on nodes), and the line replaces the pair where it lowers the information criterion of
 :mod:`.select` (one effect instead of two or three; two unequal masses apart fit the line worse, and
-stay)."""
+stay). A line the search found as one mass (its centre; a body whose inertia stands for the line's
+second moment) is tried as lines through that centre in four directions and several lengths, the
+best walked the same way; it must lower the criterion by one effect's penalty more, as its direction
+and length are two coordinates a point does not have."""
 
 from __future__ import annotations
 
@@ -16,12 +19,16 @@ from itertools import combinations
 import numpy as np
 
 from .catalogue import weighted_centre
-from .fitting import RANK_STEPS, estimate
+from .fitting import RANK_STEPS, estimate, pattern_search
 from .line_mass import KIND
+from .merge import groups
+from .reanalysis import Reanalysis
 from .select import ALPHA, adopt, penalty
 
 #: a line's length over the distance between the two point masses that stand in for it
 SPREAD = np.sqrt(3.0)
+#: lengths a line standing for one mass is first tried at (each sqrt 2 times the one before)
+LENGTHS = 7
 
 
 def _masses(chosen, groups) -> list:
@@ -50,52 +57,103 @@ def _pairs(candidates, sel, groups) -> list:
     return sorted(out, key=lambda t: float(np.linalg.norm(t[2][1] - t[2][0])))
 
 
-def _walk(res, others, line, fit, layout, step: float, bounds):
-    """(line, fit) with each end moved by a pattern search (steps of ``step`` [m] along x and y while
-    chi^2 drops, then halved, down to ``step`` / 4; quick fits)."""
-    ends = np.asarray(line.geometry["segment"], float)
-    for s in step / 2.0 ** np.arange(3):
-        moved = True
-        while moved:
-            moved = False
-            for k, d in ((k, d) for k in (0, 1) for d in ((s, 0.0), (-s, 0.0), (0.0, s), (0.0, -s))):
-                trial_ends = ends.copy()
-                trial_ends[k] += d
-                trial_line = KIND.across(layout, *trial_ends)
-                if trial_line is None:
-                    continue
-                trial = estimate(res, fit.p, others + [trial_line], fit.values, RANK_STEPS, bounds)
-                if trial.state is not None and trial.chi2 < fit.chi2 * (1.0 - 1e-6):
-                    line, fit, ends, moved = trial_line, trial, trial_ends, True
-                    break
-    return line, fit
+def _lines(layout):
+    """The lines a pattern search tries: ends (x0, y0, x1, y1) [m] -> [the line mass across ``layout``'s
+    plate], None where it misses the plate or its ends meet."""
+    def build(ends):
+        ends = np.reshape(ends, (2, 2))
+        line = None if np.linalg.norm(ends[1] - ends[0]) < 1e-6 else KIND.across(layout, *ends)
+        return None if line is None else [line]
+    return build
 
 
-def as_lines(res, candidates: list, sel, groups, layout, step: float, bounds=None, newton_steps: int = 8,
+def _singles(candidates, sel, groups, h: float) -> list:
+    """[(candidate indices of one mass found (a body's inertia with its mass), its mass, centre (2,)
+    [m], the length a line standing for it starts at)]: a body's radius of gyration r gives the line
+    of the same rotary inertia averaged over the two in-plane axes (m L^2 / 24 = m r^2); a point
+    mass, two elements."""
+    chosen = [candidates[i] for i in sel.chosen]
+    v = np.asarray(sel.values, float)
+    out = []
+    for g, gm in _masses(chosen, groups):
+        radius = max((chosen[k].data.get("radius", 0.0) for k in gm), default=0.0)
+        length = max(np.sqrt(24.0) * radius, 2.0 * h)
+        out.append(([sel.chosen[k] for k in g], float(v[gm].sum()), weighted_centre([chosen[k] for k in gm], v[gm])[:2],
+                    length))
+    return out
+
+
+def _oriented(res, sel, rest, values, m, centre, length, layout, bounds) -> tuple:
+    """(ends (2, 2) [m], chi^2) of the line through ``centre`` that fits best of four directions (0,
+    45, 90, 135 degrees) and :data:`LENGTHS` lengths from ``length`` up, by quick fits reduced to the
+    selection's solved state (:class:`.reanalysis.Reanalysis`; the mass it stands for goes to zero);
+    ends None where none lies on the plate."""
+    rx, P = Reanalysis(res, sel.state), res.param_columns(sel.state)
+    best, ends = np.inf, None
+    for a, L in ((a, length * 2.0 ** (k / 2)) for a in np.deg2rad([0.0, 45.0, 90.0, 135.0]) for k in range(LENGTHS)):
+        half = 0.5 * L * np.array([np.cos(a), np.sin(a)])
+        e = np.array([centre - half, centre + half])
+        line = KIND.across(layout, *e)
+        if line is None:
+            continue
+        trial = estimate(res, sel.p, rest + [line], np.r_[values, m], RANK_STEPS, bounds, param_columns=P, reduced=rx)
+        if trial.state is not None and trial.chi2 < best:
+            best, ends = trial.chi2, e
+    return ends, best
+
+
+def _as_line(res, candidates, sel, replaced, m, ends, layout, step, bounds, newton_steps, pen, extra: float) -> bool:
+    """Replace the chosen effects ``replaced`` (candidate indices) by one line mass of mass ``m``
+    starting at ``ends``, walked (:func:`.fitting.pattern_search`, quick fits reduced to the line's
+    fitted state where it starts: a walk is hundreds of them), where the criterion drops by more than
+    ``extra``; True when it did (``sel`` updated in place, the line appended to ``candidates``)."""
+    line = KIND.across(layout, *ends)
+    if line is None:
+        return False
+    pos = {i: k for k, i in enumerate(sel.chosen)}
+    others = [i for i in sel.chosen if i not in replaced]
+    rest = [candidates[i] for i in others]
+    fit = estimate(res, sel.p, rest + [line], np.r_[[sel.values[pos[i]] for i in others], m], newton_steps, bounds)
+    if fit.state is None or not fit.values[-1] > 0:
+        return False
+    rx, P = Reanalysis(res, fit.state), res.param_columns(fit.state)
+    start = estimate(res, fit.p, rest + [line], fit.values, RANK_STEPS, bounds, param_columns=P, reduced=rx)
+    ends, quick = pattern_search(res, rest, np.ravel(line.geometry["segment"]), _lines(layout), start, step, 3, bounds,
+                                 reduced=rx, param_columns=P)
+    line = KIND.across(layout, *ends.reshape(2, 2))
+    fit = estimate(res, quick.p, rest + [line], quick.values, newton_steps, bounds)
+    if fit.state is None or not fit.values[-1] > 0 or not fit.chi2 + (len(others) + 1) * pen + extra < sel.criterion[-1]:
+        return False
+    candidates.append(line)
+    adopt(sel, others + [len(candidates) - 1], fit, pen)
+    return True
+
+
+def as_lines(res, candidates: list, sel, reach: float, layout, step: float, bounds=None, newton_steps: int = 8,
              alpha: float = ALPHA):
-    """``sel`` with each pair of chosen point-mass groups (``groups``: lists of positions in
-    ``sel.chosen`` reported as one effect) refitted as one line mass across ``layout``'s plate (module
-    doc), its ends walked from steps of ``step`` [m], where that lowers the criterion. Line candidates
-    are appended to ``candidates``; ``sel`` is updated in place."""
+    """``sel`` with each pair of chosen point-mass groups (effects within ``reach`` [m], reported as
+    one: :func:`.merge.groups`) refitted as one line mass across ``layout``'s plate (module doc), its
+    ends walked from steps of ``step`` [m], where that lowers the criterion; then each mass left alone
+    tried as lines through its centre, the best walked where it already fits better than the mass
+    and kept where the criterion drops by one effect's penalty more (module doc). Line candidates are
+    appended to ``candidates``; ``sel`` is updated in place."""
     if not layout.planar:
         return sel
     pen = penalty(res.n_rows, len(candidates), alpha)
-    for pair, m, ends in _pairs(candidates, sel, groups):
-        if not set(pair) <= set(sel.chosen) or not m > 0:  # a mass already taken by another line
-            continue
-        line = KIND.across(layout, *ends)
-        if line is None:
+
+    def mass_groups():
+        return groups([candidates[i] for i in sel.chosen], reach)
+
+    for pair, m, ends in _pairs(candidates, sel, mass_groups()):
+        if set(pair) <= set(sel.chosen) and m > 0:  # not a mass already taken by another line
+            _as_line(res, candidates, sel, pair, m, ends, layout, step, bounds, newton_steps, pen, 0.0)
+    for single, m, centre, length in _singles(candidates, sel, mass_groups(), 2.0 * step):
+        if not (set(single) <= set(sel.chosen) and m > 0):
             continue
         pos = {i: k for k, i in enumerate(sel.chosen)}
-        others = [i for i in sel.chosen if i not in pair]
-        rest = [candidates[i] for i in others]
-        fit = estimate(res, sel.p, rest + [line], np.r_[[sel.values[pos[i]] for i in others], m], newton_steps, bounds)
-        if fit.state is None or not fit.values[-1] > 0:
-            continue
-        line, quick = _walk(res, rest, line, fit, layout, step, bounds)
-        fit = estimate(res, quick.p, rest + [line], quick.values, newton_steps, bounds)
-        if fit.state is None or not fit.values[-1] > 0 or not fit.chi2 + (len(others) + 1) * pen < sel.criterion[-1]:
-            continue
-        candidates.append(line)
-        adopt(sel, others + [len(candidates) - 1], fit, pen)
+        others = [i for i in sel.chosen if i not in single]
+        ends, chi2 = _oriented(res, sel, [candidates[i] for i in others], [sel.values[pos[i]] for i in others], m,
+                               centre, length, layout, bounds)
+        if ends is not None and chi2 < sel.chi2[-1]:  # else no line is worth walking
+            _as_line(res, candidates, sel, single, m, ends, layout, step, bounds, newton_steps, pen, pen)
     return sel

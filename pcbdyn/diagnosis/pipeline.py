@@ -283,10 +283,9 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
         say("fitting a part found as a mass with an inertia beside it as one body")
         sel = as_bodies(res, cands, sel, groups([cands[i] for i in sel.chosen], MERGE_REACH * h),
                         MERGE_REACH * h, models.bounds, alpha=alpha)
-    if sum(cands[i].kind == "point_mass" for i in sel.chosen) >= 2:
-        say("fitting masses found apart as one mass along a line")
-        sel = as_lines(res, cands, sel, groups([cands[i] for i in sel.chosen], MERGE_REACH * h), layout, h / 2,
-                       models.bounds, alpha=alpha)
+    if any(cands[i].kind == "point_mass" for i in sel.chosen):
+        say("fitting masses found as masses along lines")
+        sel = as_lines(res, cands, sel, MERGE_REACH * h, layout, h / 2, models.bounds, alpha=alpha)
     sel = without_vanished(res, cands, sel, models.bounds, alpha=alpha)
     carried = [(cands[i], v) for i, v in zip(sel.chosen, sel.values) if cands[i].kind in MASS_KINDS or cands[i].between_nodes]
     searched = cands  # the candidates on the model's own mesh (the evidence map is drawn on it)

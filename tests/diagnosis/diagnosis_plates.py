@@ -20,13 +20,13 @@ def cantilever(nx=10, ny=8):
     return m
 
 
-def guided_card(nx=12, ny=14):
+def guided_card(nx=12, ny=14, E=26e9):
     """A 160 x 180 x 2.8 mm card in two guides (x = 0 and x = 160 mm, kr = 300 N m/rad/m), about 13
     mm elements, carrying a declared 30 g mass off-centre (it breaks the mirror symmetries that
-    frequencies alone cannot resolve)."""
+    frequencies alone cannot resolve); the laminate's modulus ``E`` [Pa]."""
     nodes, conn = rectangle(0.16, 0.18, nx, ny)
     m = Model(nodes)
-    m.add("plate", "quad4", conn, ShellProperty(26e9, 0.3, 2640.0, 2.8e-3))
+    m.add("plate", "quad4", conn, ShellProperty(E, 0.3, 2640.0, 2.8e-3))
     for x in (0.0, 0.16):
         e = nodes_where(nodes, x=x)
         m.fix(e, ("ux", "uy", "uz", "rx", "rz"))
