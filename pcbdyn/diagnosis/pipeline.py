@@ -23,8 +23,8 @@ whether what remains is noise, and otherwise find, place and size the effects th
    declared parameters, each effect kept only if it also predicts data it was not fitted to; runs
    along the sides, stiffener lines, rectangular regions and point masses are walked to where they fit
    best (:func:`.select.refine`, :class:`.moves.LocalMoves`), a mass with an inertia beside it
-   refitted as one body (:mod:`.bodies`) and two masses apart as one mass along a line
-   (:mod:`.mass_lines`). The masses (and supports) found are then put on the finer meshes and the mesh
+   refitted as one body (:mod:`.bodies`), two masses apart, or one alone, as one mass along a
+   line (:mod:`.mass_lines`). The masses (and supports) found are then put on the finer meshes and the mesh
    correction measured again (:func:`.budget.with_carried`: they change the shapes it depends on); where
    stiffeners were found, the structure is meshed along their lines first, every effect carried,
    and the ribs' ends and sections fitted there (:func:`_on_lines`, :mod:`.conforming`,
