@@ -92,8 +92,8 @@ def pattern_search(res, others: list, x, build, fit: Fit, step: float, levels: i
     step sizes in all; ``build(x)``: the candidates at ``x`` (None off the structure), fitted with
     ``others`` by quick fits from ``fit`` (on ``reduced``, a :class:`.reanalysis.Reanalysis`, where
     given, with the parameters' columns ``param_columns`` of its state: the fit returned is then that
-    reduced one). A mass's place is a geometric parameter the
-    linear fit of magnitudes cannot move (what :mod:`.bodies` and :mod:`.mass_lines` walk)."""
+    reduced one). A mass's place is a geometric parameter the linear fit of magnitudes cannot move
+    (what :mod:`.bodies` and :mod:`.mass_lines` walk)."""
     x = np.asarray(x, float).copy()
     for s in step / 2.0 ** np.arange(levels):
         moved = True

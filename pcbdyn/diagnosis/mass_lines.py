@@ -117,6 +117,7 @@ def _as_line(res, candidates, sel, replaced, m, ends, layout, step, bounds, newt
     if fit.state is None or not fit.values[-1] > 0:
         return False
     rx, P = Reanalysis(res, fit.state), res.param_columns(fit.state)
+    # the walk compares reduced fits with a reduced fit, not with the full one
     start = estimate(res, fit.p, rest + [line], fit.values, RANK_STEPS, bounds, param_columns=P, reduced=rx)
     ends, quick = pattern_search(res, rest, np.ravel(line.geometry["segment"]), _lines(layout), start, step, 3, bounds,
                                  reduced=rx, param_columns=P)
