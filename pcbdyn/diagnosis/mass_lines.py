@@ -67,19 +67,23 @@ def _lines(layout):
     return build
 
 
-def _singles(candidates, sel, groups, h: float) -> list:
+def _singles(candidates, sel, groups, h: float, reach: float) -> list:
     """[(candidate indices of one mass found (a body's inertia with its mass), its mass, centre (2,)
     [m], the length a line standing for it starts at)]: a body's radius of gyration r gives the line
     of the same rotary inertia averaged over the two in-plane axes (m L^2 / 24 = m r^2); a point
-    mass, two elements."""
+    mass, two elements. A mass with a spring to ground found within ``reach`` [m] is a bracket (a
+    mass held by a spring), not a line, and is left out."""
     chosen = [candidates[i] for i in sel.chosen]
     v = np.asarray(sel.values, float)
+    springs = np.array([c.at[:2] for c in chosen if c.kind == "ground_spring"], float).reshape(-1, 2)
     out = []
     for g, gm in _masses(chosen, groups):
+        centre = weighted_centre([chosen[k] for k in gm], v[gm])[:2]
+        if (np.linalg.norm(springs - centre, axis=1) <= reach).any():
+            continue
         radius = max((chosen[k].data.get("radius", 0.0) for k in gm), default=0.0)
         length = max(np.sqrt(24.0) * radius, 2.0 * h)
-        out.append(([sel.chosen[k] for k in g], float(v[gm].sum()), weighted_centre([chosen[k] for k in gm], v[gm])[:2],
-                    length))
+        out.append(([sel.chosen[k] for k in g], float(v[gm].sum()), centre, length))
     return out
 
 
@@ -148,7 +152,7 @@ def as_lines(res, candidates: list, sel, reach: float, layout, step: float, boun
     for pair, m, ends in _pairs(candidates, sel, mass_groups()):
         if set(pair) <= set(sel.chosen) and m > 0:  # not a mass already taken by another line
             _as_line(res, candidates, sel, pair, m, ends, layout, step, bounds, newton_steps, pen, 0.0)
-    for single, m, centre, length in _singles(candidates, sel, mass_groups(), 2.0 * step):
+    for single, m, centre, length in _singles(candidates, sel, mass_groups(), 2.0 * step, reach):
         if not (set(single) <= set(sel.chosen) and m > 0):
             continue
         pos = {i: k for k, i in enumerate(sel.chosen)}
