@@ -31,16 +31,18 @@ SPREAD = np.sqrt(3.0)
 LENGTHS = 7
 
 
-def _masses(chosen, groups) -> list:
+def _masses(chosen, values, groups) -> list:
     """[(positions in ``chosen`` of one mass found: a group of point-mass shares, or a body of
-    :mod:`.bodies` with its inertia (the two share the body's ``centre``), positions of its mass)]."""
+    :mod:`.bodies` with its inertia (the two share the body's ``centre``), positions of its mass, the
+    mass, its centre (2,) [m])]; ``values``: the chosen effects' magnitudes."""
+    v = np.asarray(values, float)
     out = []
     for g in groups:
         if not all(chosen[k].kind == "point_mass" for k in g):
             continue
         bodies = {chosen[k].data["centre"] for k in g if "radius" in chosen[k].data}
         inertias = [k for k, c in enumerate(chosen) if c.kind == "point_inertia" and c.data.get("centre") in bodies]
-        out.append((g + inertias, g))
+        out.append((g + inertias, g, float(v[g].sum()), weighted_centre([chosen[k] for k in g], v[g])[:2]))
     return out
 
 
@@ -48,12 +50,10 @@ def _pairs(candidates, sel, groups) -> list:
     """[(candidate indices of both masses (a body's inertia with its mass), their summed mass, the
     line's ends (2, 2) [m])] for every two masses found, nearest first."""
     chosen = [candidates[i] for i in sel.chosen]
-    v = np.asarray(sel.values, float)
     out = []
-    for (g, gm), (h, hm) in combinations(_masses(chosen, groups), 2):
-        a, b = (weighted_centre([chosen[k] for k in q], v[q])[:2] for q in (gm, hm))
+    for (g, _, ma, a), (h, _, mb, b) in combinations(_masses(chosen, sel.values, groups), 2):
         mid, half = 0.5 * (a + b), 0.5 * SPREAD * (b - a)
-        out.append(([sel.chosen[k] for k in g + h], float(v[gm + hm].sum()), np.array([mid - half, mid + half])))
+        out.append(([sel.chosen[k] for k in g + h], ma + mb, np.array([mid - half, mid + half])))
     return sorted(out, key=lambda t: float(np.linalg.norm(t[2][1] - t[2][0])))
 
 
@@ -74,16 +74,13 @@ def _singles(candidates, sel, groups, h: float, reach: float) -> list:
     mass, two elements. A mass with a spring to ground found within ``reach`` [m] is a bracket (a
     mass held by a spring), not a line, and is left out."""
     chosen = [candidates[i] for i in sel.chosen]
-    v = np.asarray(sel.values, float)
     springs = np.array([c.at[:2] for c in chosen if c.kind == "ground_spring"], float).reshape(-1, 2)
     out = []
-    for g, gm in _masses(chosen, groups):
-        centre = weighted_centre([chosen[k] for k in gm], v[gm])[:2]
+    for g, gm, m, centre in _masses(chosen, sel.values, groups):
         if (np.linalg.norm(springs - centre, axis=1) <= reach).any():
             continue
         radius = max((chosen[k].data.get("radius", 0.0) for k in gm), default=0.0)
-        length = max(np.sqrt(24.0) * radius, 2.0 * h)
-        out.append(([sel.chosen[k] for k in g], float(v[gm].sum()), centre, length))
+        out.append(([sel.chosen[k] for k in g], m, centre, max(np.sqrt(24.0) * radius, 2.0 * h)))
     return out
 
 
