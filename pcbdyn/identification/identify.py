@@ -104,20 +104,21 @@ def identify(frfs, band=None, max_order: int = 40, select=None) -> Identificatio
     c = stability.chart(all_poles, f, rows, frfs.kind, band)
     groups, notes = (stability.auto_select(c), []) if select is None else stability.pick(c, select)
     chosen = [stability.representative(c, g) for g in groups]
-    poles = c.pole[chosen]
+    poles = np.array([stability.group_pole(c, g) for g in groups])
     A = lscf.residues(poles, f, rows, frfs.kind)
     if select is None:  # the automatic choice keeps the modes the FRFs show (stability.MIN_SHARE)
         seen = stability.share(poles, A, f, rows, frfs.kind) >= stability.MIN_SHARE
         if not seen.all():
             groups = [g for g, s in zip(groups, seen) if s]
             chosen = [k for k, s in zip(chosen, seen) if s]
-            poles = c.pole[chosen]
+            poles = poles[seen]
             A = lscf.residues(poles, f, rows, frfs.kind)
     psi, scaling = shapes(A, pairs, frfs, poles)
     phi, mpc = real_modes(psi)
     big = np.argmax(np.abs(phi), axis=0)
     phi = phi * np.sign(phi[big, np.arange(phi.shape[1])])
-    modes = MeasuredModes(frfs.points, frfs.response, c.frequency[chosen], phi, c.damping[chosen], mpc)
+    modes = MeasuredModes(frfs.points, frfs.response, np.abs(poles) / (2.0 * np.pi), phi, -poles.real / np.abs(poles),
+                          mpc)
     return Identification(modes, c, chosen, "auto" if select is None else "manual", scaling,
                           (float(lo), float(hi)), order, _neighbours(phi), indicators(psi, mpc, c, groups),
                           stability.criteria(len(rows)), notes)

@@ -20,7 +20,7 @@ neighbours starts a new group; a group holding two poles of one order is cut at 
 into as many modes); a group is a mode when it is seen at MIN_SUPPORT of the orders from the one it
 first appears at (a mode of a wide band appears only once the order can hold it; on a noisy FRF the
 noise poles take turns with it at the nearest-pole comparison, so its column has gaps) and at
-MIN_ORDERS_FRACTION of all orders, at least 3; it is represented by its pole of median frequency.
+MIN_ORDERS_FRACTION of all orders, at least 3; it is represented by its pole of median frequency, with the median damping of its column.
 A mode must then be seen in the data (:func:`share`): in the FRF where its modal term is largest, that
 term makes at least MIN_SHARE of the measured FRF at its own frequency. A pole fitted to noise, or to
 the skirt of a strong neighbour or of a mode outside the band, can be as stable on a single FRF as a
@@ -162,10 +162,25 @@ def share(poles, A, f, rows, kind: str) -> np.ndarray:
     return out
 
 
-def representative(c: Chart, g) -> int:
-    """The pole standing for a group: of median frequency among its most stable poles."""
+def _most_stable(c: Chart, g) -> np.ndarray:
     rank = np.array([RANK[s] for s in c.code[g]], dtype=int)
-    return _median_pole(c, np.asarray(g)[rank == rank.max()])
+    return np.asarray(g)[rank == rank.max()]
+
+
+def representative(c: Chart, g) -> int:
+    """The pole standing for a group in the chart: of median frequency among its most stable poles."""
+    return _median_pole(c, _most_stable(c, g))
+
+
+def group_pole(c: Chart, g) -> complex:
+    """The mode's pole: the representative's natural frequency and the median damping ratio of the
+    group's most stable poles. One pole's damping scatters from order to order far more than its
+    frequency does (on one noisy FRF a pole of median frequency had 0.18 % for a 0.8 % mode whose
+    column's median was 0.70 %), so the column's median stands for it, as the cluster statistics of
+    automated modal analysis do (Reynders et al. 2012)."""
+    wn = 2.0 * np.pi * c.frequency[representative(c, g)]
+    z = float(np.median(c.damping[_most_stable(c, g)]))
+    return complex(-z * wn, wn * np.sqrt(1.0 - z * z))
 
 
 def pick(c: Chart, frequencies) -> tuple:

@@ -3,7 +3,8 @@ damped plate gives: a strong low mode below the band, and above it pairs of clos
 apart, damping 0.5-0.8 %) with residues a tenth of the low mode's or less; 2 % complex noise on every
 line, 0.5 Hz lines. The true poles are known: every mode of the band is found, and nothing else (the
 choice before issue 38's plates gave 3 to 5 modes for these 7, one a noise pole at 302 Hz); the damping
-of one noisy FRF is known only roughly (a close pair's 0.5 % comes out at 0.76 %)."""
+of one noisy FRF is known to some 15 % when a mode's column of poles gives it (the one pole of median
+frequency once gave 0.18 % for 0.8 %)."""
 
 import numpy as np
 import pytest
@@ -39,5 +40,5 @@ def test_every_close_mode_of_one_noisy_frf_and_no_other(seed):
     assert r.selection == "auto" and r.criteria["shape_test"] == "none: one FRF"
     assert r.modes.n_modes == truth.shape[0], r.modes.frequencies
     np.testing.assert_allclose(r.modes.frequencies, truth[:, 0], rtol=0.005)
-    assert np.all((r.modes.damping > truth[:, 1] / 2) & (r.modes.damping < 2 * truth[:, 1])), r.modes.damping
+    np.testing.assert_allclose(r.modes.damping, truth[:, 1], rtol=0.25)
     assert r.criteria["min_share_of_frf"] == 0.5
