@@ -118,22 +118,25 @@ class Blocks:
     owner: np.ndarray
 
 
-def spread_mass_blocks(candidates, weights) -> list:
-    """Blocks of dM/dm for masses spread over each candidate's nodes by ``weights`` (one array per
-    candidate, summing to one) on the three translations; dK = 0."""
-    nodes = np.concatenate([c.nodes for c in candidates])
-    Me = np.zeros((nodes.size, 6, 6))
-    Me[:, [0, 1, 2], [0, 1, 2]] = np.concatenate(weights)[:, None]
-    owner = np.repeat(np.arange(len(candidates)), [c.nodes.size for c in candidates])
-    return [Blocks(nodes[:, None], np.zeros_like(Me), Me, owner)]
+class SpreadMass:
+    """Base of the kinds whose parameter is a mass m spread over the candidate's nodes by the kind's
+    ``weights(model, candidate)`` (summing to one) on the three translations: M is linear in m, K does
+    not depend on it."""
 
+    def blocks(self, model, candidates) -> list:
+        """Blocks of dM/dm; dK = 0."""
+        nodes = np.concatenate([c.nodes for c in candidates])
+        Me = np.zeros((nodes.size, 6, 6))
+        Me[:, [0, 1, 2], [0, 1, 2]] = np.concatenate([self.weights(model, c) for c in candidates])[:, None]
+        owner = np.repeat(np.arange(len(candidates)), [c.nodes.size for c in candidates])
+        return [Blocks(nodes[:, None], np.zeros_like(Me), Me, owner)]
 
-def with_spread_mass(model, candidate, weights, value: float):
-    """A copy of ``model`` with mass ``value`` spread over the candidate's nodes by ``weights``."""
-    m = model.copy()
-    for k, (n, w) in enumerate(zip(candidate.nodes, weights)):
-        m.add(f"effects.{candidate.name}.{k}", "mass", [[int(n)]], MassProperty(value * w))
-    return m
+    def apply(self, model, candidate, value: float):
+        """A copy of ``model`` with mass ``value`` spread over the candidate's nodes."""
+        m = model.copy()
+        for k, (n, w) in enumerate(zip(candidate.nodes, self.weights(model, candidate))):
+            m.add(f"effects.{candidate.name}.{k}", "mass", [[int(n)]], MassProperty(value * w))
+        return m
 
 
 def kind(name: str):

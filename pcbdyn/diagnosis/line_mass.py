@@ -10,11 +10,11 @@ from __future__ import annotations
 import numpy as np
 
 from ..board.effects import tributary_weights
-from .catalogue import register, AlongSides, Candidate, spread_mass_blocks, with_spread_mass
+from .catalogue import register, AlongSides, Candidate, SpreadMass
 from .stiffener import label
 
 
-class _LineMass(AlongSides):
+class _LineMass(SpreadMass, AlongSides):
     name = report_as = "line_mass"
     param = "mass"
     unit = "kg"
@@ -52,12 +52,6 @@ class _LineMass(AlongSides):
                 raise ValueError(f"{candidate.name}: its line misses the plate")
             return c
         return super().place(layout, candidate)
-
-    def blocks(self, model, candidates) -> list:
-        return spread_mass_blocks(candidates, [self.weights(model, c) for c in candidates])
-
-    def apply(self, model, candidate, value: float):
-        return with_spread_mass(model, candidate, self.weights(model, candidate), value)
 
 
 KIND = _LineMass()

@@ -14,11 +14,11 @@ from __future__ import annotations
 import numpy as np
 
 from ..board.effects import area_weights
-from .catalogue import register, spread_mass_blocks, with_spread_mass
+from .catalogue import register, SpreadMass
 from .region_stiffness import _RegionStiffness
 
 
-class _RegionMass(_RegionStiffness):
+class _RegionMass(SpreadMass, _RegionStiffness):
     name = report_as = "region_mass"
     uses_properties = False
     param = "mass"
@@ -35,12 +35,6 @@ class _RegionMass(_RegionStiffness):
     def weights(model, candidate) -> np.ndarray:
         """The share of the mass at each of ``candidate.nodes`` (sum 1)."""
         return area_weights(model.nodes[:, :2], list(candidate.data["cells"].values()), candidate.nodes)
-
-    def blocks(self, model, candidates) -> list:
-        return spread_mass_blocks(candidates, [self.weights(model, c) for c in candidates])
-
-    def apply(self, model, candidate, value: float):
-        return with_spread_mass(model, candidate, self.weights(model, candidate), value)
 
 
 KIND = _RegionMass()
