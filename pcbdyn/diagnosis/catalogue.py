@@ -23,7 +23,8 @@ plugin module of this package that registers an object (:func:`register`, into :
   effects by the search (:mod:`.halves`);
 - ``saturates`` (optional, False by default): True when the effect stiffens the modes near it up to a
   pin or a clamp (a support), so that the search screens more of its candidates at large magnitudes
-  (:func:`.scan.saturated`).
+  (:func:`.scan.saturated`; its optional ``saturated_values`` (multiples of ``scale``) and
+  ``saturated_screen`` (how many) replace the screen's defaults).
 
 Every effect enters K and M linearly in its parameter, so dK/dp and dM/dp are exact and the
 same at every value, and the first-order eigenvalue sensitivity (thesis eq. 3.11 with k = i)

@@ -120,20 +120,23 @@ def saturated(rx, effects, values, candidates, gain, per_kind: int) -> dict:
     """{candidate index: magnitude} of the ``per_kind`` candidates of each kind whose effect saturates
     (a support stiffens the modes near it up to a pin) that leave the least chi^2 on the reanalysis
     ``rx`` of a state (its parameters, ``effects`` at ``values``), each at the best of
-    :data:`SATURATED_VALUES`, among the :data:`SATURATED_SCREEN` best by their linear score ``gain``.
+    :data:`SATURATED_VALUES` (or the kind's ``saturated_values``), among the :data:`SATURATED_SCREEN` (or
+    its ``saturated_screen``) best by their linear score ``gain``. A kind whose quick fits the
+    reanalysis does not follow (a rib) is still ranked on it: the screen only chooses what is fitted.
     Near its saturation every place of such an effect has about the same linear score (a stiff
     spring at the edge of a large thin card: the true place's was 106th of 1730), while its
     saturated effect differs from place to place."""
     kinds = np.array([c.kind for c in candidates])
-    todo = [k for k in np.unique(kinds) if getattr(kind(k), "saturates", False) and getattr(kind(k), "reanalysed", True)]
+    todo = [k for k in np.unique(kinds) if getattr(kind(k), "saturates", False)]
     out = {}
     for k in todo:
+        spec = kind(k)
         idx = np.flatnonzero((kinds == k) & np.isfinite(gain))
-        idx = idx[np.argsort(-gain[idx], kind="stable")[:SATURATED_SCREEN]]
+        idx = idx[np.argsort(-gain[idx], kind="stable")[:getattr(spec, "saturated_screen", SATURATED_SCREEN)]]
         best = []
         for j in idx:
             tried = [(_reduced_chi2(rx, rx.st.p, list(effects) + [candidates[j]], np.r_[values, v]), v)
-                     for v in kind(k).scale * np.asarray(SATURATED_VALUES)]
+                     for v in spec.scale * np.asarray(getattr(spec, "saturated_values", SATURATED_VALUES))]
             best.append((*min(tried), int(j)))
         out.update({j: v for _, v, j in sorted(best)[:per_kind]})
     return out
