@@ -179,8 +179,9 @@ def group_pole(c: Chart, g) -> complex:
     frequency does (on one noisy FRF a pole of median frequency had 0.18 % for a 0.8 % mode whose
     column's median was 0.70 %), so the column's median stands for it, as the cluster statistics of
     automated modal analysis do (Reynders et al. 2012)."""
-    wn = 2.0 * np.pi * c.frequency[representative(c, g)]
-    z = float(np.median(c.damping[_most_stable(c, g)]))
+    top = _most_stable(c, g)
+    wn = 2.0 * np.pi * c.frequency[_median_pole(c, top)]
+    z = float(np.median(c.damping[top]))
     return complex(-z * wn, wn * np.sqrt(1.0 - z * z))
 
 
