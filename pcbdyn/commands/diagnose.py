@@ -37,6 +37,9 @@ STATES = ("before", "parameters_only", "after")
               help="a first look at a fraction of the cost: the mesh correction from one finer mesh (twice as fine) "
                    "instead of two, candidates on a grid half as fine (still walked to place), one trial fit per kind "
                    "in each scan instead of two, and the masses found not carried onto the finer meshes")
+@click.option("--parameters-only", is_flag=True,
+              help="stop after fitting the declared parameters and testing what they leave against the noise: the "
+                   "error budget and the parameters-only correlation, no search for effects")
 @click.option("--workers", type=click.IntRange(min=1), default=None,
               help="local processes for the finer-mesh solves, the trial fits and the configurations of each "
                    "re-solve (default: the cores; 1: this process)")
@@ -48,8 +51,8 @@ STATES = ("before", "parameters_only", "after")
                 force="replace an earlier <board>.diagnosed.toml beside the board (default: a numbered name)")
 @library_option()
 @units_option
-def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size, quick, workers, scheduler, out, force,
-            json_path, html):
+def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size, quick, parameters_only, workers,
+            scheduler, out, force, json_path, html):
     """Find the effects a board model lacks from modal tests: TEST_UFF (with mode shapes) of the base
     configuration and NAME=FILE for each perturbed configuration of board.toml (e.g. c2=test2.uff)."""
     from ..diagnosis.pipeline import diagnose
@@ -74,7 +77,7 @@ def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size,
         try:
             d = diagnose(board, tests, freq_pct, shape_pct, mesh_size=ms, kinds=chosen, max_effects=max_effects,
                          progress=lambda msg: click.echo(f"    {msg}", err=True), quick=quick, workers=workers,
-                         scheduler=scheduler, record=record)
+                         scheduler=scheduler, record=record, search_effects=not parameters_only)
         except Exception as exc:
             if json_path is not None:  # a bug, or a state no model can take: keep what was computed
                 write_json(json_path, {"complete": False, "error": f"{type(exc).__name__}: {exc}",

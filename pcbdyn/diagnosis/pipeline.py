@@ -171,7 +171,7 @@ def _walked(res, cands, held, fit, moves, bounds, alpha, runner, say) -> tuple:
 
 def diagnose(structure, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_size=None, kinds=None,
              max_effects: int = 3, alpha: float = ALPHA, progress=None, workers: int | None = None,
-             scheduler=None, quick: bool = False, record: dict | None = None) -> Diagnosis:
+             scheduler=None, quick: bool = False, record: dict | None = None, search_effects: bool = True) -> Diagnosis:
     """Diagnose ``structure`` (a board, or any structure of :mod:`pcbdyn.domain`) against ``tests`` =
     [(configuration name or None, :class:`pcbdyn.testdata.MeasuredModes`)]. ``workers`` local processes (None:
     the cores; 1: this process) or the Dask cluster at ``scheduler`` run the independent solves of
@@ -184,14 +184,15 @@ def diagnose(structure, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_s
     re-solve share the local cores (:func:`pcbdyn.parallel.spare_cores`). ``record``: a dict that the
     diagnosis fills as it goes (``before``, ``parameters_only``: summaries of the states;
     ``parameters``, ``statistics``), so that a caller still has what was computed when a later step
-    fails."""
+    fails. ``search_effects`` False: stop after the parameters and the noise test (steps 1-3), a tenth of
+    the cost where the search is long."""
     with spare_cores(workers):
         return _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kinds, max_effects, alpha,
-                         progress, workers, scheduler, quick, {} if record is None else record)
+                         progress, workers, scheduler, quick, {} if record is None else record, search_effects)
 
 
 def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kinds, max_effects, alpha, progress,
-              workers, scheduler, quick, record) -> Diagnosis:
+              workers, scheduler, quick, record, search_effects) -> Diagnosis:
     say = progress or (lambda msg: None)
     runner = Runner(workers, scheduler, lambda msg: say(f"  {msg}"))
     h = mesh_size or structure.mesh_size
@@ -238,19 +239,22 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
              "sigma_shape_pct": [None if o.sigma_s is None else np.round(100 * o.sigma_s, 4).tolist() for o in obs]}
     noise_only = stats["p_value_noise"] > alpha and not any(unmatched.values())
     told = base if noise_only else told
+    stats["effects_searched"] = search_effects and not noise_only
     stats["update"] = None if update is None else {"status": update.status, "parameters": update.values,
                                                    "parameters_only_from_update": told is not own}
     out = dict(before=before.summary(obs), parameters_only=(res.evaluate(told.p) if support else told.state).summary(obs),
                parameters={n: {"initial": float(a), "parameters_only": float(b)} for n, a, b in zip(names, p0, told.p)},
                statistics=stats)
     record.update(out)
-    if noise_only:
+    if noise_only or not search_effects:
         for n, v in zip(names, base.p):
             out["parameters"][n]["final"] = float(v)
-        return Diagnosis([], True, "what remains after fitting the declared parameters is within the noise "
-                         f"(chi^2 = {base.chi2:.1f} for {stats['dof']} degrees of freedom, p = "
-                         f"{stats['p_value_noise']:.2f}): no effect is missing that the data can show",
-                         after=out["parameters_only"], **out)
+        test = (f"chi^2 = {base.chi2:.1f} for {stats['dof']} degrees of freedom, p = {stats['p_value_noise']:.2f}")
+        msg = (f"what remains after fitting the declared parameters is within the noise ({test}): no effect is missing "
+               "that the data can show" if noise_only else
+               f"effects not searched; what the declared parameters leave is "
+               f"{'within' if stats['p_value_noise'] > alpha else 'beyond'} the noise ({test})")
+        return Diagnosis([], noise_only, msg, after=out["parameters_only"], **out)
     say("generating the candidate effects")
     grid = QUICK_CANDIDATE_OPTIONS if quick else CANDIDATE_OPTIONS
     options = {k: v * h if k == "path_spacing" else v for k, v in grid.items() if k in _options(kinds)}
