@@ -11,6 +11,10 @@ from scipy.stats import chi2 as chi2_dist
 from .fitting import estimate
 from .residual import ModalResidual
 
+#: update's fit and the diagnosis's own are one fit (one search) where every parameter agrees to this
+#: fraction: they end in one minimum, and a second search from there costs a third of the run for nothing
+SAME_FIT_REL = 1e-3
+
 
 def paired_start(models, obs, p0, before, say, rounds: int = 2) -> tuple:
     """(declared parameter values, the state of all test modes there) from which the diagnosis pairs
@@ -57,7 +61,8 @@ def parameter_stage(plain, own, update, models, say) -> tuple:
     ``own`` and update's refined in the diagnosis's residual. Where update's is lower, the search runs
     from both: a lower chi^2 of the declared parameters alone can be another compromise with the
     missing effect, one that hides it from the linearised search (a 15 g line mass on the six-part
-    card: chi^2 2.6 % lower from update's fit, nothing found from there). Reported: :func:`reported`
+    card: chi^2 2.6 % lower from update's fit, nothing found from there), unless the two are one fit
+    (:data:`SAME_FIT_REL`). Reported: :func:`reported`
     of those and update's fit as it ended."""
     if update is None:
         return own, [own], own
@@ -66,6 +71,8 @@ def parameter_stage(plain, own, update, models, say) -> tuple:
     shown = reported(plain, [own, alt, estimate(plain, at, [], [], 0, models.bounds)])
     if not alt.chi2 < own.chi2:
         return own, [own], shown
+    if np.all(np.abs(alt.p - own.p) <= SAME_FIT_REL * np.abs(own.p)):
+        return alt, [alt], shown
     say(f"  update's fit leaves the lower chi^2 ({alt.chi2:.5g} against {own.chi2:.5g}): the search starts from both")
     return alt, [alt, own], shown
 

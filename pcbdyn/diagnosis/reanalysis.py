@@ -57,6 +57,7 @@ class _Config:
         self.K_phi, self.M_phi = cs.K @ self.phi, cs.M @ self.phi
         self.X, self.KX, self.MX, self.read_X = {}, {}, {}, {}
         self._moved: dict = {}
+        self._on_phi: dict = {}
 
     def correction(self, key, dK, dM) -> None:
         """The compressed static correction of direction ``key`` (dK, dM), kept."""
@@ -77,6 +78,21 @@ class _Config:
         if full not in self._moved:
             B = np.column_stack([self.phi] + [self.X[k] for k in keys])
             self._moved[full] = (B.T @ (dK @ B), B.T @ (dM @ B))
+        return self._moved[full]
+
+    def moved_parameter(self, j: int, dK, dM, keys) -> tuple:
+        """:meth:`moved` of the declared parameter ``j``, whose dK and dM span the structure: their products
+        with the modes are made once, those with the corrections of each candidate set (a few columns) anew."""
+        full = (("p", j), tuple(keys))
+        if full not in self._moved:
+            if j not in self._on_phi:
+                self._on_phi[j] = [(D @ self.phi, self.phi.T @ (D @ self.phi)) for D in (dK, dM)]
+            X = np.column_stack([self.phi[:, :0]] + [self.X[k] for k in keys])
+            blocks = []
+            for D, (D_phi, phi_D_phi) in zip((dK, dM), self._on_phi[j]):
+                D_X = D @ X
+                blocks.append(np.block([[phi_D_phi, self.phi.T @ D_X], [X.T @ D_phi, X.T @ D_X]]))
+            self._moved[full] = tuple(blocks)
         return self._moved[full]
 
     def basis(self, keys) -> tuple:
@@ -126,7 +142,7 @@ class Reanalysis:
                 cfg.correction(c.name, *self._derivative(k, c))
             names = [c.name for c in dirs]
             KB, MB, T, points = cfg.basis(names)
-            moves = [cfg.moved(("p", j), dK, dM, names) for j, (dK, dM) in enumerate(self.param_derivs[k])]
+            moves = [cfg.moved_parameter(j, dK, dM, names) for j, (dK, dM) in enumerate(self.param_derivs[k])]
             moves += [cfg.moved(c.name, *self._derivative(k, c), names) for c in dirs]
             self._bases[key] = (KB, MB, T, points, moves)
         return self._bases[key]
