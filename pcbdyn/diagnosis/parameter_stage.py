@@ -62,8 +62,7 @@ def parameter_stage(plain, own, update, models, say) -> tuple:
     from both: a lower chi^2 of the declared parameters alone can be another compromise with the
     missing effect, one that hides it from the linearised search (a 15 g line mass on the six-part
     card: chi^2 2.6 % lower from update's fit, nothing found from there), unless the two are one fit
-    (:data:`SAME_FIT_REL`). Reported: :func:`reported`
-    of those and update's fit as it ended."""
+    (:data:`SAME_FIT_REL`). Reported: :func:`reported` of those and update's fit as it ended."""
     if update is None:
         return own, [own], own
     at = np.array([update.values[n] for n in models.names])

@@ -184,8 +184,7 @@ def diagnose(structure, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_s
     re-solve share the local cores (:func:`pcbdyn.parallel.spare_cores`). ``record``: a dict that the
     diagnosis fills as it goes (``before``, ``parameters_only``: summaries of the states;
     ``parameters``, ``statistics``), so that a caller still has what was computed when a later step
-    fails. ``search_effects`` False: stop after the parameters and the noise test (steps 1-3), a tenth of
-    the cost where the search is long."""
+    fails. ``search_effects`` False: stop after the parameters and the noise test (steps 1-3)."""
     with spare_cores(workers):
         return _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kinds, max_effects, alpha,
                          progress, workers, scheduler, quick, {} if record is None else record, search_effects)
@@ -249,7 +248,7 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
     if noise_only or not search_effects:
         for n, v in zip(names, base.p):
             out["parameters"][n]["final"] = float(v)
-        test = (f"chi^2 = {base.chi2:.1f} for {stats['dof']} degrees of freedom, p = {stats['p_value_noise']:.2f}")
+        test = f"chi^2 = {base.chi2:.1f} for {stats['dof']} degrees of freedom, p = {stats['p_value_noise']:.2f}"
         msg = (f"what remains after fitting the declared parameters is within the noise ({test}): no effect is missing "
                "that the data can show" if noise_only else
                f"effects not searched; what the declared parameters leave is "
