@@ -20,12 +20,12 @@ neighbours starts a new group; a group holding two poles of one order is cut at 
 into as many modes); a group is a mode when it is seen at MIN_SUPPORT of the orders from the one it
 first appears at (a mode of a wide band appears only once the order can hold it; on a noisy FRF the
 noise poles take turns with it at the nearest-pole comparison, so its column has gaps) and at
-MIN_ORDERS_FRACTION of all orders, at least 3; it is represented by its pole of median frequency,
-with the median damping of its column. A mode must then be seen in the data (:func:`share`): in the
-FRF where its modal term is largest, that term makes at least MIN_SHARE of the measured FRF at its own
-frequency. A pole fitted to noise, or to
-the skirt of a strong neighbour or of a mode outside the band, can be as stable on a single FRF as a
-mode is, but it is not what makes the FRF there.
+MIN_ORDERS_FRACTION of all orders, at least 3; its most stable poles give it their median damping and
+the frequency of their pole of median frequency (:func:`group_pole`). A mode must then be seen in the data
+(:func:`share`): in the FRF where its modal term is largest, that term makes at least MIN_SHARE of the
+measured FRF at its own frequency. A pole fitted to noise, or to the skirt of a strong neighbour or of
+a mode outside the band, can be as stable on a single FRF as a mode is, but it is not what makes the
+FRF there.
 Manual choice: every pole stable in frequency is grouped likewise, and each frequency given takes the
 nearest group within TOL_PICK, distinct ones where the groups allow, the most stable pole of median
 frequency standing for it; requests that share one group are said so.
