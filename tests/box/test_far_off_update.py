@@ -17,6 +17,9 @@ from pcbdyn.testdata.simulate import simulate_on_model
 
 from box_helpers import POINTS, edited
 
+#: the module's fixtures are made once: its tests run on one xdist worker
+pytestmark = pytest.mark.xdist_group("far_off_update")
+
 NOISE = Noise(0.2, 2.0, 0.0)
 #: the declared model's start against the box as drawn (E, rho of the upper plate; rib heights 10 mm)
 START = {"E_upper": 1.4, "rho_upper": 0.6, "h_side": 1.6, "h_back": 0.6, "h_upper_x": 1.45, "h_upper_y": 0.5}

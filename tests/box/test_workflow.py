@@ -27,6 +27,9 @@ from pcbdyn.updating.iteration import build_equations
 
 from box_helpers import POINTS, edited
 
+#: the module's fixtures are made once: its tests run on one xdist worker
+pytestmark = pytest.mark.xdist_group("box_workflow")
+
 MESH = "8 mm"  # the model's; the test structure's is half of it
 F_MAX = 1500.0
 NOISE = Noise(0.2, 2.0, 0.0)

@@ -20,6 +20,9 @@ from reference import load
 from pcbdyn.fe.modal import solve_modes
 from pcbdyn.testdata import Points, TestData, read_points_csv, read_uff, write_uff
 
+#: the module's fixtures are made once: its tests run on one xdist worker
+pytestmark = pytest.mark.xdist_group("correlate_command")
+
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "six_part_card"
 POINTS = EXAMPLE / "points.csv"
 U1 = 'ref = "U1"\npackage = "PGA"\nat = ["40.5 mm", "38.14 mm"]\n'

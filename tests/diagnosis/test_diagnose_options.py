@@ -19,6 +19,9 @@ from test_diagnose_bench import judge, location_error_mm  # noqa: E402
 
 from pcbdyn.cli import main  # noqa: E402
 
+#: the module's fixtures are made once: its tests run on one xdist worker
+pytestmark = pytest.mark.xdist_group("diagnose_options")
+
 CASE = bc.BY_NAME["gs_standoff"]
 #: the kinds searched (the standoff's and the one a point residual is most often mistaken for)
 KINDS = "ground_spring,point_mass"

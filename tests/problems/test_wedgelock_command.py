@@ -14,6 +14,9 @@ from pcbdyn.board import load_board
 from pcbdyn.cli import main
 from pcbdyn.testdata import TestData, write_uff
 
+#: the module's fixtures are made once: its tests run on one xdist worker
+pytestmark = pytest.mark.xdist_group("wedgelock_command")
+
 TRUE_K = 5000.0
 
 

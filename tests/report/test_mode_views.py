@@ -18,6 +18,9 @@ from click.testing import CliRunner
 
 from pcbdyn.cli import main
 
+#: the module's fixtures are made once: its tests run on one xdist worker
+pytestmark = pytest.mark.xdist_group("mode_views")
+
 ROOT = Path(__file__).resolve().parents[2]
 
 
