@@ -10,7 +10,9 @@ pair stood on nodes), and the line replaces the pair where it lowers the informa
 stay). A line the search found as one mass (its centre; a body whose inertia stands for the line's
 second moment) is tried as lines through that centre in four directions and several lengths, the
 best walked the same way; it must lower the criterion by one effect's penalty more, as its direction
-and length are two coordinates a point does not have."""
+and length are two coordinates a point does not have, and end at least two elements long: a shorter
+line is not one the mesh resolves, and a mass between nodes fits it as well as a point (dev seed 0's
+50 g point mass had become a 7.8 mm line on 6 mm elements)."""
 
 from __future__ import annotations
 
@@ -103,11 +105,13 @@ def _oriented(res, sel, rest, values, m, centre, length, layout, bounds) -> tupl
     return ends, best
 
 
-def _as_line(res, candidates, sel, replaced, m, ends, layout, step, bounds, newton_steps, pen, extra: float) -> bool:
+def _as_line(res, candidates, sel, replaced, m, ends, layout, step, bounds, newton_steps, pen, extra: float,
+             shortest: float = 0.0) -> bool:
     """Replace the chosen effects ``replaced`` (candidate indices) by one line mass of mass ``m``
     starting at ``ends``, walked (:func:`.fitting.pattern_search`, quick fits reduced to the line's
     fitted state where it starts: a walk is hundreds of them), where the criterion drops by more than
-    ``extra``; True when it did (``sel`` updated in place, the line appended to ``candidates``)."""
+    ``extra`` and the walked line is at least ``shortest`` [m] long; True when it did (``sel`` updated
+    in place, the line appended to ``candidates``)."""
     line = KIND.across(layout, *ends)
     if line is None:
         return False
@@ -123,6 +127,8 @@ def _as_line(res, candidates, sel, replaced, m, ends, layout, step, bounds, newt
     ends, quick = pattern_search(res, rest, np.ravel(line.geometry["segment"]), _lines(layout), start, step, 3, bounds,
                                  reduced=rx, param_columns=P)
     line = KIND.across(layout, *ends.reshape(2, 2))
+    if line is None or line.data["length"] < shortest:
+        return False
     fit = estimate(res, quick.p, rest + [line], quick.values, newton_steps, bounds)
     if fit.state is None or not fit.values[-1] > 0 or not fit.chi2 + (len(others) + 1) * pen + extra < sel.criterion[-1]:
         return False
@@ -135,10 +141,11 @@ def as_lines(res, candidates: list, sel, reach: float, layout, step: float, boun
              alpha: float = ALPHA):
     """``sel`` with each pair of chosen point-mass groups (effects within ``reach`` [m], reported as
     one: :func:`.merge.groups`) refitted as one line mass across ``layout``'s plate (module doc), its
-    ends walked from steps of ``step`` [m], where that lowers the criterion; then each mass left alone
-    tried as lines through its centre, the best walked where it already fits better than the mass
-    and kept where the criterion drops by one effect's penalty more (module doc). Line candidates are
-    appended to ``candidates``; ``sel`` is updated in place."""
+    ends walked from steps of ``step`` [m] (half the model's element size), where that lowers the
+    criterion; then each mass left alone tried as lines through its centre, the best walked where it
+    already fits better than the mass and kept where the criterion drops by one effect's penalty more
+    and it ends two elements long or more (module doc). Line candidates are appended to
+    ``candidates``; ``sel`` is updated in place."""
     if not layout.planar:
         return sel
     pen = penalty(res.n_rows, len(candidates), alpha)
@@ -149,7 +156,8 @@ def as_lines(res, candidates: list, sel, reach: float, layout, step: float, boun
     for pair, m, ends in _pairs(candidates, sel, mass_groups()):
         if set(pair) <= set(sel.chosen) and m > 0:  # not a mass already taken by another line
             _as_line(res, candidates, sel, pair, m, ends, layout, step, bounds, newton_steps, pen, 0.0)
-    for single, m, centre, length in _singles(candidates, sel, mass_groups(), 2.0 * step, reach):
+    h = 2.0 * step  # the element size
+    for single, m, centre, length in _singles(candidates, sel, mass_groups(), h, reach):
         if not (set(single) <= set(sel.chosen) and m > 0):
             continue
         pos = {i: k for k, i in enumerate(sel.chosen)}
@@ -157,5 +165,5 @@ def as_lines(res, candidates: list, sel, reach: float, layout, step: float, boun
         ends, chi2 = _oriented(res, sel, [candidates[i] for i in others], [sel.values[pos[i]] for i in others], m,
                                centre, length, layout, bounds)
         if ends is not None and chi2 < sel.chi2[-1]:  # else no line is worth walking
-            _as_line(res, candidates, sel, single, m, ends, layout, step, bounds, newton_steps, pen, pen)
+            _as_line(res, candidates, sel, single, m, ends, layout, step, bounds, newton_steps, pen, pen, 2.0 * h)
     return sel

@@ -140,3 +140,29 @@ def test_one_point_mass_standing_in_for_a_line_becomes_the_line(card):
     assert sel.values[0] == pytest.approx(0.012, rel=0.05)
     assert sel.p[0] == pytest.approx(26e9, rel=0.005)
     assert sel.chi2[-1] < N_MODES and sel.chi2[-1] + pen < fit.chi2
+
+
+@pytest.mark.parametrize("xy", [(0.0733, 0.0836), (0.06, 0.11), (0.10, 0.13)])
+def test_a_point_mass_between_the_nodes_is_no_short_line(card, xy):
+    """A 20 g point mass inside a cell (interpolated between its nodes), found as a point mass on the
+    nearest node: a line of the same mass 17-25 mm long fits the frequencies better than the node
+    does (it spreads the mass over the nodes around the point), but a line under two elements
+    (26 mm) is none the mesh resolves, and the mass stays a point with the mass fitted on its node."""
+    from dataclasses import replace
+
+    from pcbdyn.diagnosis.point_mass import MASS
+
+    m, layout = card
+    cands = list(dg.generate(layout, kinds=["point_mass"]))
+    near = min(range(len(cands)), key=lambda i: np.linalg.norm(np.subtract(cands[i].at[:2], xy)))
+    assert np.linalg.norm(np.subtract(cands[near].at[:2], xy)) > 0.004  # the point is not on a node
+    truth = dg.add_effect(m, MASS.place(layout, replace(cands[near], at=xy)), 0.020)
+    f_test = solve_modes(truth, n_modes=N_MODES).frequencies
+    res = ModalResidual([Observation(None, MeasuredModes.frequencies_only(f_test), np.full(N_MODES, SIGMA))],
+                        lambda p: [m])
+    fit = estimate(res, np.zeros(0), [cands[near]], [0.020], 8)
+    sel = Selection(chosen=[near], values=fit.values, p=fit.p, chi2=[fit.chi2],
+                    criterion=[fit.chi2 + penalty(res.n_rows, len(cands))], state=fit.state)
+    sel = as_lines(res, cands, sel, 0.02, layout, 0.0065)
+    assert [cands[i].kind for i in sel.chosen] == ["point_mass"]
+    assert sel.values == pytest.approx(fit.values, rel=1e-12)
