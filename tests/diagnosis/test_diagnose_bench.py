@@ -120,6 +120,10 @@ def judge(case, truth: dict, data: dict) -> list:
             bad.append(f"{t['type']} magnitude {e['magnitude']:.4g} {e.get('unit', '')} vs truth {t['magnitude']:.4g} "
                        f"({100 * rel:+.0f} %, tolerance {100 * MAG_TOL:g} %)")
     po, after = data["parameters_only"]["max_freq_error_pct"], data["after"]["max_freq_error_pct"]
+    said = data.get("statistics", {}).get("after_worse_than_parameters_only"), "grew from" in data.get("message", "")
+    if said != (after > po, after > po):
+        bad.append(f"max frequency error after {after:.3f} % against {po:.3f} % with the parameters only: the flag "
+                   "after_worse_than_parameters_only and the message must both say whether it grew")
     unpaired = {c["configuration"]: c["unpaired_test_modes"] for c in data["after"]["configurations"]
                 if c.get("unpaired_test_modes")}
     if unpaired:  # the max error is over the paired modes: one left without a partner fails the case

@@ -1,7 +1,8 @@
 """Nothing reported that the data do not need (issue 37): of two effects fitted together, one real (a
 mass the test board carries) and one the data do not ask for (a spring elsewhere, its value fitted to the
 noise), :func:`pcbdyn.diagnosis.select.noticed` keeps the mass, whose removal raises chi^2 far beyond an
-effect's penalty, and drops the spring."""
+effect's penalty, and drops the spring. And an "after" worse than "parameters only" is said, with what
+moved the model in between (:func:`pcbdyn.diagnosis.pipeline.worse_note`)."""
 
 from __future__ import annotations
 
@@ -33,3 +34,16 @@ def test_an_effect_the_data_do_not_need_is_dropped(card):
     kept = noticed(res, both, sel)
     assert kept.chosen == [0]
     assert kept.values[0] == pytest.approx(0.02, rel=0.05)
+
+
+def test_a_worse_after_is_said_with_what_moved_the_model():
+    """Dev seed 3 (a bracket in guides): nothing reported, the plate theory's share fitted at the Kirchhoff
+    limit, the largest frequency error 1.22 % with the parameters only and 4.07 % after. The note says
+    so and names the share; it compares no chi^2 (the share's fit changes the noise units)."""
+    from pcbdyn.diagnosis.pipeline import worse_note
+
+    note = worse_note(1.22, 4.07, effects=False, theta=1.0)
+    assert "grew from 1.22 % (parameters only) to 4.07 %" in note and "plate theory's share" in note
+    assert "effects found" not in note and "chi^2" not in note
+    assert "the effects found and the plate theory's share" in worse_note(1.0, 1.5, effects=True, theta=0.4)
+    assert worse_note(1.22, 1.22, effects=True, theta=1.0) == worse_note(1.5, 0.3, effects=True, theta=0.0) == ""
