@@ -197,15 +197,20 @@ def check_report(data: dict, out: Path) -> None:
 
 
 def test_judge_on_truth_itself():
-    """The judging code: the truth reported as found passes, a far or wrong-sized one fails."""
+    """The judging code: the truth reported as found passes, a far or wrong-sized one fails, and so does
+    an 'after' worse than 'parameters only' that the diagnosis does not say."""
     case = bc.BY_NAME["line_mass_top_cfg"]
     truth = {"effects": [{"type": "line_mass", "parameter": "mass", "at_mm": [61.0, 178.0], "magnitude": 0.02,
                           "segment_mm": [[40.0, 178.0], [81.0, 178.0]], "required": True}]}
     ok = {"effects": [{"type": "line_mass", "parameter": "mass", "at_mm": [60.75, 178.0], "magnitude": 0.022,
                        "unit": "kg", "segment_mm": [[40.5, 178.0], [81.0, 178.0]]}],
           "noise_only": False, "parameters_only": {"max_freq_error_pct": 3.0},
-          "after": {"max_freq_error_pct": 0.3, "configurations": [{"configuration": "base"}]}}
+          "after": {"max_freq_error_pct": 0.3, "configurations": [{"configuration": "base"}]},
+          "statistics": {"after_worse_than_parameters_only": False}, "message": "1 effect(s) the model lacks"}
     assert judge(case, truth, ok) == []
+    unsaid = json.loads(json.dumps(ok))  # 'after' worse than 'parameters only', and neither flag nor message say so
+    unsaid["after"]["max_freq_error_pct"] = 3.5
+    assert any("must both say whether it grew" in b for b in judge(case, truth, unsaid))
     unpaired = json.loads(json.dumps(ok))
     unpaired["after"]["configurations"][0]["unpaired_test_modes"] = [1]
     assert judge(case, truth, unpaired) == ["test modes without a model partner after the effects: {'base': [1]}"]
