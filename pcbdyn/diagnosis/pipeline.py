@@ -53,7 +53,7 @@ from . import conforming, geometry_fit
 from .budget import MASS_KINDS, observations, set_noise, with_carried
 from .model_form import MESH_LEVELS, fit_plate_share
 from .parameter_stage import declared_origin, paired_start, parameter_stage, range_test, update_start
-from .residual import ModalResidual
+from .residual import ModalResidual, worst_on_common
 from .fitting import estimate
 from .scan import Runner
 from .select import ALPHA, Selection, adopt, noticed, penalty, refine, search, without_vanished
@@ -337,7 +337,7 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
     if any(left.values()):
         msg += f"; test modes with no model partner (MAC < 0.3), left out of the fit: {left}"
     after = sel.state.summary(res.observations)
-    po, worse = out["parameters_only"]["max_freq_error_pct"], after["max_freq_error_pct"]
+    po, worse = worst_on_common(out["parameters_only"], after)
     stats["after_worse_than_parameters_only"] = bool(worse > po)
     msg += worse_note(po, worse, bool(effects), theta)
     return Diagnosis(effects, False, msg, after=after, evidence=evidence(plain, base.state, searched),
@@ -345,15 +345,15 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
 
 
 def worse_note(po: float, after: float, effects: bool, theta: float) -> str:
-    """The message's note where the largest frequency error of the paired modes grew from the declared
-    parameters fitted (``po`` %) to the end (``after`` %), naming what moved the model in between (the
-    effects found, the plate theory's ``theta``); "" where it did not grow. No chi^2 is compared: it
-    weighs the shapes too and, once theta is fitted, in other noise units (dev seed 3 had read "chi^2
-    is lower (1.641e+04 -> 1.651e+04)" with nothing reported)."""
+    """The message's note where the largest frequency error of the modes paired in both grew from the
+    declared parameters fitted (``po`` %) to the end (``after`` %; :func:`.residual.worst_on_common`),
+    naming what moved the model in between (the effects found, the plate theory's ``theta``); "" where
+    it did not grow. No chi^2 is compared: it weighs the shapes too and, once theta is fitted, in other
+    noise units (dev seed 3 had read "chi^2 is lower (1.641e+04 -> 1.651e+04)" with nothing reported)."""
     if not after > po:
         return ""
     moved = [what for what, on in (("the effects found", effects), ("the plate theory's share fitted", theta > 0.0))
              if on] or ["the declared parameters fitted again"]
-    return (f"; note: the largest frequency error of the paired modes grew from {po:.2f} % (parameters only) to "
-            f"{after:.2f} % with " + " and ".join(moved) + ": the fit weighs the shapes too and may trade "
+    return (f"; note: the largest frequency error of the modes paired in both grew from {po:.2f} % (parameters only) "
+            f"to {after:.2f} % with " + " and ".join(moved) + ": the fit weighs the shapes too and may trade "
             "frequencies for them, or pair other modes; read it with care")

@@ -94,6 +94,14 @@ def run_diagnose(case, board, uffs, out: Path) -> dict:
     return json.loads(js.read_text())
 
 
+def _on_both(a: dict, b: dict) -> tuple:
+    """Largest |df| [%] of correlation summaries ``a`` and ``b`` over the test modes paired in both."""
+    pa, pb = ({(c["configuration"], m["test_mode"]): abs(m["df_pct"]) for c in s["configurations"]
+               for m in c["modes"] if m["paired"]} for s in (a, b))
+    common = pa.keys() & pb.keys()
+    return (max(pa[k] for k in common), max(pb[k] for k in common)) if common else (0.0, 0.0)
+
+
 def judge(case, truth: dict, data: dict) -> list:
     """Acceptance failures (empty: the case passes)."""
     bad = []
@@ -120,10 +128,12 @@ def judge(case, truth: dict, data: dict) -> list:
             bad.append(f"{t['type']} magnitude {e['magnitude']:.4g} {e.get('unit', '')} vs truth {t['magnitude']:.4g} "
                        f"({100 * rel:+.0f} %, tolerance {100 * MAG_TOL:g} %)")
     po, after = data["parameters_only"]["max_freq_error_pct"], data["after"]["max_freq_error_pct"]
+    po_c, after_c = _on_both(data["parameters_only"], data["after"])
     said = data.get("statistics", {}).get("after_worse_than_parameters_only"), "grew from" in data.get("message", "")
-    if said != (after > po, after > po):
-        bad.append(f"max frequency error after {after:.3f} % against {po:.3f} % with the parameters only: the flag "
-                   "after_worse_than_parameters_only and the message must both say whether it grew")
+    if said != (after_c > po_c, after_c > po_c):
+        bad.append(f"max frequency error over the modes paired in both, after {after_c:.3f} % against {po_c:.3f} % "
+                   "with the parameters only: the flag after_worse_than_parameters_only and the message must both "
+                   "say whether it grew")
     unpaired = {c["configuration"]: c["unpaired_test_modes"] for c in data["after"]["configurations"]
                 if c.get("unpaired_test_modes")}
     if unpaired:  # the max error is over the paired modes: one left without a partner fails the case
@@ -196,6 +206,13 @@ def check_report(data: dict, out: Path) -> None:
         assert enriched.name.endswith(".diagnosed.toml") and load_board(enriched).name
 
 
+def _summary(modes) -> dict:
+    """A correlation summary of one configuration: ``modes`` [(df %, paired)]."""
+    rows = [{"test_mode": i + 1, "df_pct": d, "paired": p} for i, (d, p) in enumerate(modes)]
+    return {"max_freq_error_pct": max(abs(d) for d, p in modes if p),
+            "configurations": [{"configuration": "base", "modes": rows}]}
+
+
 def test_judge_on_truth_itself():
     """The judging code: the truth reported as found passes, a far or wrong-sized one fails, and so does
     an 'after' worse than 'parameters only' that the diagnosis does not say."""
@@ -204,19 +221,23 @@ def test_judge_on_truth_itself():
                           "segment_mm": [[40.0, 178.0], [81.0, 178.0]], "required": True}]}
     ok = {"effects": [{"type": "line_mass", "parameter": "mass", "at_mm": [60.75, 178.0], "magnitude": 0.022,
                        "unit": "kg", "segment_mm": [[40.5, 178.0], [81.0, 178.0]]}],
-          "noise_only": False, "parameters_only": {"max_freq_error_pct": 3.0},
-          "after": {"max_freq_error_pct": 0.3, "configurations": [{"configuration": "base"}]},
+          "noise_only": False, "parameters_only": _summary([(3.0, True), (-1.0, True)]),
+          "after": _summary([(0.3, True), (0.2, True)]),
           "statistics": {"after_worse_than_parameters_only": False}, "message": "1 effect(s) the model lacks"}
     assert judge(case, truth, ok) == []
     unsaid = json.loads(json.dumps(ok))  # 'after' worse than 'parameters only', and neither flag nor message say so
-    unsaid["after"]["max_freq_error_pct"] = 3.5
+    unsaid["after"] = _summary([(3.5, True), (0.2, True)])
     assert any("must both say whether it grew" in b for b in judge(case, truth, unsaid))
+    more = json.loads(json.dumps(ok))  # 'after' pairs a mode 'parameters only' left unpaired: not a worse fit
+    more["parameters_only"] = _summary([(0.3, True), (-40.0, False)])
+    more["after"] = _summary([(0.2, True), (0.45, True)])
+    assert judge(case, truth, more) == []
     unpaired = json.loads(json.dumps(ok))
     unpaired["after"]["configurations"][0]["unpaired_test_modes"] = [1]
     assert judge(case, truth, unpaired) == ["test modes without a model partner after the effects: {'base': [1]}"]
     far = json.loads(json.dumps(ok))
     far["effects"][0].update(at_mm=[120.0, 178.0], segment_mm=[[100.0, 178.0], [140.0, 178.0]], magnitude=0.03)
-    far["after"]["max_freq_error_pct"] = 0.8
+    far["after"] = _summary([(0.8, True), (0.2, True)])
     assert len(judge(case, truth, far)) == 3
     assert judge(bc.BY_NAME["noise_card"], {}, {"effects": [], "noise_only": True}) == []
     assert judge(bc.BY_NAME["noise_card"], {}, {"effects": ok["effects"], "noise_only": False})
