@@ -94,6 +94,12 @@ class LocalMoves:
             return None
         return None if made is None else self._add([made])[0]
 
+    def region(self, name: str, box) -> int | None:
+        """The region of kind ``name`` over rectangle ``box`` (x0, y0, x1, y1) [m], made on demand; None
+        where it holds no cell."""
+        made = kind(name).rectangle(self.layout, *box)
+        return None if made is None else self._add([made])[0]
+
     def __call__(self, k) -> list:
         c = self.cands[k]
         if "run" in c.data:

@@ -22,7 +22,8 @@ whether what remains is noise, and otherwise find, place and size the effects th
    :func:`.parameter_stage.declared_origin`), the effects' magnitudes estimated together with the
    declared parameters, each effect kept only if it also predicts data it was not fitted to; runs
    along the sides, stiffener lines, rectangular regions and point masses are walked to where they fit
-   best (:func:`.select.refine`, :class:`.moves.LocalMoves`), a mass with an inertia beside it
+   best (:func:`.select.refine`, :class:`.moves.LocalMoves`), overlapping regions refitted as one
+   (:mod:`.one_region`), a mass with an inertia beside it
    refitted as one body (:mod:`.bodies`), two masses apart, or one alone, as one mass along a
    line (:mod:`.mass_lines`). The masses (and supports) found are then put on the finer meshes and the mesh
    correction measured again (:func:`.budget.with_carried`: they change the shapes it depends on); where
@@ -48,7 +49,8 @@ from .evidence import evidence
 from .layout import from_structure
 from .mass_lines import as_lines
 from .merge import MERGE_REACH, groups, mean_path, merged
-from .moves import LocalMoves, movable, on_node
+from .moves import REGION_KINDS, LocalMoves, movable, on_node
+from .one_region import as_one_region
 from . import conforming, geometry_fit
 from .budget import MASS_KINDS, observations, set_noise, with_carried
 from .model_form import MESH_LEVELS, fit_plate_share
@@ -272,17 +274,20 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
             begin = estimate(res, origin.p, [cands[i] for i in held], [v for _, v in support], 10, models.bounds)
             begin, placed = _walked(res, cands, held, begin, moves, models.bounds, alpha, runner, say)
         sels.append(search(res, cands, p0, models.bounds, max_effects=max_effects, shortlist=1 if quick else 2,
-                           alpha=alpha, base=begin, runner=runner, held=placed))
+                           alpha=alpha, base=begin, runner=runner, held=placed, moves=moves))
     declared = None if held else declared_origin(res, base, start, models, say)
     stats["searched_from_declared"] = declared is not None
     if declared is not None:
         sels.append(search(res, cands, p0, models.bounds, max_effects=max_effects, shortlist=1 if quick else 2,
-                           alpha=alpha, base=declared, runner=runner, without=base.chi2))
+                           alpha=alpha, base=declared, runner=runner, without=base.chi2, moves=moves))
     sel = min(sels, key=lambda s: s.criterion[-1])
     if any(movable(cands[i]) for i in sel.chosen):
         say("refining where the effects along the sides begin and end, where stiffeners run, what regions cover "
             "and where masses sit")
         sel = refine(res, cands, sel, moves, models.bounds, alpha=alpha, runner=runner)
+    if sum(cands[i].kind in REGION_KINDS for i in sel.chosen) > 1:
+        say("fitting overlapping regions found as one region")
+        sel = as_one_region(res, cands, sel, moves, MERGE_REACH * h, models.bounds, alpha=alpha, runner=runner)
     if {"point_mass", "point_inertia"} <= {cands[i].kind for i in sel.chosen}:
         say("fitting a part found as a mass with an inertia beside it as one body")
         sel = as_bodies(res, cands, sel, groups([cands[i] for i in sel.chosen], MERGE_REACH * h),

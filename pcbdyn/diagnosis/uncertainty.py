@@ -5,7 +5,7 @@ reported standard deviation combines, in quadrature,
 
 - the larger of the fit's covariance (:func:`pcbdyn.updating.solvers.covariance`: the noise, rows
   weighted as in thesis eq. 4.28, propagated through the sensitivities) and a jackknife over the
-  held-out folds of :func:`.select.held_out_share` (one configuration, or one mode, left out at a
+  held-out folds of :func:`.held_out.held_out_share` (one configuration, or one mode, left out at a
   time, to first order at the fitted state): when the modes or configurations disagree on a
   magnitude, the spread between them is the better measure;
 - a model-form budget, a fixed share of the magnitude (:data:`MODEL_FORM`), measured on the
@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .select import fit_without, folds
+from .held_out import fit_without, folds
 
 #: the model-form budget: one standard deviation as a share of the magnitude, for every reported type.
 #: Calibrated with ``benchmarks/bench_coverage.py --calibrate`` on the bench and hold-out cases other

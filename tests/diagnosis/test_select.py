@@ -205,7 +205,7 @@ def test_held_out_share_tells_an_effect_every_fold_sees_from_one_fitted_to_one_f
     """Cross-validation over folds (:func:`held_out_share`): a column that shapes the residual of
     every mode predicts each left-out mode; one that matches a single mode's error (beside what
     the held columns explain) predicts none of the others."""
-    from pcbdyn.diagnosis.select import held_out_share
+    from pcbdyn.diagnosis.held_out import held_out_share
 
     class Rows:  # one configuration: the folds are its modes
         def row_groups(self):
@@ -277,7 +277,7 @@ def test_distances_to_segments_used_to_merge_effects():
     (("point_mass", "ground_spring"), (0.11, 0.15), (0.015, 3e4)),  # a bracket: 15 g held by a spring
     pytest.param(("point_mass", "ground_spring"), (0.05, 0.07), (0.02, 1e5), marks=pytest.mark.xfail(strict=True, reason=(
         "from eight frequencies alone the spring beside the mass predicts 5 of the 8 left-out modes, where each "
-        "half of a body must predict 6 (select._predicts): nothing is reported, chi^2 7071 is left"))),
+        "half of a body must predict 6 (held_out.predicts): nothing is reported, chi^2 7071 is left"))),
 ])
 def test_a_body_of_two_effects_at_one_place_is_found_as_both(card, kinds, xy, values):
     """A heat sink (a region stiffer and heavier) and a bracket (a mass on a spring at one point): each

@@ -1,0 +1,78 @@
+"""Whether an effect predicts data it was not fitted to (issue 7, step 5: selection checked by
+cross-validation across configurations and modes): the rows split into held-out folds, the first-order
+prediction of each fold with and without the effect, at the state without it or along the secant to
+the state with it (:func:`.select.search` keeps an addition only where it predicts them)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .fitting import Fit
+
+
+def folds(res) -> np.ndarray:
+    """The held-out fold of every row of the residual ``res``: its configuration when there are
+    several, else its mode."""
+    cfg, mode = res.row_groups()
+    return cfg if np.unique(cfg).size > 1 else mode
+
+
+def fit_without(A, r, fold) -> np.ndarray:
+    """The least-squares fit of columns ``A`` to ``r`` on the rows outside ``fold`` (a mask), the
+    directions weaker than :data:`CV_RCOND` dropped."""
+    return np.linalg.lstsq(A[~fold], r[~fold], rcond=CV_RCOND)[0] if A.shape[1] else np.zeros(0)
+
+
+def held_out_share(res, r, held, column) -> float:
+    """How well an effect predicts data it was not fitted to, to first order (residual ``r`` without
+    it, columns ``held`` of the declared parameters and the effects already chosen, the new effect's
+    ``column``, at that state or on the secant of :func:`secant`): the rows are split into
+    :func:`folds`; on each, the held columns with and without the new one are fitted to the other
+    folds and the fold's rows predicted. Returns the share of folds whose prediction the effect
+    improves (:data:`HELD_OUT_SHARE` at least to keep the effect). A real effect improves nearly all;
+    one that explains a structured model error of one configuration or mode does not (issue 7, step
+    5: selection checked by cross-validation across modes and configurations). Counting folds, not
+    adding their chi^2, keeps one fold that a large effect's linearisation overshoots (a mode it moves
+    onto another) from outvoting the rest."""
+    groups = folds(res)
+    better = []
+    for f in np.unique(groups):
+        test = groups == f
+        err = []
+        for A in (held, np.column_stack([held, column])):
+            e = r[test] - A[test] @ fit_without(A, r, test)
+            err.append(float(e @ e))
+        better.append(err[1] < err[0] - 1.0)  # by more than a unit of chi^2: the noise's own scale
+    return float(np.mean(better))
+
+
+#: the share of held-out folds an effect must predict better to be kept (real effects of the
+#: bench and hold-out cases: 7 of 8 folds or more; effects fitted to another code's model-form
+#: error: 2 of 3 configurations, 4 of 8 modes)
+HELD_OUT_SHARE = 0.75
+#: fits on part of the data drop the directions of the columns (declared parameters, effects at
+#: their typical size) weaker than this part of the strongest: parts' thicknesses that one
+#: configuration cannot tell apart must not extrapolate wildly to another
+CV_RCOND = 1e-3
+
+
+def predicts(res, r, held, column) -> bool:
+    """The addition of the columns ``column`` predicts the held-out folds (:func:`held_out_share`); for
+    the two halves of a body, each half too beside the other: a half that only rides along with the
+    other (a spring beside a mass that explains it all) is not kept."""
+    if held_out_share(res, r, held, column) < HELD_OUT_SHARE:
+        return False
+    k = column.shape[1]
+    return k == 1 or all(held_out_share(res, r, np.hstack([held, np.delete(column, h, axis=1)]), column[:, [h]])
+                         >= HELD_OUT_SHARE for h in range(k))
+
+
+def secant(res, held, column, fit: Fit, effects: list, scale: np.ndarray) -> tuple:
+    """(held, column) for :func:`held_out_share` on the secant from the state without the new effects
+    (the columns ``held`` and theirs, ``column``; they are the last of ``effects``) to the fitted state of
+    ``fit``: the mean of the columns at both ends. A large addition (a bar across a card) moves the
+    modes so far that a first-order prediction from the state without it misses the data; the mean of
+    the two slopes follows the whole step, as the trapezoidal rule does."""
+    E = res.effect_columns(fit.state, effects) * scale
+    k = column.shape[1]
+    return 0.5 * (held + np.hstack([res.param_columns(fit.state), E[:, :-k]])), 0.5 * (column + E[:, -k:])

@@ -1,0 +1,86 @@
+"""A region found as two overlapping rectangles refitted as one (:mod:`pcbdyn.diagnosis.one_region`),
+and two regions that are two left as they are. The card of :func:`diagnosis_plates.guided_card`
+(13.3 x 12.9 mm elements), frequencies with 0.2 % noise."""
+
+import numpy as np
+import pytest
+
+from pcbdyn import diagnosis as dg
+from pcbdyn.diagnosis.moves import LocalMoves, rectangle
+from pcbdyn.diagnosis.one_region import as_one_region, starts
+from pcbdyn.diagnosis.region_stiffness import KIND
+from pcbdyn.diagnosis.residual import ModalResidual, Observation
+from pcbdyn.diagnosis.select import Selection, estimate, penalty
+from pcbdyn.fe.modal import solve_modes
+from pcbdyn.testdata import MeasuredModes
+
+from diagnosis_plates import guided_card
+
+N_MODES, SIGMA = 8, 0.002
+DX, DY = 0.16 / 12, 0.18 / 14  # the card's element sizes
+
+
+@pytest.fixture(scope="module")
+def card():
+    m = guided_card()
+    return m, dg.from_model(m)
+
+
+def _pair_fitted(m, layout, truth, boxes, v0):
+    """The card's frequencies with the regions ``truth`` [(rectangle, change)], noise added, and the
+    selection of the regions ``boxes`` fitted to them: (residual, candidates, moves, selection)."""
+    model = m
+    for box, s in truth:
+        model = dg.add_effect(model, KIND.rectangle(layout, *box), s)
+    f = solve_modes(model, n_modes=N_MODES).frequencies
+    f = f * (1.0 + SIGMA * np.random.default_rng(1).standard_normal(N_MODES))
+    res = ModalResidual([Observation(None, MeasuredModes.frequencies_only(f), np.full(N_MODES, SIGMA))], lambda p: [m])
+    cands: list = []
+    moves = LocalMoves(layout, cands, DX)
+    idx = [moves.region("region_stiffness", b) for b in boxes]
+    fit = estimate(res, np.zeros(0), [cands[i] for i in idx], v0, 8)
+    pen = penalty(res.n_rows, len(cands))
+    sel = Selection(chosen=idx, values=fit.values, p=fit.p, chi2=[fit.chi2], criterion=[fit.chi2 + len(idx) * pen],
+                    state=fit.state)
+    return res, cands, moves, sel
+
+
+def test_a_region_between_two_grid_rectangles_becomes_one(card):
+    """A 53 x 51 mm region 50 % softer, fitted first as two rectangles offset from it by two elements
+    (one left, one down, as a grid of patches meets it; their union is twice its area and the
+    area-weighted change over it -0.29): refitted as one rectangle on the truth's cells and the change
+    within 5 %, at the noise's chi^2."""
+    m, layout = card
+    truth = (3 * DX, 4 * DY, 7 * DX, 8 * DY)
+    res, cands, moves, sel = _pair_fitted(m, layout, [(truth, -0.5)],
+                                          [(1 * DX, 4 * DY, 5 * DX, 8 * DY), (3 * DX, 2 * DY, 7 * DX, 6 * DY)],
+                                          [-0.3, -0.3])
+    pair = sel.chi2[-1]
+    as_one_region(res, cands, sel, moves, 0.03)
+    assert [cands[i].kind for i in sel.chosen] == ["region_stiffness"]
+    assert np.abs(np.subtract(rectangle(cands[sel.chosen[0]]), truth)).max() < 0.5 * DX
+    assert sel.values[0] == pytest.approx(-0.5, rel=0.05)
+    assert sel.chi2[-1] < min(pair, 4 * N_MODES)
+
+
+def test_two_overlapping_regions_stay_two(card):
+    """A softer and a stiffer region that overlap: one rectangle cannot stand for them, and the
+    criterion keeps both, unchanged."""
+    m, layout = card
+    a, b = (1 * DX, 2 * DY, 5 * DX, 8 * DY), (3 * DX, 6 * DY, 10 * DX, 11 * DY)
+    res, cands, moves, sel = _pair_fitted(m, layout, [(a, -0.4), (b, 0.8)], [a, b], [-0.3, 0.3])
+    before = (list(sel.chosen), sel.values.copy())
+    as_one_region(res, cands, sel, moves, 0.03)
+    assert sel.chosen == before[0] and np.array_equal(sel.values, before[1])
+
+
+def test_the_starts_keep_the_change_where_regions_overlap():
+    """Changes add where regions overlap: two rectangles of -0.2 and -0.3 give their intersection -0.5,
+    and a rectangle twice the size of one of them half its change; masses are shared by area."""
+    a, b = (0.0, 0.0, 0.02, 0.02), (0.01, 0.0, 0.03, 0.02)
+    got = dict(starts([a, b], [-0.2, -0.3], "region_stiffness"))
+    assert got[(0.01, 0.0, 0.02, 0.02)] == pytest.approx(-0.5)
+    assert got[(0.0, 0.0, 0.03, 0.02)] == pytest.approx((-0.2 * 2 - 0.3 * 2) / 3)
+    masses = dict(starts([a, b], [0.002, 0.004], "region_mass"))
+    assert masses[(0.0, 0.0, 0.03, 0.02)] == pytest.approx(0.006)
+    assert masses[(0.01, 0.0, 0.02, 0.02)] == pytest.approx(0.003)
