@@ -23,8 +23,8 @@ A new effect is kept only if its chi^2 drop exceeds the penalty
 variance left after the fit, chi^2 / (n - k): noise or model error larger than stated must not
 turn into effects; and it must predict data it was not fitted to (:mod:`.held_out`: left-out
 configurations, or modes), so that a model error confined to one configuration or mode is not taken
-for an effect; an addition worth its penalty that the held-out folds refuse is first walked to where
-it fits best and tested there (a grid's candidate beside a real effect predicts it badly). Where the
+for an effect; a region worth its penalty that the held-out folds refuse is first walked to where it
+fits best and tested there (a patch of the coarse grid beside a real region predicts it badly). Where the
 trial that fits best is one that only the screen of saturating kinds or the bodies brought in and it
 is refused, the next best is weighed: they must not hide what the linear shortlist found (a bar on a
 card in guides, behind a guide's stiffness or a heat sink refused). After each addition an earlier
@@ -41,7 +41,7 @@ from scipy.stats import chi2 as chi2_dist
 from .fitting import RANK_STEPS, UPPER, Fit, estimate  # noqa: F401  (re-exported)
 from .halves import Halves, bodies, body_moves, per_kind
 from .held_out import predicts, secant
-from .moves import movable
+from .moves import rectangle
 from .reanalysis import Reanalysis
 from .scan import Runner, rank, saturated, worth_full
 
@@ -85,8 +85,8 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
     the fit of the declared parameters and the held effects when already made, or the state the search
     starts from; ``without``: the least chi^2 without a new effect where ``base`` is not that fit (a
     search from the declared values), which every addition must then beat; ``runner``: where the
-    shortlist's trial fits run (:mod:`.scan`); ``moves``: a :class:`.moves.LocalMoves` that walks an
-    addition worth its penalty but refused by the held-out folds before it is refused (:func:`_walked`).
+    shortlist's trial fits run (:mod:`.scan`); ``moves``: a :class:`.moves.LocalMoves` that walks a
+    region worth its penalty but refused by the held-out folds before it is refused (:func:`_walked`).
     ``max_effects`` counts the held effects."""
     p0 = np.asarray(p0, float)
     n = res.n_rows
@@ -157,8 +157,12 @@ def _walked(res, candidates, sel, fit, j, trial, held, moves, newton_steps, boun
     to where it fits best, where it is then kept (:func:`_kept`); else (None, None). An addition worth
     its penalty that does not predict the held-out folds may be a real effect the candidates' grid
     misplaces (dev seed 12: a region 19 x 28 mm met by a 22 x 20 mm patch 10 mm off, which made four
-    of ten modes' predictions worse; walked onto the region, eight of ten better)."""
-    if not movable(candidates[j]):
+    of ten modes' predictions worse; walked onto the region, eight of ten better). Regions only: theirs
+    is the grid coarser than the mesh (patches of 20 and 40 mm); stiffeners lie on every row of nodes,
+    masses on every node, and a walk gives a model error there one more chance to pass (ho_noise_card,
+    the hold-out's card without any effect: a stiffener refused at its row was walked across a corner
+    and kept)."""
+    if rectangle(candidates[j]) is None:
         return None, None
     stay, idx = set(sel.chosen), sel.chosen + [j]
     start = estimate(res, fit.p, [candidates[i] for i in idx], trial.values, newton_steps, bounds)
