@@ -171,22 +171,6 @@ class State:
                 "mean_mac": float(np.mean(macs)) if macs else None, "configurations": per}
 
 
-def worst_on_common(a: dict, b: dict) -> tuple:
-    """(max |frequency error| [%] of summary ``a``, of ``b``) over the test modes paired in both
-    (:meth:`State.summary`): an effect that gives a partner to a mode the other state left unpaired must
-    not count as a worse fit for the error that mode carries (dev seed 5: a standoff found paired two
-    more modes, and 'after' read 2.03 % against 1.64 % while the five modes paired in both went from
-    1.64 % to 1.18 %). (nan, nan) where no mode is paired in both."""
-    def paired(s):
-        return {(c["configuration"], m["test_mode"]): abs(m["df_pct"]) for c in s["configurations"]
-                for m in c["modes"] if m["paired"]}
-    pa, pb = paired(a), paired(b)
-    common = pa.keys() & pb.keys()
-    if not common:
-        return float("nan"), float("nan")
-    return max(pa[k] for k in common), max(pb[k] for k in common)
-
-
 def paired_state(ob: Observation, model, K, M, modes, U, points=None) -> ConfigState:
     """The state of observation ``ob`` against model ``modes`` (frequencies, and ``U`` their shapes at
     the points, None without measured shapes): test modes paired by MAC (the nearest free frequency

@@ -53,8 +53,7 @@ def test_after_and_parameters_only_are_compared_on_the_modes_paired_in_both():
     """Dev seed 5 (a standoff found from two modes without a partner): 'parameters only' paired five of
     the seven test modes (1.64 % at most), 'after' all seven, mode 1 at 2.03 %. On the five modes paired
     in both the error fell to 1.18 %: no worse fit, and no note."""
-    from pcbdyn.diagnosis.pipeline import worse_note
-    from pcbdyn.diagnosis.residual import worst_on_common
+    from pcbdyn.diagnosis.pipeline import worse_note, worst_on_common
 
     def summary(dfs, paired):
         return {"configurations": [{"configuration": "base", "modes": [
