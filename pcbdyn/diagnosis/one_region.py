@@ -10,20 +10,12 @@ does not rise: one effect instead of several, each of which paid a penalty."""
 from __future__ import annotations
 
 import numpy as np
+import shapely
 
 from .merge import groups
 from .moves import REGION_KINDS, rectangle
 from .fitting import estimate
 from .select import ALPHA, Selection, adopt, penalty, refine
-
-
-def _area(box) -> float:
-    return max(box[2] - box[0], 0.0) * max(box[3] - box[1], 0.0)
-
-
-def _common(a, b) -> float:
-    """Area [m^2] shared by rectangles ``a`` and ``b`` (x0, y0, x1, y1)."""
-    return _area((max(a[0], b[0]), max(a[1], b[1]), min(a[2], b[2]), min(a[3], b[3])))
 
 
 def starts(boxes, values, name: str) -> list:
@@ -32,14 +24,16 @@ def starts(boxes, values, name: str) -> list:
     each box; a stiffness change starts at the members' mean change over the rectangle (changes add
     where regions overlap), a mass at the members' masses in it (each spread over its own box)."""
     b = np.asarray(boxes, float)
+    members = [shapely.box(*m) for m in b]
     tried = [(*b[:, :2].max(axis=0), *b[:, 2:].min(axis=0)), (*b[:, :2].min(axis=0), *b[:, 2:].max(axis=0))]
     tried += [tuple(x) for x in b]
     out = []
     for box in tried:
-        if _area(box) <= 0.0 or any(np.allclose(box, o) for o, _ in out):
+        rect = shapely.box(*box)
+        if not (box[2] > box[0] and box[3] > box[1]) or any(np.allclose(box, o) for o, _ in out):
             continue
-        share = np.array([_common(box, m) for m in b])
-        per = share / _area(box) if name == "region_stiffness" else share / np.array([_area(m) for m in b])
+        share = np.array([rect.intersection(m).area for m in members])
+        per = share / rect.area if name == "region_stiffness" else share / np.array([m.area for m in members])
         out.append((tuple(float(x) for x in box), float(per @ np.asarray(values, float))))
     return out
 
