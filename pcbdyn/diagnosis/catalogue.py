@@ -24,7 +24,10 @@ plugin module of this package that registers an object (:func:`register`, into :
 - ``saturates`` (optional, False by default): True when the effect stiffens the modes near it up to a
   pin or a clamp (a support), so that the search screens more of its candidates at large magnitudes
   (:func:`.scan.saturated`; its optional ``saturated_values`` (multiples of ``scale``) and
-  ``saturated_screen`` (how many) replace the screen's defaults).
+  ``saturated_screen`` (how many) replace the screen's defaults);
+- ``coarse`` (optional, False by default): True when the kind's candidates lie on a grid coarser than
+  the mesh (a region's patches of 20 and 40 mm), so that an addition the held-out folds refuse may be
+  a real effect the grid misplaces: the search walks it before refusing it (:func:`.select.search`).
 
 Every effect enters K and M linearly in its parameter, so dK/dp and dM/dp are exact and the
 same at every value, and the first-order eigenvalue sensitivity (thesis eq. 3.11 with k = i)

@@ -104,6 +104,7 @@ class _RegionStiffness:
     lower = -0.9
     options = ("patch",)
     together = ("region_mass",)  # a body glued over the region (a heat sink) brings both
+    coarse = True  # patches of 20 and 40 mm: a refused region is walked before it is refused (:mod:`.select`)
 
     def generate(self, layout, patch: float = 0.02) -> list:
         if not patch > 0:

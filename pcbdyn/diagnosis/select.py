@@ -38,10 +38,10 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.stats import chi2 as chi2_dist
 
+from .catalogue import kind
 from .fitting import RANK_STEPS, UPPER, Fit, estimate  # noqa: F401  (re-exported)
 from .halves import Halves, bodies, body_moves, per_kind
 from .held_out import predicts, secant
-from .moves import rectangle
 from .reanalysis import Reanalysis
 from .scan import Runner, rank, saturated, worth_full
 
@@ -157,12 +157,12 @@ def _walked(res, candidates, sel, fit, j, trial, held, moves, newton_steps, boun
     to where it fits best, where it is then kept (:func:`_kept`); else (None, None). An addition worth
     its penalty that does not predict the held-out folds may be a real effect the candidates' grid
     misplaces (dev seed 12: a region 19 x 28 mm met by a 22 x 20 mm patch 10 mm off, which made four
-    of ten modes' predictions worse; walked onto the region, eight of ten better). Regions only: theirs
-    is the grid coarser than the mesh (patches of 20 and 40 mm); stiffeners lie on every row of nodes,
-    masses on every node, and a walk gives a model error there one more chance to pass (ho_noise_card,
-    the hold-out's card without any effect: a stiffener refused at its row was walked across a corner
-    and kept)."""
-    if rectangle(candidates[j]) is None:
+    of ten modes' predictions worse; walked onto the region, eight of ten better). Only the kinds whose
+    candidates lie on a grid coarser than the mesh (``coarse``, :mod:`.catalogue`): stiffeners lie on
+    every row of nodes, masses on every node, and a walk gives a model error there one more chance to
+    pass (ho_noise_card, the hold-out's card without any effect: a stiffener refused at its row was
+    walked across a corner and kept)."""
+    if not getattr(kind(candidates[j].kind), "coarse", False) or not moves(j):
         return None, None
     stay, idx = set(sel.chosen), sel.chosen + [j]
     start = estimate(res, fit.p, [candidates[i] for i in idx], trial.values, newton_steps, bounds)
