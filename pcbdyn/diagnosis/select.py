@@ -23,8 +23,9 @@ A new effect is kept only if its chi^2 drop exceeds the penalty
 variance left after the fit, chi^2 / (n - k): noise or model error larger than stated must not
 turn into effects; and it must predict data it was not fitted to (:mod:`.held_out`: left-out
 configurations, or modes), so that a model error confined to one configuration or mode is not taken
-for an effect; a region worth its penalty that the held-out folds refuse is first walked to where it
-fits best and tested there (a patch of the coarse grid beside a real region predicts it badly). Where the
+for an effect; an addition worth its penalty that the held-out folds refuse, of a kind whose candidates
+lie on a grid coarser than the mesh (``coarse``: regions), is first walked to where it fits best and
+tested there (a patch of the coarse grid beside a real region predicts it badly). Where the
 trial that fits best is one that only the screen of saturating kinds or the bodies brought in and it
 is refused, the next best is weighed: they must not hide what the linear shortlist found (a bar on a
 card in guides, behind a guide's stiffness or a heat sink refused). After each addition an earlier
@@ -85,8 +86,9 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
     the fit of the declared parameters and the held effects when already made, or the state the search
     starts from; ``without``: the least chi^2 without a new effect where ``base`` is not that fit (a
     search from the declared values), which every addition must then beat; ``runner``: where the
-    shortlist's trial fits run (:mod:`.scan`); ``moves``: a :class:`.moves.LocalMoves` that walks a
-    region worth its penalty but refused by the held-out folds before it is refused (:func:`_walked`).
+    shortlist's trial fits run (:mod:`.scan`); ``moves``: a :class:`.moves.LocalMoves` that walks an
+    addition of a ``coarse`` kind worth its penalty but refused by the held-out folds before it is
+    refused (:func:`_walked`).
     ``max_effects`` counts the held effects."""
     p0 = np.asarray(p0, float)
     n = res.n_rows
