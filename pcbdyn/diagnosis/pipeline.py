@@ -24,9 +24,9 @@ whether what remains is noise, and otherwise find, place and size the effects th
    along the sides, stiffener lines, rectangular regions and point masses are walked to where they fit
    best (:func:`.select.refine`, :class:`.moves.LocalMoves`), overlapping regions refitted as one
    (:mod:`.one_region`), a mass with an inertia beside it
-   refitted as one body (:mod:`.bodies`), two masses apart, or one alone, as one mass along a
-   line (:mod:`.mass_lines`). The masses (and supports) found are then put on the finer meshes and the mesh
-   correction measured again (:func:`.budget.with_carried`: they change the shapes it depends on); where
+   refitted as one body (:mod:`.bodies`), a mass on nodes placed at its point between them, two masses
+   apart, or one alone, as one mass along a line (:mod:`.mass_lines`). The masses (and supports) found
+   are then put on the finer meshes and the mesh correction measured again (:func:`.budget.with_carried`: they change the shapes it depends on); where
    stiffeners were found, the structure is meshed along their lines first, every effect carried,
    and the ribs' ends and sections fitted there (:func:`_on_lines`, :mod:`.conforming`,
    :mod:`.geometry_fit`). Last, the plate
@@ -47,7 +47,7 @@ from .bodies import as_bodies
 from .catalogue import KINDS, generate, kind
 from .evidence import evidence
 from .layout import from_structure
-from .mass_lines import as_lines
+from .mass_lines import as_lines, as_points
 from .merge import MERGE_REACH, groups, mean_path, merged
 from .moves import REGION_KINDS, LocalMoves, movable, on_node
 from .one_region import as_one_region
@@ -292,6 +292,9 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
         say("fitting a part found as a mass with an inertia beside it as one body")
         sel = as_bodies(res, cands, sel, groups([cands[i] for i in sel.chosen], MERGE_REACH * h),
                         MERGE_REACH * h, models.bounds, alpha=alpha)
+    if any(on_node(cands[i]) for i in sel.chosen):
+        say("placing the masses found on nodes at their points between the nodes")
+        sel = as_points(res, cands, sel, MERGE_REACH * h, layout, h / 2, models.bounds, alpha=alpha)
     if any(cands[i].kind == "point_mass" for i in sel.chosen):
         say("fitting masses found as masses along lines")
         sel = as_lines(res, cands, sel, MERGE_REACH * h, layout, h / 2, models.bounds, alpha=alpha)
