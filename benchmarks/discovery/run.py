@@ -72,6 +72,13 @@ def run_case(seed: int, options: dict, shared=None) -> dict:
     return result
 
 
+#: report seeds a session has read case by case (their files, their diagnosis step by step): no longer
+#: unseen, so the figures are printed without them too (kept here, not in :mod:`cases`, whose code is
+#: part of the cached cases' key). 1021: its failure followed into the search's start from the modes
+#: without a partner; 1022: its point mass beside a hinged edge (2026-11-30).
+SEEN = {1021, 1022}
+
+
 def _pct(k: int, n: int) -> str:
     return f"{k}/{n} ({100 * k / n:.0f} %)" if n else "-"
 
@@ -136,8 +143,21 @@ def main(argv=None):
               f"after {v.get('after', float('nan')):6.2f} % (po {v.get('parameters_only', float('nan')):6.2f}) "
               f"{result['wall_s']:5.0f} s{'' if result['exit'] == 0 else ' EXIT ' + str(result['exit'])} "
               f"[load {os.getloadavg()[0]:.1f}]", flush=True)
+    print(f"\n{len(rows)} cases in {time.perf_counter() - t0:.0f} s")
+    unseen = [r for r in rows if r[0]["case"]["seed"] not in SEEN]
     s = summary(rows)
-    print(f"\n{s['cases']} cases in {time.perf_counter() - t0:.0f} s (crashed {s['crashed']})")
+    _print(s)
+    if len(unseen) < len(rows):
+        print(f"without the report seeds read case by case ({', '.join(map(str, sorted(SEEN)))}: SEEN):")
+        _print(summary(unseen))
+    if a.json:
+        Path(a.json).write_text(json.dumps({"summary": s, "summary_unseen": summary(unseen),
+                                            "rows": [v | {"seed": t["case"]["seed"]} for t, _, v in rows]},
+                                           indent=1, default=float))
+
+
+def _print(s: dict) -> None:
+    print(f"  {s['cases']} cases (crashed {s['crashed']})")
     print(f"  effects of detectable size found (kind, place, magnitude): {_pct(*s['found_detectable'])}; "
           f"placed: {_pct(*s['placed_detectable'])}")
     print(f"  noise-only cases clean: {_pct(*s['clean_noise_only'])}")
@@ -145,9 +165,6 @@ def main(argv=None):
     print(f"  2-sigma coverage of found magnitudes: {_pct(*s['covered_2sigma'])}")
     print(f"  error after: median {s['median_after_pct']} %, <= 0.5 %: {_pct(*s['after_le_0.5'])}")
     print(f"  wall per case: median {s['median_wall_s']:.0f} s, slowest {s['max_wall_s']:.0f} s")
-    if a.json:
-        Path(a.json).write_text(json.dumps({"summary": s, "rows": [v | {"seed": t["case"]["seed"]} for t, _, v in rows]},
-                                           indent=1, default=float))
 
 
 if __name__ == "__main__":
