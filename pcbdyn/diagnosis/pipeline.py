@@ -4,7 +4,9 @@ whether what remains is noise, and otherwise find, place and size the effects th
 1. One mesh for every configuration (:class:`pcbdyn.problems.StructureModels`, ``shared_mesh``), test modes paired by
    MAC, residual rows in units of noise (:mod:`.residual`). A free model's test mode of rigid-body
    shape that no elastic mode resembles shows a support it lacks: a spring to ground is placed and
-   sized from it (:mod:`.support`) and held through the search.
+   sized from it (:mod:`.support`; a mode without a partner on a held model, a mass: :mod:`.unpaired`)
+   and held through the search; placed with the modes at the starting values, it may mislead, so the
+   search also runs without it and the lower criterion wins.
 2. The error budget (:mod:`.budget`, its rules :mod:`pcbdyn.problems.error_budget`'s): the noise
    stated, or for shapes without a stated level the part of each measured shape that no
    combination of the model's modes can represent; the paired frequencies corrected to a converged
@@ -26,12 +28,11 @@ whether what remains is noise, and otherwise find, place and size the effects th
    (:mod:`.one_region`), a mass with an inertia beside it
    refitted as one body (:mod:`.bodies`), a mass on nodes placed at its point between them, two masses
    apart, or one alone, as one mass along a line (:mod:`.mass_lines`). The masses (and supports) found
-   are then put on the finer meshes and the mesh correction measured again (:func:`.budget.with_carried`: they change the shapes it depends on); where
-   stiffeners were found, the structure is meshed along their lines first, every effect carried,
-   and the ribs' ends and sections fitted there (:func:`_on_lines`, :mod:`.conforming`,
-   :mod:`.geometry_fit`). Last, the plate
-   theory's share is fitted with the effects found (:func:`.model_form.fit_plate_share`; kept
-   only where significant).
+   are then put on the finer meshes and the mesh correction measured again (:func:`.budget.with_carried`:
+   they change the shapes it depends on); where stiffeners were found, the structure is meshed along
+   their lines first, every effect carried, and the ribs' ends and sections fitted there
+   (:func:`_on_lines`, :mod:`.conforming`, :mod:`.geometry_fit`). Last, the plate theory's share is
+   fitted with the effects found (:func:`.model_form.fit_plate_share`; kept only where significant).
 """
 
 from __future__ import annotations
@@ -266,6 +267,10 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
     cands += [c for c, _ in support]
     held = list(range(len(cands) - len(support), len(cands)))
     moves = LocalMoves(layout, cands, h)
+
+    def searched(begin, **kw):
+        return search(res, cands, p0, models.bounds, max_effects=max_effects, shortlist=1 if quick else 2, alpha=alpha,
+                      base=begin, runner=runner, moves=moves, **kw)
     sels = []
     for origin in origins:
         begin, placed = origin, held
@@ -273,14 +278,19 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
             say("fitting the support with the declared parameters")
             begin = estimate(res, origin.p, [cands[i] for i in held], [v for _, v in support], 10, models.bounds)
             begin, placed = _walked(res, cands, held, begin, moves, models.bounds, alpha, runner, say)
-        sels.append(search(res, cands, p0, models.bounds, max_effects=max_effects, shortlist=1 if quick else 2,
-                           alpha=alpha, base=begin, runner=runner, held=placed, moves=moves))
+        sels.append(searched(begin, held=placed))
+    if held:  # placed from the starting values' modes, a support can lead the search astray: it runs without too
+        say("searching again without the effects the modes without a partner showed")
+        sels.append(searched(estimate(res, origins[0].p, [], [], 10, models.bounds)))
     declared = None if held else declared_origin(res, base, start, models, say)
     stats["searched_from_declared"] = declared is not None
     if declared is not None:
-        sels.append(search(res, cands, p0, models.bounds, max_effects=max_effects, shortlist=1 if quick else 2,
-                           alpha=alpha, base=declared, runner=runner, without=base.chi2, moves=moves))
+        sels.append(searched(declared, without=base.chi2))
     sel = min(sels, key=lambda s: s.criterion[-1])
+    if held and sel is sels[len(origins)]:
+        say("  the search without them fits better")
+        support, shown = [], {}
+        stats["support_test_modes"] = shown
     if any(movable(cands[i]) for i in sel.chosen):
         say("refining where the effects along the sides begin and end, where stiffeners run, what regions cover "
             "and where masses sit")
