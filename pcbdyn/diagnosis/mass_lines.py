@@ -16,7 +16,6 @@ line is not one the mesh resolves, and a mass between nodes fits it as well as a
 
 from __future__ import annotations
 
-from dataclasses import replace
 from itertools import combinations
 
 import numpy as np
@@ -149,17 +148,11 @@ def _walked_in(res, candidates, sel, replaced, m, first, x, build, step, bounds,
 
 
 def _points(layout, home):
-    """The points a pattern search tries: (x, y) [m] -> [a point mass there, between the nodes
-    (:meth:`.point_mass._Lumped.place`)], None off the plate; ``home``: a point-mass candidate."""
-    plain = {k: v for k, v in home.data.items() if k not in ("radius", "centre")}
-
+    """The points a pattern search tries: (x, y) [m] -> [a mass like ``home`` there, between the nodes
+    (:meth:`.point_mass._Lumped.at_point`)], None off the plate."""
     def build(xy):
-        c = MASS.place(layout, replace(home, at=(float(xy[0]), float(xy[1])), data=plain))
-        try:
-            MASS.footprint(layout.model, c)
-        except ValueError:  # its point lies off the shell
-            return None
-        return [replace(c, name=f"point_mass@{1e3 * xy[0]:.2f},{1e3 * xy[1]:.2f}mm")]
+        c = MASS.at_point(layout, home, xy)
+        return None if c is None else [c]
     return build
 
 

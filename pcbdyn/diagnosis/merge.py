@@ -77,13 +77,13 @@ def groups(chosen, reach: float) -> list:
     return [np.flatnonzero(label == g).tolist() for g in dict.fromkeys(label.tolist())]
 
 
-def merged(chosen, values, cov, cov_jack, group) -> dict:
+def merged(chosen, values, cov, cov_jack, cov_place, group) -> dict:
     """One effect entry (JSON-ready) for a group: the magnitudes summed at their weighted centre (on
     line masses: the place and extent of the largest; parallel stiffeners: their weighted mean
     path; overlapping regions: the mean stiffness change over the area they cover, their union, which
     keeps the change's integral over the board, or their masses summed over it), the uncertainty of
-    that combination from the fit's covariance ``cov``, the jackknife's ``cov_jack`` and the
-    model-form budget (:func:`.uncertainty.parts`)."""
+    that combination from the fit's covariance ``cov``, the jackknife's ``cov_jack``, what the places
+    leave open ``cov_place`` and the model-form budget (:func:`.uncertainty.parts`)."""
     lines = [k for k in group if chosen[k].kind == "line_mass"]
     c = chosen[max(lines, key=lambda k: values[k]) if lines else group[0]]
     d = c.describe()
@@ -107,7 +107,7 @@ def merged(chosen, values, cov, cov_jack, group) -> dict:
         d["mass_kg"] = float(sum(chosen[k].spec.mass(chosen[k], values[k]) for k in group))
         d["section_height_mm"] = round(1e3 * c.spec.section_of(c).h, 4)
     sub = np.ix_(group, group)
-    u = parts(float(w @ v), w, cov[sub] if cov.size else cov, cov_jack[sub])
+    u = parts(float(w @ v), w, cov[sub] if cov.size else cov, cov_jack[sub], cov_place[sub])
     d.update(magnitude=float(w @ v), uncertainty=u.pop("total"), uncertainty_parts=u, kind=c.kind)
     return d
 

@@ -29,9 +29,14 @@ REGION_KINDS = ("region_stiffness", "region_mass")
 
 def movable(cand) -> bool:
     """A candidate :class:`LocalMoves` can move (a run of pieces of a side, a stiffener, a
-    rectangular region, a point between nodes, a point mass on a node)."""
+    rectangular region, a point between nodes, a point mass on a node or at its point)."""
     return ("run" in cand.data or cand.kind == "stiffener" or rectangle(cand) is not None or cand.between_nodes
-            or on_node(cand))
+            or on_node(cand) or at_point(cand))
+
+
+def at_point(cand) -> bool:
+    """A point mass placed at its point between a plate's nodes (a body of no size: :mod:`.mass_lines`)."""
+    return cand.kind == "point_mass" and cand.data.get("radius") == 0.0 and len(cand.at) == 2
 
 
 def on_node(cand) -> bool:
@@ -54,8 +59,8 @@ class LocalMoves:
     same kind and side that start and end at most one piece from its own; for a stiffener, its line
     moved half an element (:data:`LINE_STEP`) across itself either way; for a rectangular region,
     the rectangles with one side moved by one element (:data:`RECT_STEP`) in or out; for a point
-    between nodes (a support, :mod:`.support`), the points a quarter element (:data:`POINT_STEP`)
-    away along x and y; for a point mass on a node, the nodes around it (:data:`NODE_REACH`: a mass
+    between nodes (a support, :mod:`.support`, or a mass at its point), the points a quarter element
+    (:data:`POINT_STEP`) away along x and y; for a point mass on a node, the nodes around it (:data:`NODE_REACH`: a mass
     placed at the parameters' starting values, from a mode without a partner, sits where that model's
     modes put it, and walks to where the fitted model's do). Lines, rectangles and points are made on
     demand and appended to ``cands``."""
@@ -117,6 +122,11 @@ class LocalMoves:
                 except ProbeError:  # off the board
                     continue
             return self._add(made)
+        if at_point(c):
+            step = POINT_STEP * self.h
+            made = [c.spec.at_point(self.layout, c, (c.at[0] + dx, c.at[1] + dy))
+                    for dx, dy in ((step, 0.0), (-step, 0.0), (0.0, step), (0.0, -step))]
+            return self._add([m for m in made if m is not None])
         if on_node(c):
             pts = self.layout.points
             d = np.linalg.norm(pts - pts[int(c.nodes[0])], axis=1)

@@ -61,7 +61,7 @@ from .fitting import estimate
 from .scan import Runner
 from .select import ALPHA, Selection, adopt, noticed, penalty, refine, search, without_vanished
 from .unpaired import partners
-from .uncertainty import jackknife_cov
+from .uncertainty import jackknife_cov, place_cov
 
 #: where candidates go: sides cut into 16 pieces (every run of consecutive pieces is a candidate);
 #: stiffener rows and columns every element (``path_spacing`` in element sizes)
@@ -337,8 +337,11 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
     for n, v in zip(names, sel.p):
         out["parameters"][n]["final"] = float(v)
     chosen = [cands[i] for i in sel.chosen]
-    cov_jack = jackknife_cov(res, sel.state, chosen, np.array([c.spec.scale for c in chosen]))
-    effects = [merged(chosen, sel.values, sel.cov, cov_jack, g) for g in groups(chosen, MERGE_REACH * h)]
+    scale = np.array([c.spec.scale for c in chosen])
+    cov_jack = jackknife_cov(res, sel.state, chosen, scale)
+    near = LocalMoves(from_structure(models.models[0]), cands, h)
+    cov_place = place_cov(res, sel.state, chosen, scale, lambda j: [cands[i] for i in near(sel.chosen[j])])
+    effects = [merged(chosen, sel.values, sel.cov, cov_jack, cov_place, g) for g in groups(chosen, MERGE_REACH * h)]
     if effects:
         msg = f"{len(effects)} effect(s) the model lacks: " + "; ".join(
             f"{e['type']} ({e['parameter']}) at {e['at_mm']} mm" for e in effects)

@@ -47,6 +47,17 @@ class _Lumped:
             return replace(placed, at=candidate.at, data={**candidate.data, "radius": 0.0, "centre": centre})
         return placed
 
+    def at_point(self, layout, home, xy):
+        """A mass like candidate ``home`` at the point ``xy`` [m] of a plate between the nodes (a body of
+        no size, :meth:`place`), named for its point; None where the point lies off the shell."""
+        plain = {k: v for k, v in home.data.items() if k not in ("radius", "centre")}
+        c = self.place(layout, replace(home, at=(float(xy[0]), float(xy[1])), data=plain))
+        try:
+            self.footprint(layout.model, c)
+        except ValueError:  # off the shell
+            return None
+        return replace(c, name=f"{self.name}@{1e3 * xy[0]:.2f},{1e3 * xy[1]:.2f}mm")
+
     def footprint(self, model, candidate) -> tuple:
         """(cell nodes, sample weights or None) the candidate's body moves with: with
         ``data["radius"]`` (a body of that radius of gyration centred at ``data["centre"]``,

@@ -235,7 +235,7 @@ def test_parallel_stiffeners_side_by_side_are_reported_as_one_rib(card):
                                                                     np.array([0.16, 0.09]))
     groups = groups([a, b, cross], 0.02)
     assert sorted(map(sorted, groups)) == [[0, 1], [2]]
-    d = merged([a, b, cross], np.array([3.0, 1.0, 2.0]), np.zeros((0, 0)), np.zeros((3, 3)), [0, 1])
+    d = merged([a, b, cross], np.array([3.0, 1.0, 2.0]), np.zeros((0, 0)), np.zeros((3, 3)), np.zeros((3, 3)), [0, 1])
     assert d["magnitude"] == pytest.approx(4.0)
     assert np.allclose(np.asarray(d["path_mm"])[:, 0], 62.5)
 
@@ -252,7 +252,7 @@ def test_overlapping_regions_are_reported_as_one_with_their_mean_change(card):
     a, b = region.rectangle(layout, 0.02, 0.02, 0.06, 0.06), region.rectangle(layout, 0.04, 0.04, 0.08, 0.08)
     far = region.rectangle(layout, 0.10, 0.10, 0.14, 0.14)
     assert sorted(map(sorted, groups([a, b, far], 0.02))) == [[0, 1], [2]]
-    d = merged([a, b], np.array([2.0, 1.0]), np.zeros((0, 0)), np.zeros((2, 2)), [0, 1])
+    d = merged([a, b], np.array([2.0, 1.0]), np.zeros((0, 0)), np.zeros((2, 2)), np.zeros((2, 2)), [0, 1])
     union = shapely.Polygon(d["polygon_mm"])
     assert union.bounds == pytest.approx((20.0, 20.0, 80.0, 80.0))
     assert union.area == pytest.approx(2 * 40.0**2 - 20.0**2)
