@@ -60,10 +60,10 @@ class LocalMoves:
     moved half an element (:data:`LINE_STEP`) across itself either way; for a rectangular region,
     the rectangles with one side moved by one element (:data:`RECT_STEP`) in or out; for a point
     between nodes (a support, :mod:`.support`, or a mass at its point), the points a quarter element
-    (:data:`POINT_STEP`) away along x and y; for a point mass on a node, the nodes around it (:data:`NODE_REACH`: a mass
-    placed at the parameters' starting values, from a mode without a partner, sits where that model's
-    modes put it, and walks to where the fitted model's do). Lines, rectangles and points are made on
-    demand and appended to ``cands``."""
+    (:data:`POINT_STEP`) away along x and y; for a point mass on a node, the nodes around it
+    (:data:`NODE_REACH`: a mass placed at the parameters' starting values, from a mode without a
+    partner, sits where that model's modes put it, and walks to where the fitted model's do). Lines,
+    rectangles and points are made on demand and appended to ``cands``."""
 
     def __init__(self, layout, cands: list, h: float):
         self.layout, self.cands, self.h = layout, cands, h
