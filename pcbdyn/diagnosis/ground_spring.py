@@ -2,7 +2,7 @@
 component touching the board). dK/dk has a single 1 on the node's uz; dM = 0, so
 d lambda_i / dk = phi_i(node, z)^2 (thesis eq. 3.11 with k = i). On a structure in 3-D (a box) the
 spring acts along the shells' normal n at the node (``data["normal"]``): dK/dk = n n^T on its
-translations. A spring at a point between nodes (:func:`at_point`: a support placed from a measured
+translations. A spring at a point between nodes (:meth:`_GroundSpring.at_point`: a support placed from a measured
 mode, :mod:`.support`) acts on the point that the shell cell's shape functions interpolate
 (``data["point_weights"]`` over its nodes): dK/dk = (w w^T) (x) n n^T, the same point on any mesh."""
 
@@ -14,7 +14,7 @@ import numpy as np
 
 from ..fe import SpringProperty
 from ..fe.elements.discrete import point_spring
-from ..fe.probe import model_probe
+from ..fe.probe import ProbeError, model_probe
 from .catalogue import register, Blocks, Candidate, node_candidates, on_nearest_node
 
 
@@ -34,9 +34,20 @@ class _GroundSpring:
 
     def place(self, layout, candidate):
         if candidate.between_nodes:
-            return at_point(layout, candidate.at)
+            return _at(layout, candidate.at)
         placed = on_nearest_node(layout, candidate)
         return placed if "normal" not in candidate.data else _normal(layout, placed)
+
+    def at_point(self, layout, home, xy):
+        """A spring to ground at the point ``xy`` [m] of a board between the nodes (interpolated by the shell
+        cell that holds it); None off the board or on a structure in 3-D. ``home``: the candidate it moves
+        from (the same call as :meth:`.point_mass._Lumped.at_point`)."""
+        if not layout.planar:
+            return None
+        try:
+            return _at(layout, xy)
+        except ProbeError:
+            return None
 
     def blocks(self, model, candidates) -> list:
         out = []
@@ -56,8 +67,9 @@ class _GroundSpring:
         return m
 
 
-def at_point(layout, xy) -> Candidate:
-    """A spring to ground at the point ``xy`` [m] of a board (x, y), on the shell cell that holds it."""
+def _at(layout, xy) -> Candidate:
+    """A spring to ground at the point ``xy`` [m] of a board (x, y), on the shell cell that holds it;
+    :class:`..fe.probe.ProbeError` off the board."""
     z = float(layout.model.nodes[layout.shell_nodes()[0], 2])
     loc = model_probe(layout.model, [[xy[0], xy[1], z]]).location
     keep = loc.weights[0] != 0.0  # a triangle repeats its last node with weight 0

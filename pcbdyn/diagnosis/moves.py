@@ -9,7 +9,6 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..fe.probe import ProbeError
 from .catalogue import kind
 
 #: [element sizes] how far a stiffener's line moves across itself in one step of the local search
@@ -30,13 +29,13 @@ REGION_KINDS = ("region_stiffness", "region_mass")
 def movable(cand) -> bool:
     """A candidate :class:`LocalMoves` can move (a run of pieces of a side, a stiffener, a
     rectangular region, a point between nodes, a point mass on a node or at its point)."""
-    return ("run" in cand.data or cand.kind == "stiffener" or rectangle(cand) is not None or cand.between_nodes
-            or on_node(cand) or at_point(cand))
+    return "run" in cand.data or cand.kind == "stiffener" or rectangle(cand) is not None or on_node(cand) or at_point(cand)
 
 
 def at_point(cand) -> bool:
-    """A point mass placed at its point between a plate's nodes (a body of no size: :mod:`.mass_lines`)."""
-    return cand.kind == "point_mass" and cand.data.get("radius") == 0.0 and len(cand.at) == 2
+    """An effect at its point between a plate's nodes: a support (:mod:`.support`) or a point mass (a body
+    of no size: :mod:`.mass_lines`); its kind's ``at_point`` places it at another point."""
+    return cand.between_nodes or (cand.kind == "point_mass" and cand.data.get("radius") == 0.0)
 
 
 def on_node(cand) -> bool:
@@ -114,14 +113,6 @@ class LocalMoves:
                     if (a, b) != (i, j) and (a, b) in runs]
         if c.kind == "stiffener":
             return self._add(kind("stiffener").parallel(self.layout, c, LINE_STEP * self.h * np.array([-1.0, 1.0])))
-        if c.between_nodes:
-            step, made = POINT_STEP * self.h, []
-            for d in ((step, 0.0), (-step, 0.0), (0.0, step), (0.0, -step)):
-                try:
-                    made.append(c.spec.place(self.layout, replace(c, at=(c.at[0] + d[0], c.at[1] + d[1]))))
-                except ProbeError:  # off the board
-                    continue
-            return self._add(made)
         if at_point(c):
             step = POINT_STEP * self.h
             made = [c.spec.at_point(self.layout, c, (c.at[0] + dx, c.at[1] + dy))

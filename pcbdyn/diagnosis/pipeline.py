@@ -281,13 +281,13 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
         sels.append(searched(begin, held=placed))
     if held:  # placed from the starting values' modes, a support can lead the search astray: it runs without too
         say("searching again without the effects the modes without a partner showed")
-        sels.append(searched(estimate(res, origins[0].p, [], [], 10, models.bounds)))
+        sels.append(free := searched(estimate(res, origins[0].p, [], [], 10, models.bounds)))
     declared = None if held else declared_origin(res, base, start, models, say)
     stats["searched_from_declared"] = declared is not None
     if declared is not None:
         sels.append(searched(declared, without=base.chi2))
     sel = min(sels, key=lambda s: s.criterion[-1])
-    if held and sel is sels[len(origins)]:
+    if held and sel is free:
         say("  the search without them fits better")
         support, shown = [], {}
         stats["support_test_modes"] = shown
@@ -339,7 +339,7 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
     chosen = [cands[i] for i in sel.chosen]
     scale = np.array([c.spec.scale for c in chosen])
     cov_jack = jackknife_cov(res, sel.state, chosen, scale)
-    near = LocalMoves(from_structure(models.models[0]), cands, h)
+    near = moves if lined is None else LocalMoves(from_structure(models.models[0]), cands, h)
     cov_place = place_cov(res, sel.state, chosen, scale, lambda j: [cands[i] for i in near(sel.chosen[j])])
     effects = [merged(chosen, sel.values, sel.cov, cov_jack, cov_place, g) for g in groups(chosen, MERGE_REACH * h)]
     if effects:

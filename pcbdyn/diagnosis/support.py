@@ -30,9 +30,8 @@ from scipy.linalg import eigh
 
 from ..correlation.mac import mac
 from ..fe.mesh import DOF_NAMES, NDOF
-from ..fe.probe import ProbeError
 from .catalogue import effect_forms
-from .ground_spring import at_point
+from .ground_spring import KIND as SPRING
 from .select import orth
 
 #: a test mode without a model partner is a support's when at least this share of its shape at
@@ -158,10 +157,7 @@ def _between_nodes(layout, rigid, points, nr: int, x):
     c = np.linalg.lstsq(np.column_stack([B, points[:, nr:]]), x[:, 0], rcond=None)[0][:3]
     if abs(c[0]) <= 1e-9 * np.abs(c).max():
         return None
-    try:
-        return at_point(layout, c[1:] / c[0])
-    except ProbeError:
-        return None
+    return SPRING.at_point(layout, None, c[1:] / c[0])
 
 
 #: how far the mean MAC of the other paired modes may fall when a support is added (:func:`shapes_kept`)

@@ -8,7 +8,7 @@ import pytest
 from diagnosis_plates import PLATE, measured
 
 import pcbdyn.diagnosis as dg
-from pcbdyn.diagnosis.ground_spring import at_point
+from pcbdyn.diagnosis.ground_spring import KIND as SPRING
 from pcbdyn.diagnosis.residual import ModalResidual, Observation
 from pcbdyn.diagnosis.support import locate, rigid_share, support_modes
 from pcbdyn.fe import MassProperty, Model
@@ -38,7 +38,7 @@ def test_bounce_places_and_sizes_the_spring(at, k, mass):
     both)."""
     model = free_plate()
     layout = dg.from_model(model)
-    point = at_point(layout, at)
+    point = SPRING.at_point(layout, None, at)
     truth = dg.add_effect(model, point, k)
     if mass:  # a bracket's mass on the same point
         truth.add("bracket", "mass", [point.nodes], MassProperty(mass, footprint=[point.data["point_weights"]]))
