@@ -5,9 +5,12 @@ whether what the fit leaves is noise (thesis section 5.2.3)."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from scipy.stats import chi2 as chi2_dist
 
+from ..parallel import beside, spare
 from .fitting import estimate
 from .residual import ModalResidual
 
@@ -37,22 +40,45 @@ def paired_start(models, obs, p0, before, say, rounds: int = 2) -> tuple:
     return p, at
 
 
-def update_start(structure, tests, noise, h, say):
-    """``pcbdyn update``'s fit of the declared parameters to ``tests`` ([(configuration, measured
-    modes)], every test mode, as the command reads them), called as the command calls it
-    (:func:`pcbdyn.problems.fit.fit`: the one fitting engine of update, calibrate and wedgelock, with its
-    scanned starts, trust region and mesh check); None where it cannot run. Not given the diagnosis's
-    own mesh correction: on a card in guides with a softer region that fit stops in another basin (the
-    guides' stiffness 3 times lower, 5.6 % left on the paired modes against update's 2.0 %)."""
+@dataclass
+class Updated:
+    """What the diagnosis keeps of ``pcbdyn update``'s fit: its ``status`` and parameter ``values`` [SI]."""
+
+    status: str
+    values: dict
+
+
+def _update(structure, tests, noise, h) -> Updated:
     from ..problems import UpdateProblem
     from ..problems.fit import fit
 
-    say("fitting the declared parameters as pcbdyn update does")
-    try:
-        return fit(UpdateProblem(structure, mesh_size=h), list(tests), noise=noise, mesh_check=True)
-    except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
-        say(f"  update's fit did not run ({exc}); the diagnosis goes on from its own")
-        return None
+    done = fit(UpdateProblem(structure, mesh_size=h), list(tests), noise=noise, mesh_check=True)
+    return Updated(done.status, dict(done.values))
+
+
+def update_start(structure, tests, noise, h, say):
+    """A callable giving ``pcbdyn update``'s fit of the declared parameters to ``tests`` ([(configuration,
+    measured modes)], every test mode, as the command reads them; :class:`Updated`), or None where it
+    cannot run. Called as the command calls it (:func:`pcbdyn.problems.fit.fit`: the one fitting engine
+    of update, calibrate and wedgelock, with its scanned starts, trust region and mesh check); on a
+    spare core (:func:`pcbdyn.parallel.beside`) while this process fits its own, where there is one.
+    Not given the diagnosis's own mesh correction: on a card in guides with a softer region that fit
+    stops in another basin (the guides' stiffness 3 times lower, 5.6 % left on the paired modes
+    against update's 2.0 %)."""
+    pending = None
+    if spare():
+        say("fitting the declared parameters as pcbdyn update does, on a spare core")
+        pending = beside(_update, structure, tests, noise, h)
+
+    def result():
+        if pending is None:
+            say("fitting the declared parameters as pcbdyn update does")
+        try:
+            return _update(structure, tests, noise, h) if pending is None else pending.result()
+        except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
+            say(f"  update's fit did not run ({exc}); the diagnosis goes on from its own")
+            return None
+    return result
 
 
 def parameter_stage(plain, own, update, models, say) -> tuple:

@@ -203,6 +203,7 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
     names, p0 = models.names, models.p0
     obs = observations(tests, models.models)
     res = ModalResidual.of_models(models, obs)
+    updated = update_start(structure, tests, (freq_noise_pct, shape_noise_pct), h, say) if names else None
     say("solving the model as given")
     before = res.evaluate(p0)
     record["before"] = before.summary(obs)
@@ -230,7 +231,7 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
     # the declared parameters alone, on the modes they can pair (a support's bounce has no partner without it)
     plain = ModalResidual.of_models(models, [ob.subset(~b) for ob, b in zip(obs, bounce)]) if support else res
     own = estimate(plain, start, [], [], 10, models.bounds)
-    update = update_start(structure, tests, (freq_noise_pct, shape_noise_pct), h, say) if names else None
+    update = updated() if names else None
     base, origins, told = parameter_stage(plain, own, update, models, say)
     stats = {"quick": quick, "unpaired_test_modes": unmatched, "support_test_modes": shown, "chi2_before": before.chi2,
              **range_test(plain, base, len(names), alpha),

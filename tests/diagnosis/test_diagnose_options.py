@@ -5,6 +5,7 @@ in this process, in worker processes or on a Dask cluster give the same findings
 from __future__ import annotations
 
 import json
+import os
 import re
 import sys
 from pathlib import Path
@@ -43,10 +44,16 @@ def _diagnose(case, out: Path, *extra) -> tuple:
 
 
 @pytest.fixture(scope="module")
-def default(case, tmp_path_factory):
-    data, _ = _diagnose(case, tmp_path_factory.mktemp("default"))
+def default_run(case, tmp_path_factory):
+    """(JSON, progress) of the run with the default workers (the cores)."""
+    data, output = _diagnose(case, tmp_path_factory.mktemp("default"))
     assert not judge(CASE, case[2], data)
-    return data
+    return data, output
+
+
+@pytest.fixture(scope="module")
+def default(default_run):
+    return default_run[0]
 
 
 def _same_findings(a: dict, b: dict, mag_rel: float, at_mm: float) -> None:
@@ -87,11 +94,19 @@ def test_scheduler_gives_the_same_findings(case, default, tmp_path):
     assert np.isfinite(data["effects"][0]["uncertainty"])
 
 
-def test_worker_processes_give_the_findings_of_one_process(case, default, tmp_path):
+def test_worker_processes_give_the_findings_of_one_process(case, default_run, tmp_path):
     """The quick fits that screen each scan and the full trial fits run in two local worker processes
-    by default and all in this process with ``--workers 1``: the same findings (to round-off), so
-    where a job ran never changes an answer."""
+    by default and all in this process with ``--workers 1``, and ``pcbdyn update``'s fit of the declared
+    parameters on a spare core beside the diagnosis's own (with two cores or more) or after it: the same
+    findings and the same update (to round-off), so where a job ran never changes an answer."""
+    default, beside = default_run
     data, output = _diagnose(case, tmp_path, "--workers", "1")
+    assert "as pcbdyn update does" in output and "on a spare core" not in output
+    if (os.cpu_count() or 1) > 1:
+        assert "as pcbdyn update does, on a spare core" in beside
+    ran, ran_beside = data["statistics"]["update"], default["statistics"]["update"]
+    assert ran["status"] == ran_beside["status"] and list(ran["parameters"]) == list(ran_beside["parameters"])
+    assert list(ran["parameters"].values()) == pytest.approx(list(ran_beside["parameters"].values()), rel=1e-9)
     assert "trials screened on the reanalysis" in output
     _same_findings(data, default, 1e-9, 1e-6)
     assert data["after"]["max_freq_error_pct"] == pytest.approx(default["after"]["max_freq_error_pct"], rel=1e-9)
