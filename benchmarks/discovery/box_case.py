@@ -14,6 +14,10 @@ only and after, update's, and the wall times with the machine's load.
 Measured (2026-11-28, the truth at 2.5 mm): relay found 0.7 mm off (the model's nearest node), 80.5 g
 (+0.6 %); max |df| 29.7 % as given, 3.09 % parameters only, 0.95 % after; pcbdyn update 27.5 % ("cannot fit":
 with the relay's mode among the data its fit finds another basin); diagnose 78-94 s, update 25-27 s wall.
+Measured again (2026-11-30, load 0.2-0.4): the same figures but parameters only 2.86 %; diagnose 181 s (a second
+search without the support placed from the relay's unpaired mode, and the diagnosis's own and update's fits of
+the declared parameters one after the other), 135 s with update's fit on the spare core beside the diagnosis's
+own; update 44-45 s.
 """
 
 from __future__ import annotations
