@@ -61,7 +61,8 @@ def update_start(structure, tests, noise, h, say):
     measured modes)], every test mode, as the command reads them; :class:`Updated`), or None where it
     cannot run. Called as the command calls it (:func:`pcbdyn.problems.fit.fit`: the one fitting engine
     of update, calibrate and wedgelock, with its scanned starts, trust region and mesh check); on a
-    spare core (:func:`pcbdyn.parallel.beside`) while this process fits its own, where there is one.
+    spare core (:func:`pcbdyn.parallel.beside`) while this process fits its own, where there is one (a
+    fit of several configurations shares them out on the same spare processes, and waits for them).
     Not given the diagnosis's own mesh correction: on a card in guides with a softer region that fit
     stops in another basin (the guides' stiffness 3 times lower, 5.6 % left on the paired modes
     against update's 2.0 %)."""
