@@ -12,7 +12,8 @@ second moment) is tried as lines through that centre in four directions and seve
 best walked the same way; it must lower the criterion by one effect's penalty more, as its direction
 and length are two coordinates a point does not have, and end at least two elements long: a shorter
 line is not one the mesh resolves, and a mass between nodes fits it as well as a point (dev seed 0's
-50 g point mass had become a 7.8 mm line on 6 mm elements)."""
+50 g point mass had become a 7.8 mm line on 6 mm elements). The same walk places a mass or a spring to
+ground found on nodes at its point between them (:func:`as_points`)."""
 
 from __future__ import annotations
 
@@ -24,7 +25,6 @@ from .catalogue import weighted_centre
 from .fitting import RANK_STEPS, estimate, pattern_search
 from .line_mass import KIND
 from .moves import on_node
-from .point_mass import MASS
 from .merge import groups
 from .reanalysis import Reanalysis
 from .select import ALPHA, adopt, penalty
@@ -48,6 +48,18 @@ def _masses(chosen, values, groups) -> list:
         inertias = [k for k, c in enumerate(chosen) if c.kind == "point_inertia" and c.data.get("centre") in bodies]
         out.append((g + inertias, g, float(v[g].sum()), weighted_centre([chosen[k] for k in g], v[g])[:2]))
     return out
+
+
+def spring_on_node(cand) -> bool:
+    """A spring to ground found on one node of a board (the search's grid; :func:`as_points` places it)."""
+    return cand.kind == "ground_spring" and cand.nodes.size == 1 and not cand.between_nodes and "normal" not in cand.data
+
+
+def _springs(chosen, values, groups) -> list:
+    """:func:`_masses`' tuples for the springs to ground found on nodes (a group of shares on nodes)."""
+    v = np.asarray(values, float)
+    return [(g, g, float(v[g].sum()), weighted_centre([chosen[k] for k in g], v[g])[:2]) for g in groups
+            if all(spring_on_node(chosen[k]) for k in g)]
 
 
 def _pairs(candidates, sel, groups) -> list:
@@ -148,30 +160,32 @@ def _walked_in(res, candidates, sel, replaced, m, first, x, build, step, bounds,
 
 
 def _points(layout, home):
-    """The points a pattern search tries: (x, y) [m] -> [a mass like ``home`` there, between the nodes
-    (:meth:`.point_mass._Lumped.at_point`)], None off the plate."""
+    """The points a pattern search tries: (x, y) [m] -> [an effect like ``home`` there, between the nodes
+    (its kind's ``at_point``)], None off the plate."""
     def build(xy):
-        c = MASS.at_point(layout, home, xy)
+        c = home.spec.at_point(layout, home, xy)
         return None if c is None else [c]
     return build
 
 
 def as_points(res, candidates: list, sel, reach: float, layout, step: float, bounds=None, newton_steps: int = 8,
               alpha: float = ALPHA):
-    """``sel`` with each mass found on nodes (one node, or shares on nodes within ``reach`` [m] reported
-    as one, :func:`.merge.groups`) refitted as one mass at a point between the nodes, walked from its
-    (shares') centre from steps of ``step`` [m] (half the model's element size), where that lowers the
-    criterion. Forward selection finds a mass on the node nearest to it, or as shares on two nodes;
-    the generated benchmark's masses lie anywhere (dev seed 4's 32.5 g, found as 35.2 g on two nodes
-    with their centre 2.2 mm off, is placed 0.4 mm off as 32.9 g). Candidates are appended to
+    """``sel`` with each mass or spring to ground found on nodes (one node, or shares on nodes within
+    ``reach`` [m] reported as one, :func:`.merge.groups`) refitted as one at a point between the nodes,
+    walked from its (shares') centre from steps of ``step`` [m] (half the model's element size), where
+    that lowers the criterion. Forward selection finds an effect on the node nearest to it, or as shares
+    on two nodes; the generated benchmark's lie anywhere (dev seed 4's 32.5 g, found as 35.2 g on two
+    nodes with their centre 2.2 mm off, is placed 0.4 mm off as 32.9 g). Candidates are appended to
     ``candidates``; ``sel`` is updated in place."""
     if not layout.planar:
         return sel
     pen = penalty(res.n_rows, len(candidates), alpha)
     chosen = [candidates[i] for i in sel.chosen]
-    for g, gm, m, centre in _masses(chosen, sel.values, groups(chosen, reach)):
+    grouped = groups(chosen, reach)
+    for g, gm, m, centre in _masses(chosen, sel.values, grouped) + _springs(chosen, sel.values, grouped):
         ids = [sel.chosen[k] for k in g]
-        if len(g) != len(gm) or not all(on_node(chosen[k]) for k in gm) or not m > 0 or not set(ids) <= set(sel.chosen):
+        if len(g) != len(gm) or not all(on_node(chosen[k]) or spring_on_node(chosen[k]) for k in gm) or not m > 0 \
+                or not set(ids) <= set(sel.chosen):
             continue
         build = _points(layout, chosen[gm[0]])
         first = build(centre)

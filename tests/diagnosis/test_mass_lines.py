@@ -196,3 +196,29 @@ def test_a_point_mass_found_on_a_node_is_placed_at_its_point(card, xy):
     assert np.linalg.norm(np.subtract(placed.at[:2], xy)) < 0.002
     assert sel.values[0] == pytest.approx(0.020, rel=0.03)
     assert sel.chi2[-1] < fit.chi2
+
+
+@pytest.mark.parametrize("xy", [(0.0733, 0.0836), (0.10, 0.13)])
+def test_a_spring_found_on_a_node_is_placed_at_its_point(card, xy):
+    """A 30 kN/m spring to ground inside a cell, found on the nearest node that moves: placed between
+    the nodes by :func:`as_points` like a mass, it lands within 2 mm of its point with its stiffness
+    within 3 %, and fits the frequencies better than the node's spring did."""
+    from pcbdyn.diagnosis.ground_spring import KIND as SPRING
+    from pcbdyn.diagnosis.mass_lines import as_points
+
+    m, layout = card
+    cands = list(dg.generate(layout, kinds=["ground_spring"]))
+    moving = [i for i, c in enumerate(cands) if c.at[0] > 1e-6]
+    near = min(moving, key=lambda i: np.linalg.norm(np.subtract(cands[i].at[:2], xy)))
+    truth = dg.add_effect(m, SPRING.at_point(layout, None, xy), 3e4)
+    res = ModalResidual([Observation(None, MeasuredModes.frequencies_only(solve_modes(truth, n_modes=N_MODES).frequencies),
+                                     np.full(N_MODES, SIGMA))], lambda p: [m])
+    fit = estimate(res, np.zeros(0), [cands[near]], [3e4], 8)
+    sel = Selection(chosen=[near], values=fit.values, p=fit.p, chi2=[fit.chi2],
+                    criterion=[fit.chi2 + penalty(res.n_rows, len(cands))], state=fit.state)
+    sel = as_points(res, cands, sel, 0.02, layout, 0.0065)
+    placed = cands[sel.chosen[0]]
+    assert placed.kind == "ground_spring" and placed.between_nodes and sel.chosen[0] != near
+    assert np.linalg.norm(np.subtract(placed.at[:2], xy)) < 0.002
+    assert sel.values[0] == pytest.approx(3e4, rel=0.03)
+    assert sel.chi2[-1] < fit.chi2
