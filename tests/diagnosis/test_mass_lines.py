@@ -169,56 +169,29 @@ def test_a_point_mass_between_the_nodes_is_no_short_line(card, xy):
 
 
 @pytest.mark.parametrize("xy", [(0.0733, 0.0836), (0.10, 0.13)])
-def test_a_point_mass_found_on_a_node_is_placed_at_its_point(card, xy):
-    """A 20 g point mass inside a cell, found as a point mass on the nearest node (that moves: the
-    guides' nodes do not): placed between the nodes by :func:`as_points`, it lands within 2 mm of its
-    point with its mass within 3 %, and fits the frequencies better than the node's mass did. (Beside a
-    guide the frequencies cannot place it: across the element next to the edge the modes are linear
-    in x, and a mass m at x is the mass m (x / x')^2 at x'.)"""
-    from dataclasses import replace
-
+@pytest.mark.parametrize("kind, value", [("point_mass", 0.020), ("ground_spring", 3e4)])
+def test_an_effect_found_on_a_node_is_placed_at_its_point(card, kind, value, xy):
+    """A 20 g point mass or a 30 kN/m spring to ground inside a cell, found on the nearest node (that
+    moves: the guides' nodes do not): placed between the nodes by :func:`as_points`, it lands within
+    2 mm of its point with its magnitude within 3 %, and fits the frequencies better than the node's
+    effect did. (Beside a guide the frequencies cannot place a mass: across the element next to the
+    edge the modes are linear in x, and a mass m at x is the mass m (x / x')^2 at x'.)"""
+    from pcbdyn.diagnosis.catalogue import kind as spec
     from pcbdyn.diagnosis.mass_lines import as_points
-    from pcbdyn.diagnosis.point_mass import MASS
 
     m, layout = card
-    cands = list(dg.generate(layout, kinds=["point_mass"]))
+    cands = list(dg.generate(layout, kinds=[kind]))
     moving = [i for i, c in enumerate(cands) if c.at[0] > 1e-6]
     near = min(moving, key=lambda i: np.linalg.norm(np.subtract(cands[i].at[:2], xy)))
-    truth = dg.add_effect(m, MASS.place(layout, replace(cands[near], at=xy)), 0.020)
+    truth = dg.add_effect(m, spec(kind).at_point(layout, cands[near], xy), value)
     res = ModalResidual([Observation(None, MeasuredModes.frequencies_only(solve_modes(truth, n_modes=N_MODES).frequencies),
                                      np.full(N_MODES, SIGMA))], lambda p: [m])
-    fit = estimate(res, np.zeros(0), [cands[near]], [0.020], 8)
+    fit = estimate(res, np.zeros(0), [cands[near]], [value], 8)
     sel = Selection(chosen=[near], values=fit.values, p=fit.p, chi2=[fit.chi2],
                     criterion=[fit.chi2 + penalty(res.n_rows, len(cands))], state=fit.state)
     sel = as_points(res, cands, sel, 0.02, layout, 0.0065)
     placed = cands[sel.chosen[0]]
-    assert [c.kind for c in (placed,)] == ["point_mass"] and sel.chosen[0] != near
+    assert placed.kind == kind and sel.chosen[0] != near
     assert np.linalg.norm(np.subtract(placed.at[:2], xy)) < 0.002
-    assert sel.values[0] == pytest.approx(0.020, rel=0.03)
-    assert sel.chi2[-1] < fit.chi2
-
-
-@pytest.mark.parametrize("xy", [(0.0733, 0.0836), (0.10, 0.13)])
-def test_a_spring_found_on_a_node_is_placed_at_its_point(card, xy):
-    """A 30 kN/m spring to ground inside a cell, found on the nearest node that moves: placed between
-    the nodes by :func:`as_points` like a mass, it lands within 2 mm of its point with its stiffness
-    within 3 %, and fits the frequencies better than the node's spring did."""
-    from pcbdyn.diagnosis.ground_spring import KIND as SPRING
-    from pcbdyn.diagnosis.mass_lines import as_points
-
-    m, layout = card
-    cands = list(dg.generate(layout, kinds=["ground_spring"]))
-    moving = [i for i, c in enumerate(cands) if c.at[0] > 1e-6]
-    near = min(moving, key=lambda i: np.linalg.norm(np.subtract(cands[i].at[:2], xy)))
-    truth = dg.add_effect(m, SPRING.at_point(layout, None, xy), 3e4)
-    res = ModalResidual([Observation(None, MeasuredModes.frequencies_only(solve_modes(truth, n_modes=N_MODES).frequencies),
-                                     np.full(N_MODES, SIGMA))], lambda p: [m])
-    fit = estimate(res, np.zeros(0), [cands[near]], [3e4], 8)
-    sel = Selection(chosen=[near], values=fit.values, p=fit.p, chi2=[fit.chi2],
-                    criterion=[fit.chi2 + penalty(res.n_rows, len(cands))], state=fit.state)
-    sel = as_points(res, cands, sel, 0.02, layout, 0.0065)
-    placed = cands[sel.chosen[0]]
-    assert placed.kind == "ground_spring" and placed.between_nodes and sel.chosen[0] != near
-    assert np.linalg.norm(np.subtract(placed.at[:2], xy)) < 0.002
-    assert sel.values[0] == pytest.approx(3e4, rel=0.03)
+    assert sel.values[0] == pytest.approx(value, rel=0.03)
     assert sel.chi2[-1] < fit.chi2
