@@ -24,7 +24,7 @@ import numpy as np
 from .catalogue import weighted_centre
 from .fitting import RANK_STEPS, estimate, pattern_search
 from .line_mass import KIND
-from .moves import on_node
+from .moves import on_node, spring_on_node
 from .merge import groups
 from .reanalysis import Reanalysis
 from .select import ALPHA, adopt, penalty
@@ -48,11 +48,6 @@ def _masses(chosen, values, groups) -> list:
         inertias = [k for k, c in enumerate(chosen) if c.kind == "point_inertia" and c.data.get("centre") in bodies]
         out.append((g + inertias, g, float(v[g].sum()), weighted_centre([chosen[k] for k in g], v[g])[:2]))
     return out
-
-
-def spring_on_node(cand) -> bool:
-    """A spring to ground found on one node of a board (the search's grid; :func:`as_points` places it)."""
-    return cand.kind == "ground_spring" and cand.nodes.size == 1 and not cand.between_nodes and "normal" not in cand.data
 
 
 def _springs(chosen, values, groups) -> list:

@@ -43,6 +43,12 @@ def on_node(cand) -> bool:
     return cand.kind == "point_mass" and cand.nodes.size == 1 and "radius" not in cand.data
 
 
+def spring_on_node(cand) -> bool:
+    """A spring to ground on one node of a board, as the search's grid puts it (not walked node to node:
+    :func:`.mass_lines.as_points` places it at its point)."""
+    return cand.kind == "ground_spring" and cand.nodes.size == 1 and not cand.between_nodes and "normal" not in cand.data
+
+
 def rectangle(cand):
     """(x0, y0, x1, y1) [m] of a region candidate whose polygon is an axis-aligned rectangle, else None."""
     if cand.kind not in REGION_KINDS or np.shape(cand.geometry["polygon"])[1] != 2:

@@ -48,9 +48,9 @@ from .bodies import as_bodies
 from .catalogue import KINDS, generate, kind
 from .evidence import evidence
 from .layout import from_structure
-from .mass_lines import as_lines, as_points, spring_on_node
+from .mass_lines import as_lines, as_points
 from .merge import MERGE_REACH, groups, mean_path, merged
-from .moves import REGION_KINDS, LocalMoves, movable, on_node
+from .moves import REGION_KINDS, LocalMoves, movable, on_node, spring_on_node
 from .one_region import as_one_region
 from . import conforming, geometry_fit
 from .budget import MASS_KINDS, observations, set_noise, with_carried
