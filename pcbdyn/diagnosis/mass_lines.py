@@ -24,7 +24,7 @@ import numpy as np
 from .catalogue import weighted_centre
 from .fitting import RANK_STEPS, estimate, pattern_search
 from .line_mass import KIND
-from .moves import on_node, spring_on_node
+from .moves import at_grid_node
 from .merge import groups
 from .reanalysis import Reanalysis
 from .select import ALPHA, adopt, penalty
@@ -54,7 +54,7 @@ def _springs(chosen, values, groups) -> list:
     """:func:`_masses`' tuples for the springs to ground found on nodes (a group of shares on nodes)."""
     v = np.asarray(values, float)
     return [(g, g, float(v[g].sum()), weighted_centre([chosen[k] for k in g], v[g])[:2]) for g in groups
-            if all(spring_on_node(chosen[k]) for k in g)]
+            if all(chosen[k].kind == "ground_spring" and at_grid_node(chosen[k]) for k in g)]
 
 
 def _pairs(candidates, sel, groups) -> list:
@@ -179,8 +179,7 @@ def as_points(res, candidates: list, sel, reach: float, layout, step: float, bou
     grouped = groups(chosen, reach)
     for g, gm, m, centre in _masses(chosen, sel.values, grouped) + _springs(chosen, sel.values, grouped):
         ids = [sel.chosen[k] for k in g]
-        if len(g) != len(gm) or not all(on_node(chosen[k]) or spring_on_node(chosen[k]) for k in gm) or not m > 0 \
-                or not set(ids) <= set(sel.chosen):
+        if len(g) != len(gm) or not all(at_grid_node(chosen[k]) for k in gm) or not m > 0 or not set(ids) <= set(sel.chosen):
             continue
         build = _points(layout, chosen[gm[0]])
         first = build(centre)

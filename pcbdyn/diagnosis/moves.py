@@ -43,10 +43,11 @@ def on_node(cand) -> bool:
     return cand.kind == "point_mass" and cand.nodes.size == 1 and "radius" not in cand.data
 
 
-def spring_on_node(cand) -> bool:
-    """A spring to ground on one node of a board, as the search's grid puts it (not walked node to node:
-    :func:`.mass_lines.as_points` places it at its point)."""
-    return cand.kind == "ground_spring" and cand.nodes.size == 1 and not cand.between_nodes and "normal" not in cand.data
+def at_grid_node(cand) -> bool:
+    """A point mass or a spring to ground on one node of a board, as the search's grid puts it (the
+    springs are not walked node to node): :func:`.mass_lines.as_points` places it at its point."""
+    spring = cand.kind == "ground_spring" and cand.nodes.size == 1 and not cand.between_nodes and "normal" not in cand.data
+    return spring or on_node(cand)
 
 
 def rectangle(cand):

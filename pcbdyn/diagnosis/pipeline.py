@@ -50,7 +50,7 @@ from .evidence import evidence
 from .layout import from_structure
 from .mass_lines import as_lines, as_points
 from .merge import MERGE_REACH, groups, mean_path, merged
-from .moves import REGION_KINDS, LocalMoves, movable, on_node, spring_on_node
+from .moves import REGION_KINDS, LocalMoves, at_grid_node, movable, on_node
 from .one_region import as_one_region
 from . import conforming, geometry_fit
 from .budget import MASS_KINDS, observations, set_noise, with_carried
@@ -303,7 +303,7 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
         say("fitting a part found as a mass with an inertia beside it as one body")
         sel = as_bodies(res, cands, sel, groups([cands[i] for i in sel.chosen], MERGE_REACH * h),
                         MERGE_REACH * h, models.bounds, alpha=alpha)
-    if any(on_node(cands[i]) or spring_on_node(cands[i]) for i in sel.chosen):
+    if any(at_grid_node(cands[i]) for i in sel.chosen):
         say("placing the masses and springs found on nodes at their points between the nodes")
         sel = as_points(res, cands, sel, MERGE_REACH * h, layout, h / 2, models.bounds, alpha=alpha)
     if any(cands[i].kind == "point_mass" for i in sel.chosen):
