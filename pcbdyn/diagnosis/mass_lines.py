@@ -13,7 +13,7 @@ best walked the same way; it must lower the criterion by one effect's penalty mo
 and length are two coordinates a point does not have, and end at least two elements long: a shorter
 line is not one the mesh resolves, and a mass between nodes fits it as well as a point (dev seed 0's
 50 g point mass had become a 7.8 mm line on 6 mm elements). The same walk places a mass or a spring to
-ground found on nodes at its point between them (:func:`as_points`)."""
+ground found on nodes at its point between them (:mod:`.at_points`)."""
 
 from __future__ import annotations
 
@@ -24,7 +24,6 @@ import numpy as np
 from .catalogue import weighted_centre
 from .fitting import RANK_STEPS, estimate, pattern_search
 from .line_mass import KIND
-from .moves import at_grid_node
 from .merge import groups
 from .reanalysis import Reanalysis
 from .select import ALPHA, adopt, penalty
@@ -35,7 +34,7 @@ SPREAD = np.sqrt(3.0)
 LENGTHS = 7
 
 
-def _masses(chosen, values, groups) -> list:
+def masses_found(chosen, values, groups) -> list:
     """[(positions in ``chosen`` of one mass found: a group of point-mass shares, or a body of
     :mod:`.bodies` with its inertia (the two share the body's ``centre``), positions of its mass, the
     mass, its centre (2,) [m])]; ``values``: the chosen effects' magnitudes."""
@@ -50,19 +49,12 @@ def _masses(chosen, values, groups) -> list:
     return out
 
 
-def _springs(chosen, values, groups) -> list:
-    """:func:`_masses`' tuples for the springs to ground found on nodes (a group of shares on nodes)."""
-    v = np.asarray(values, float)
-    return [(g, g, float(v[g].sum()), weighted_centre([chosen[k] for k in g], v[g])[:2]) for g in groups
-            if all(chosen[k].kind == "ground_spring" and at_grid_node(chosen[k]) for k in g)]
-
-
 def _pairs(candidates, sel, groups) -> list:
     """[(candidate indices of both masses (a body's inertia with its mass), their summed mass, the
     line's ends (2, 2) [m])] for every two masses found, nearest first."""
     chosen = [candidates[i] for i in sel.chosen]
     out = []
-    for (g, _, ma, a), (h, _, mb, b) in combinations(_masses(chosen, sel.values, groups), 2):
+    for (g, _, ma, a), (h, _, mb, b) in combinations(masses_found(chosen, sel.values, groups), 2):
         mid, half = 0.5 * (a + b), 0.5 * SPREAD * (b - a)
         out.append(([sel.chosen[k] for k in g + h], ma + mb, np.array([mid - half, mid + half])))
     return sorted(out, key=lambda t: float(np.linalg.norm(t[2][1] - t[2][0])))
@@ -87,7 +79,7 @@ def _singles(candidates, sel, groups, h: float, reach: float) -> list:
     chosen = [candidates[i] for i in sel.chosen]
     springs = np.array([c.at[:2] for c in chosen if c.kind == "ground_spring"], float).reshape(-1, 2)
     out = []
-    for g, gm, m, centre in _masses(chosen, sel.values, groups):
+    for g, gm, m, centre in masses_found(chosen, sel.values, groups):
         if (np.linalg.norm(springs - centre, axis=1) <= reach).any():
             continue
         radius = max((chosen[k].data.get("radius", 0.0) for k in gm), default=0.0)
@@ -117,15 +109,15 @@ def _oriented(res, sel, rest, values, m, centre, length, layout, bounds) -> tupl
 def _as_line(res, candidates, sel, replaced, m, ends, layout, step, bounds, newton_steps, pen, extra: float,
              shortest: float = 0.0) -> bool:
     """Replace the chosen effects ``replaced`` (candidate indices) by one line mass of mass ``m``
-    starting at ``ends``, walked (:func:`_walked_in`), where the criterion drops by more than ``extra``
+    starting at ``ends``, walked (:func:`walked_in`), where the criterion drops by more than ``extra``
     and the walked line is at least ``shortest`` [m] long; True when it did."""
     line = KIND.across(layout, *ends)
-    return line is not None and _walked_in(res, candidates, sel, replaced, m, line, np.ravel(line.geometry["segment"]),
+    return line is not None and walked_in(res, candidates, sel, replaced, m, line, np.ravel(line.geometry["segment"]),
                                            _lines(layout), step, bounds, newton_steps, pen, extra,
                                            lambda c: c.data["length"] >= shortest)
 
 
-def _walked_in(res, candidates, sel, replaced, m, first, x, build, step, bounds, newton_steps, pen, extra: float,
+def walked_in(res, candidates, sel, replaced, m, first, x, build, step, bounds, newton_steps, pen, extra: float,
                keep=lambda c: True) -> bool:
     """Replace the chosen effects ``replaced`` (candidate indices) by one mass ``m`` of candidate
     ``first``, whose geometry is the coordinates ``x`` (``build(x)``: [the candidate there]), walked
@@ -152,41 +144,6 @@ def _walked_in(res, candidates, sel, replaced, m, first, x, build, step, bounds,
     candidates.append(made[0])
     adopt(sel, others + [len(candidates) - 1], fit, pen)
     return True
-
-
-def _points(layout, home):
-    """The points a pattern search tries: (x, y) [m] -> [an effect like ``home`` there, between the nodes
-    (its kind's ``at_point``)], None off the plate."""
-    def build(xy):
-        c = home.spec.at_point(layout, home, xy)
-        return None if c is None else [c]
-    return build
-
-
-def as_points(res, candidates: list, sel, reach: float, layout, step: float, bounds=None, newton_steps: int = 8,
-              alpha: float = ALPHA):
-    """``sel`` with each mass or spring to ground found on nodes (one node, or shares on nodes within
-    ``reach`` [m] reported as one, :func:`.merge.groups`) refitted as one at a point between the nodes,
-    walked from its (shares') centre from steps of ``step`` [m] (half the model's element size), where
-    that lowers the criterion. Forward selection finds an effect on the node nearest to it, or as shares
-    on two nodes; the generated benchmark's lie anywhere (dev seed 4's 32.5 g, found as 35.2 g on two
-    nodes with their centre 2.2 mm off, is placed 0.4 mm off as 32.9 g). Candidates are appended to
-    ``candidates``; ``sel`` is updated in place."""
-    if not layout.planar:
-        return sel
-    pen = penalty(res.n_rows, len(candidates), alpha)
-    chosen = [candidates[i] for i in sel.chosen]
-    grouped = groups(chosen, reach)
-    for g, gm, m, centre in _masses(chosen, sel.values, grouped) + _springs(chosen, sel.values, grouped):
-        ids = [sel.chosen[k] for k in g]
-        if len(g) != len(gm) or not all(at_grid_node(chosen[k]) for k in gm) or not m > 0 or not set(ids) <= set(sel.chosen):
-            continue
-        build = _points(layout, chosen[gm[0]])
-        first = build(centre)
-        if first is not None:
-            _walked_in(res, candidates, sel, ids, m, first[0], np.asarray(centre, float), build, step, bounds,
-                       newton_steps, pen, 0.0)
-    return sel
 
 
 def as_lines(res, candidates: list, sel, reach: float, layout, step: float, bounds=None, newton_steps: int = 8,

@@ -34,7 +34,7 @@ def movable(cand) -> bool:
 
 def at_point(cand) -> bool:
     """An effect at its point between a plate's nodes: a support (:mod:`.support`) or a point mass (a body
-    of no size: :mod:`.mass_lines`); its kind's ``at_point`` places it at another point."""
+    of no size: :mod:`.at_points`); its kind's ``at_point`` places it at another point."""
     return cand.between_nodes or (cand.kind == "point_mass" and cand.data.get("radius") == 0.0)
 
 
@@ -45,7 +45,7 @@ def on_node(cand) -> bool:
 
 def at_grid_node(cand) -> bool:
     """A point mass or a spring to ground on one node of a board, as the search's grid puts it (the
-    springs are not walked node to node): :func:`.mass_lines.as_points` places it at its point."""
+    springs are not walked node to node): :func:`.at_points.as_points` places it at its point."""
     spring = cand.kind == "ground_spring" and cand.nodes.size == 1 and not cand.between_nodes and "normal" not in cand.data
     return spring or on_node(cand)
 

@@ -25,9 +25,9 @@ whether what remains is noise, and otherwise find, place and size the effects th
    declared parameters, each effect kept only if it also predicts data it was not fitted to; runs
    along the sides, stiffener lines, rectangular regions and point masses are walked to where they fit
    best (:func:`.select.refine`, :class:`.moves.LocalMoves`), overlapping regions refitted as one
-   (:mod:`.one_region`), a mass with an inertia beside it
-   refitted as one body (:mod:`.bodies`), a mass on nodes placed at its point between them, two masses
-   apart, or one alone, as one mass along a line (:mod:`.mass_lines`). The masses (and supports) found
+   (:mod:`.one_region`), a mass with an inertia beside it refitted as one body (:mod:`.bodies`), a mass
+   or a spring on nodes placed at its point between them (:mod:`.at_points`), two masses apart, or one
+   alone, as one mass along a line (:mod:`.mass_lines`). The masses (and supports) found
    are then put on the finer meshes and the mesh correction measured again (:func:`.budget.with_carried`:
    they change the shapes it depends on); where stiffeners were found, the structure is meshed along
    their lines first, every effect carried, and the ribs' ends and sections fitted there
@@ -48,7 +48,8 @@ from .bodies import as_bodies
 from .catalogue import KINDS, generate, kind
 from .evidence import evidence
 from .layout import from_structure
-from .mass_lines import as_lines, as_points
+from .at_points import as_points
+from .mass_lines import as_lines
 from .merge import MERGE_REACH, groups, mean_path, merged
 from .moves import REGION_KINDS, LocalMoves, at_grid_node, movable, on_node
 from .one_region import as_one_region
