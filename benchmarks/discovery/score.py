@@ -91,6 +91,15 @@ def distance(r: dict, geometry: dict) -> float:
     return float(np.linalg.norm(np.asarray(r["at_mm"], float) - p))
 
 
+def _covered(reported: dict, magnitude: float) -> bool:
+    """The true ``magnitude`` lies in the reported 2-sigma interval (``interval_2sigma``, its upper end
+    None where the data leave it open; results written before it: magnitude -+ 2 uncertainty)."""
+    if "interval_2sigma" not in reported:
+        return abs(reported["magnitude"] - magnitude) <= 2.0 * (reported.get("uncertainty") or 0.0)
+    lo, hi = reported["interval_2sigma"]
+    return lo <= magnitude and (hi is None or magnitude <= hi)
+
+
 def judge(truth: dict, result: dict, detectable_chi2: float) -> dict:
     """Per case: atoms (found or not, detectable or not, magnitude error, 2-sigma covered), the
     reported effects that match no atom (invented), noise-only cleanliness and the errors."""
@@ -115,7 +124,7 @@ def judge(truth: dict, result: dict, detectable_chi2: float) -> dict:
                 row.update(sized=True, covered=None)
             else:
                 row["sized"] = abs(r["magnitude"] / mag - 1.0) <= MAGNITUDE
-                row["covered"] = abs(r["magnitude"] - mag) <= 2.0 * (r.get("uncertainty") or 0.0)
+                row["covered"] = _covered(r, mag)
         row["found"] = bool(row["placed"] and row.get("sized", False))
         rows.append(row)
     invented = [r for j, r in enumerate(reported) if j not in used and not any(

@@ -37,7 +37,7 @@ class Fit:
 
 
 def estimate(res, p0, cands, v0, steps: int, bounds=None, tol: float = 1e-5, param_columns=None,
-             reduced=None) -> Fit:
+             reduced=None, held=()) -> Fit:
     """The declared parameters (on a log scale, within ``bounds`` = (lower, upper) of p) and the
     magnitudes of ``cands`` fitted to the residual ``res`` by the updating engine's bounded Gauss-Newton
     (:func:`pcbdyn.updating.gauss_newton.gauss_newton`); ``cov`` is the covariance of (ln p,
@@ -45,7 +45,8 @@ def estimate(res, p0, cands, v0, steps: int, bounds=None, tol: float = 1e-5, par
     that ranks candidates need not re-derive the board's matrices at every step); ``reduced``: a
     :class:`.reanalysis.Reanalysis` that evaluates the states instead of full re-solves (quick fits
     that rank candidates). Magnitudes that break their kinds' joint test (:func:`.catalogue.jointly`:
-    overlapping regions softened to no stiffness) are refused as a failed solve is."""
+    overlapping regions softened to no stiffness) are refused as a failed solve is. ``held``: [(candidate,
+    magnitude)] in the model at fixed magnitudes, not fitted (a profile of one magnitude)."""
     p = np.asarray(p0, float)
     npar = p.size
     lo_v = np.array([c.spec.lower for c in cands], float)
@@ -58,12 +59,14 @@ def estimate(res, p0, cands, v0, steps: int, bounds=None, tol: float = 1e-5, par
 
     run = res if reduced is None else reduced
     admissible = jointly(cands)
+    fixed = [c for c, _ in held]
+    fixed_values = np.array([v for _, v in held], float)
 
     def evaluate(y):
         if not admissible(y[npar:]):
             return None
         try:
-            st = run.evaluate(np.exp(y[:npar]), cands, y[npar:])
+            st = run.evaluate(np.exp(y[:npar]), list(cands) + fixed, np.r_[y[npar:], fixed_values])
         except (ValueError, ArithmeticError, np.linalg.LinAlgError):
             return None
         # a paired model mode that does not move at the points has no shape to compare

@@ -11,9 +11,9 @@ import numpy as np
 import shapely
 
 from ..fe.probe import segment_parameter
-from .catalogue import weighted_centre
+from .catalogue import kind, weighted_centre
 from .moves import REGION_KINDS, rectangle
-from .uncertainty import parts
+from .uncertainty import interval, jackknife_cov, parts, place_cov, profile_interval
 
 #: kinds that act at one node: an effect between nodes is shared by its neighbours
 POINT_KINDS = ("point_mass", "point_inertia", "ground_spring")
@@ -77,13 +77,14 @@ def groups(chosen, reach: float) -> list:
     return [np.flatnonzero(label == g).tolist() for g in dict.fromkeys(label.tolist())]
 
 
-def merged(chosen, values, cov, cov_jack, cov_place, group) -> dict:
+def merged(chosen, values, cov, cov_jack, cov_place, group, profile=None) -> dict:
     """One effect entry (JSON-ready) for a group: the magnitudes summed at their weighted centre (on
     line masses: the place and extent of the largest; parallel stiffeners: their weighted mean
     path; overlapping regions: the mean stiffness change over the area they cover, their union, which
     keeps the change's integral over the board, or their masses summed over it), the uncertainty of
     that combination from the fit's covariance ``cov``, the jackknife's ``cov_jack``, what the places
-    leave open ``cov_place`` and the model-form budget (:func:`.uncertainty.parts`)."""
+    leave open ``cov_place`` and the model-form budget (:func:`.uncertainty.parts`), and its 2-sigma
+    interval (:func:`.uncertainty.interval`; ``profile``: the chi^2 profile's of a group of one)."""
     lines = [k for k in group if chosen[k].kind == "line_mass"]
     c = chosen[max(lines, key=lambda k: values[k]) if lines else group[0]]
     d = c.describe()
@@ -108,8 +109,27 @@ def merged(chosen, values, cov, cov_jack, cov_place, group) -> dict:
         d["section_height_mm"] = round(1e3 * c.spec.section_of(c).h, 4)
     sub = np.ix_(group, group)
     u = parts(float(w @ v), w, cov[sub] if cov.size else cov, cov_jack[sub], cov_place[sub])
+    d["interval_2sigma"] = interval(float(w @ v), u, profile, c.spec.lower)
     d.update(magnitude=float(w @ v), uncertainty=u.pop("total"), uncertainty_parts=u, kind=c.kind)
     return d
+
+
+def reported(res, sel, chosen, neighbours, reach: float, bounds=None) -> list:
+    """The effects entries (JSON-ready) of the selection ``sel`` of effects ``chosen``: shares within
+    ``reach`` [m] as one (:func:`groups`, :func:`merged`), each with its uncertainty (:mod:`.uncertainty`:
+    the fit's covariance, the jackknife over the folds, what the places leave open, ``neighbours(j)``
+    giving effect j's places one step away) and its 2-sigma interval, from the chi^2 profile where one
+    effect alone is of a kind that saturates (:func:`.uncertainty.profile_interval`)."""
+    scale = np.array([c.spec.scale for c in chosen])
+    cov_jack = jackknife_cov(res, sel.state, chosen, scale)
+    cov_place = place_cov(res, sel.state, chosen, scale, neighbours)
+    out = []
+    for g in groups(chosen, reach):
+        spec = kind(chosen[g[0]].kind)
+        alone = len(g) == 1 and getattr(spec, "saturates", False) and getattr(spec, "reanalysed", True)
+        profile = profile_interval(res, sel.state, chosen, g[0], bounds) if alone and sel.values[g[0]] > 0 else None
+        out.append(merged(chosen, sel.values, sel.cov, cov_jack, cov_place, g, profile))
+    return out
 
 
 def mean_path(stiffeners, values) -> np.ndarray:

@@ -50,7 +50,7 @@ from .evidence import evidence
 from .layout import from_structure
 from .at_points import as_points
 from .mass_lines import as_lines
-from .merge import MERGE_REACH, groups, mean_path, merged
+from .merge import MERGE_REACH, groups, mean_path, reported
 from .moves import REGION_KINDS, LocalMoves, at_grid_node, movable, on_node
 from .one_region import as_one_region
 from . import conforming, geometry_fit
@@ -62,7 +62,6 @@ from .fitting import estimate
 from .scan import Runner
 from .select import ALPHA, Selection, adopt, noticed, penalty, refine, search, without_vanished
 from .unpaired import partners
-from .uncertainty import jackknife_cov, place_cov
 
 #: where candidates go: sides cut into 16 pieces (every run of consecutive pieces is a candidate);
 #: stiffener rows and columns every element (``path_spacing`` in element sizes)
@@ -339,11 +338,9 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
     for n, v in zip(names, sel.p):
         out["parameters"][n]["final"] = float(v)
     chosen = [cands[i] for i in sel.chosen]
-    scale = np.array([c.spec.scale for c in chosen])
-    cov_jack = jackknife_cov(res, sel.state, chosen, scale)
     near = moves if lined is None else LocalMoves(from_structure(models.models[0]), cands, h)
-    cov_place = place_cov(res, sel.state, chosen, scale, lambda j: [cands[i] for i in near(sel.chosen[j])])
-    effects = [merged(chosen, sel.values, sel.cov, cov_jack, cov_place, g) for g in groups(chosen, MERGE_REACH * h)]
+    effects = reported(res, sel, chosen, lambda j: [cands[i] for i in near(sel.chosen[j])], MERGE_REACH * h,
+                       models.bounds)
     if effects:
         msg = f"{len(effects)} effect(s) the model lacks: " + "; ".join(
             f"{e['type']} ({e['parameter']}) at {e['at_mm']} mm" for e in effects)

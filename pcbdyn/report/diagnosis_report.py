@@ -15,6 +15,14 @@ def shown(value: float, unit: str) -> tuple:
     return value * k, u
 
 
+def two_sigma(e: dict) -> str:
+    """An effect's 2-sigma interval in its unit shown (:func:`shown`): "lo to hi", or "lo or more" where the
+    data leave it open above."""
+    lo, hi = e["interval_2sigma"]
+    a, _ = shown(lo, e["unit"])
+    return f"{a:.3g} or more" if hi is None else f"{a:.3g} to {shown(hi, e['unit'])[0]:.3g}"
+
+
 def format_effects(effects) -> str:
     """The effects as a table; on a structure of several plates with each effect's plate and its point in
     x, y, z."""
@@ -22,13 +30,15 @@ def format_effects(effects) -> str:
         return "no effect found"
     plates = any("plate" in e for e in effects)
     plate_head, width = (f" {'plate':>8}", 24) if plates else ("", 18)
-    rows = [f"{'type':>16} {'parameter':>16}{plate_head} {'at [mm]':>{width}} {'magnitude':>12} {'+-':>10} unit"]
+    rows = [f"{'type':>16} {'parameter':>16}{plate_head} {'at [mm]':>{width}} {'magnitude':>12} {'+-':>10} "
+            f"{'2 sigma':>20} unit"]
     for e in effects:
         v, u = shown(e["magnitude"], e["unit"])
         s, _ = shown(e["uncertainty"], e["unit"])
         at = "(" + ", ".join(f"{c:.1f}" for c in e["at_mm"]) + ")"
         where = f" {e.get('plate', ''):>8}" if plates else ""
-        rows.append(f"{e['type']:>16} {e['parameter']:>16}{where} {at:>{width}} {v:>12.4g} {s:>10.2g} {u}")
+        rows.append(f"{e['type']:>16} {e['parameter']:>16}{where} {at:>{width}} {v:>12.4g} {s:>10.2g} "
+                    f"{two_sigma(e):>20} {u}")
     return "\n".join(rows)
 
 
@@ -150,7 +160,8 @@ def html_page(out, board_toml, board, d, shown_model, evidence_png=None):
         v, u = shown(e["magnitude"], e["unit"])
         s, _ = shown(e["uncertainty"], e["unit"])
         rows.append({"type": e["type"], "parameter": e["parameter"], "plate": e.get("plate", "-"),
-                     "at [mm]": ", ".join(f"{c:.1f}" for c in e["at_mm"]), "magnitude": v, "+-": s, "unit": u})
+                     "at [mm]": ", ".join(f"{c:.1f}" for c in e["at_mm"]), "magnitude": v, "+-": s,
+                     "2 sigma": two_sigma(e), "unit": u})
     if rows:
         page.table("Effects found", pd.DataFrame(rows))
     else:

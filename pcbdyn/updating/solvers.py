@@ -216,13 +216,19 @@ def covariance(J, r, stated: bool = True) -> np.ndarray:
     """Covariance of least-squares estimates with Jacobian ``J`` (n_rows, k) at residual ``r``:
     (J^T J)^+ times the residual variance s^2 = |r|^2 / (n - k). Rows in units of a ``stated`` noise
     (chi-square weights, eq. 4.28) keep at least that noise (s^2 >= 1: a fit better than the noise
-    does not make the estimates surer than it); unweighted rows take s^2 as it is."""
+    does not make the estimates surer than it); unweighted rows take s^2 as it is. The pseudo-inverse
+    is taken with the columns scaled to unit length: columns in SI units of unlike quantities (ln E
+    beside a stiff spring in N/m, 1e-8 of it) would otherwise read as a rank the pseudo-inverse drops,
+    and report a standard deviation of zero for the magnitude the data know least."""
     J = np.asarray(J, float)
     n, k = J.shape
     if k == 0:
         return np.zeros((0, 0))
     s2 = float(np.asarray(r, float) @ np.asarray(r, float)) / max(n - k, 1)
-    return (max(1.0, s2) if stated else s2) * np.linalg.pinv(J.T @ J)
+    norms = np.linalg.norm(J, axis=0)
+    d = np.divide(1.0, norms, out=np.zeros(k), where=norms > 0)
+    Js = J * d
+    return (max(1.0, s2) if stated else s2) * (d[:, None] * np.linalg.pinv(Js.T @ Js) * d[None, :])
 
 
 def line_search(residue, beta_max: float = 2.0, tol: float = 1e-4):
