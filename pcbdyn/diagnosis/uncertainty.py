@@ -145,15 +145,15 @@ def profile_interval(res, state, effects, j: int, bounds=None) -> tuple:
 def interval(magnitude: float, u: dict, profile=None, lower: float = -np.inf) -> list:
     """[lo, hi] [SI]: the reported 2-sigma interval of ``magnitude`` with :func:`parts` ``u``: magnitude
     -+ twice their total; where a ``profile`` (lo, hi) of chi^2 (:func:`profile_interval`) is given, its
-    reach either side in place of twice the noise's part (widened as the folds' part is wider), the
-    places' and the model form's parts added in quadrature: a linear magnitude gets the same interval
-    either way. lo is kept at or above ``lower`` (the kind's); hi is None where the profile leaves the
+    reach either side in place of twice the noise's part (widened as the folds' part is wider; where the
+    fit's covariance is nought, an effect at its bound, the folds' part added), the places' and the model
+    form's parts added in quadrature: a linear magnitude gets the same interval either way. lo is kept at or above ``lower`` (the kind's); hi is None where the profile leaves the
     interval open above."""
     if profile is None:
         lo, hi = magnitude - 2.0 * u["total"], magnitude + 2.0 * u["total"]
         return [max(lo, lower), hi]
     widen = max(1.0, u["across_folds"] / u["noise"]) if u["noise"] > 0 else 1.0
-    rest = 4.0 * (u["place"] ** 2 + u["model_form"] ** 2)
+    rest = 4.0 * (u["place"] ** 2 + u["model_form"] ** 2 + (0.0 if u["noise"] > 0 else u["across_folds"] ** 2))
     below, above = (None if e is None else abs(e - magnitude) * widen for e in profile)
     lo = lower if below is None else magnitude - np.sqrt(below**2 + rest)
     hi = None if above is None else magnitude + np.sqrt(above**2 + rest)
