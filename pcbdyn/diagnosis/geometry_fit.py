@@ -17,11 +17,11 @@ by more than the data resolve (:func:`resolved`), and a round of moves that take
 Each place is a mesh of its own, so chi^2 carries the mesh's changes as noise (a few % of it on a card
 with parts: 906 at the bar's line, 950 and 960 a quarter of a millimetre to either side); a parabola
 through places an element apart reads through it where finite differences at a fraction of an element
-would not. The line searches polish; the long way from the search's full-span line to a bar that stops short of the edges at its
-own angle is covered first by the bounded Gauss-Newton (thesis ch. 4) on the ends and ln h with the
-declared parameters and magnitudes, the geometry's columns by forward differences an eighth of an
-element long (:data:`STEP`), each a re-mesh run as a job; where the mesh's noise defeats it (its
-first step raises chi^2), the line searches start from the search's line.
+would not. The line searches polish; the long way from the search's full-span line to a bar that stops
+short of the edges at its own angle is covered first by the bounded Gauss-Newton (thesis ch. 4) on the
+ends and ln h with the declared parameters and magnitudes, the geometry's columns by forward
+differences an eighth of an element long (:data:`STEP`), each a re-mesh run as a job; where the mesh's
+noise defeats it (its first step raises chi^2), the line searches start from the search's line.
 """
 
 from __future__ import annotations
@@ -117,7 +117,7 @@ def resolved(fit, n_rows: int, n_ribs: int) -> float:
     of a parameter's 1-sigma interval), in units of the variance the fit leaves where that exceeds the
     stated noise (as :func:`.select.worth` weighs an effect). A move that gains less lies within the
     geometry's own uncertainty: the data cannot tell the two places apart, and each move costs re-meshed
-    solves (on dev seed 9 the last eight moves of the line searches gained 0.8 of chi^2 1854)."""
+    solves (dev seed 9: its last four moves gained 0.8 of chi^2 1854.3)."""
     k = np.size(fit.p) + np.size(fit.values) + len(MOVES) * n_ribs
     return max(fit.chi2 / max(n_rows - k, 1), 1.0)
 
