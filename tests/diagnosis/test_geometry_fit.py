@@ -82,12 +82,14 @@ def test_vertex_of_the_parabola_through_three_places():
     """chi^2 = 5 (x - x0)^2 + 40 sampled at -d, 0, d: the vertex is x0 where it lies between the outer
     places, the nearer outer place beyond them, and the least sample where the parabola opens down
     or a place could not be meshed (infinite chi^2)."""
-    from pcbdyn.diagnosis.geometry_fit import vertex
+    from pcbdyn.diagnosis.geometry_fit import parabola, vertex
 
     d = 1.7e-3
     xs = [-d, 0.0, d]
     for x0 in (-0.6e-3, 0.0, 0.9e-3):
-        assert vertex(xs, [5.0 * (x - x0) ** 2 / d**2 + 40.0 for x in xs]) == pytest.approx(x0, abs=1e-12)
+        chi2 = [5.0 * (x - x0) ** 2 / d**2 + 40.0 for x in xs]
+        assert vertex(xs, chi2) == pytest.approx(x0, abs=1e-12)
+        assert parabola(xs, chi2, vertex(xs, chi2)) == pytest.approx(40.0, rel=1e-12)  # what a move promises
     assert vertex(xs, [5.0 * (x - 3 * d) ** 2 / d**2 for x in xs]) == pytest.approx(d)
     assert vertex(xs, [1.0, 3.0, 2.0]) == -d
     assert vertex(xs, [np.inf, 3.0, 2.0]) == d
