@@ -214,8 +214,12 @@ def adopt(sel: Selection, idx: list, fit: Fit, pen: float) -> Selection:
 def without_vanished(res, candidates, sel: Selection, bounds=None, newton_steps: int = 8,
                      alpha: float = ALPHA) -> Selection:
     """``sel`` without the effects that later steps left within one standard deviation of zero
-    (a companion that the refined others made needless), the rest re-estimated."""
-    keep = [k for k, (v, s) in enumerate(zip(sel.values, sel.sigma)) if abs(v) > s]
+    (a companion that the refined others made needless), the rest re-estimated. Not the kinds that
+    saturate: a spring that pins the plate has a standard deviation far above its stiffness (any stiffer
+    one fits about as well) and is far from none (dev seed 5's rigid standoff, dropped here once the
+    covariance no longer read its column as no rank); :func:`noticed` weighs their removal."""
+    keep = [k for k, (i, v, s) in enumerate(zip(sel.chosen, sel.values, sel.sigma))
+            if abs(v) > s or getattr(kind(candidates[i].kind), "saturates", False)]
     if len(keep) == len(sel.chosen):
         return sel
     idx = [sel.chosen[k] for k in keep]

@@ -326,3 +326,15 @@ def test_refine_walks_a_heat_sink_found_on_the_patch_grid_to_its_rectangle_as_on
     assert [c.kind for c in found] == ["region_stiffness", "region_mass"]
     assert all(np.array_equal(c.nodes, stiff.nodes) for c in found)  # the same cells, both
     assert sel.values == pytest.approx([3.0, 0.03], rel=1e-3)
+
+
+def test_a_spring_that_pins_the_plate_is_not_dropped_for_its_standard_deviation(card):
+    """A spring to ground at the kind's bound (rigid) has a standard deviation far above its stiffness (the
+    frequencies no longer change with it) and is far from no spring: ``without_vanished`` keeps it (its
+    removal is weighed by chi^2, :func:`pcbdyn.diagnosis.select.noticed`)."""
+    from pcbdyn.diagnosis.select import Selection, without_vanished
+
+    _, cands = card
+    spring = next(i for i, c in enumerate(cands) if c.kind == "ground_spring")
+    sel = Selection(chosen=[spring], values=np.array([1e7]), sigma=np.array([3e7]), p=np.zeros(0))
+    assert without_vanished(None, cands, sel) is sel and sel.chosen == [spring]
