@@ -91,25 +91,33 @@ def moved(rib, move: str, amount: float, h: float):
     return kind("stiffener").along(replace(rib, data={**rib.data, "height": float(height)}), path)
 
 
+def _through(offsets, chi2):
+    """(step, slope, curvature) of the parabola through three (offset, chi^2) points equally spaced, in
+    steps from the middle one; None where it opens down."""
+    (a, _, c), d = chi2, offsets[2] - offsets[1]
+    curve = a - 2.0 * chi2[1] + c
+    return (d, 0.5 * (c - a), curve) if curve > 0.0 and np.isfinite(curve) else None
+
+
 def vertex(offsets, chi2) -> float:
     """The offset of the least chi^2 on the parabola through three (offset, chi^2) points equally
     spaced (the best of them where the parabola opens down), kept between the outer two."""
-    (a, b, c), d = chi2, offsets[2] - offsets[1]
-    curve = a - 2.0 * b + c
-    if not (curve > 0.0 and np.isfinite(curve)):
+    fit = _through(offsets, chi2)
+    if fit is None:
         return float(offsets[int(np.argmin(chi2))])
-    return float(np.clip(offsets[1] + 0.5 * d * (a - c) / curve, offsets[0], offsets[2]))
+    d, slope, curve = fit
+    return float(np.clip(offsets[1] - d * slope / curve, offsets[0], offsets[2]))
 
 
 def parabola(offsets, chi2, x: float) -> float:
     """The chi^2 at offset ``x`` on the parabola through three (offset, chi^2) points equally spaced
     (the least of them where it opens down: :func:`vertex` then takes that point)."""
-    (a, b, c), d = chi2, offsets[2] - offsets[1]
-    curve = a - 2.0 * b + c
-    if not (curve > 0.0 and np.isfinite(curve)):
+    fit = _through(offsets, chi2)
+    if fit is None:
         return float(min(chi2))
+    d, slope, curve = fit
     t = (x - offsets[1]) / d
-    return float(b + 0.5 * (c - a) * t + 0.5 * curve * t * t)
+    return float(chi2[1] + slope * t + 0.5 * curve * t * t)
 
 
 def resolved(fit, n_rows: int, n_ribs: int) -> float:
