@@ -44,21 +44,21 @@ import numpy as np
 from ..domain import StructureError
 from ..parallel import spare_cores
 from ..problems.models import StructureModels
+from . import conforming, geometry_fit
+from .at_points import as_points
 from .bodies import as_bodies
+from .budget import MASS_KINDS, observations, set_noise, with_carried
 from .catalogue import KINDS, generate, kind
 from .evidence import evidence
+from .fitting import estimate
 from .layout import from_structure
-from .at_points import as_points
 from .mass_lines import as_lines
 from .merge import MERGE_REACH, groups, mean_path, reported
+from .model_form import MESH_LEVELS, fit_plate_share
 from .moves import REGION_KINDS, LocalMoves, at_grid_node, movable, on_node
 from .one_region import as_one_region
-from . import conforming, geometry_fit
-from .budget import MASS_KINDS, observations, set_noise, with_carried
-from .model_form import MESH_LEVELS, fit_plate_share
 from .parameter_stage import declared_origin, paired_start, parameter_stage, range_test, update_start
 from .residual import ModalResidual
-from .fitting import estimate
 from .scan import Runner
 from .select import ALPHA, Selection, adopt, noticed, penalty, refine, search, without_vanished
 from .unpaired import partners
