@@ -427,3 +427,28 @@ def test_soft_in_plane_mounts_put_the_membrane_group_first_and_lose_no_mode():
     np.testing.assert_allclose(modes.omega2, lam[:8], rtol=1e-6)  # dense round-off: ~1e-16 lam_max on the soft modes
     in_plane = np.abs(modes.shapes[0::6]).max(axis=0) > np.abs(modes.shapes[2::6]).max(axis=0)
     assert in_plane[:3].all()  # the three rigid-like motions on the mounts come first
+
+
+def test_thick_plate_lowest_modes_are_bending_modes_not_drilling_ones():
+    """A clamped square steel plate, 200 x 200 x 10 mm: its in-plane modes start near 15 kHz, far
+    above its sixth bending mode (Leissa's lambda = 131.6 against 35.99: about 8 kHz), so its first six
+    modes carry their kinetic energy in w and the two bending rotations. The drilling rotation's
+    stand-in inertia must not bring spurious modes into that band (with the full rotary inertia
+    there, the drilling modes sat at about 5 kHz); the first frequency lies within Mindlin's few %
+    below Leissa's Kirchhoff value for t/a = 0.05."""
+    pytest.importorskip("pcbdyn.fe.elements.shell_quad4")
+    a, t, E, nu, rho = 0.2, 0.01, 210e9, 0.3, 7850.0
+    nodes, quads = rectangle(a, a, 16, 16)
+    model = Model(nodes)
+    model.add("plate", "quad4", quads, ShellProperty(E=E, nu=nu, rho=rho, t=t))
+    model.fix(np.flatnonzero(np.isclose(nodes[:, :2], 0).any(axis=1) | np.isclose(nodes[:, :2], a).any(axis=1)))
+    modes = solve_modes(model, n_modes=6)
+    _, M = assemble(model)
+    bending = np.isin(np.arange(M.shape[0]) % 6, (2, 3, 4))
+    phi = modes.shapes
+    share = np.einsum("ij,ij->j", phi[bending], (M[bending][:, bending] @ phi[bending])) / \
+        np.einsum("ij,ij->j", phi, M @ phi)
+    assert share.min() > 0.99
+    D = E * t**3 / (12 * (1 - nu**2))
+    f_kirchhoff = 35.99 / (2 * np.pi * a**2) * np.sqrt(D / (rho * t))
+    assert 0.95 < modes.frequencies[0] / f_kirchhoff < 1.0
