@@ -252,8 +252,9 @@ class _Block:
         A Sturm count tells how many there are, so eigsh is asked for exactly those. This is what
         keeps a block whose spectrum starts far above the cut cheap: the membrane block of a free
         flat plate has only its three rigid modes below the bending cut, while its first elastic
-        modes sit just under a tight cluster of drilling (rz) modes that ARPACK could take ~1e5
-        iterations to separate if asked for even one of them.
+        modes sit far above it, near tight clusters of drilling (rz) modes that ARPACK can take
+        ~1e5 iterations to separate if asked for even one of them (the drilling modes sit at the
+        thickness-shear frequency, :func:`.elements.shell_common.rotary_mass`).
         """
         if self.dense:
             lam, vec, rigid, _ = self._solve(0)
