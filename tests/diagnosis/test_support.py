@@ -3,6 +3,8 @@ exact data of a free plate on one spring to ground at a point between nodes, wit
 or not. The bounce is told from the elastic modes, the spring placed from its rigid-body part and
 sized from its frequency."""
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 from diagnosis_plates import PLATE, measured
@@ -10,7 +12,7 @@ from diagnosis_plates import PLATE, measured
 import pcbdyn.diagnosis as dg
 from pcbdyn.diagnosis.ground_spring import KIND as SPRING
 from pcbdyn.diagnosis.residual import ModalResidual, Observation
-from pcbdyn.diagnosis.support import locate, rigid_share, support_modes
+from pcbdyn.diagnosis.support import locate, rigid_share, shapes_kept, support_modes
 from pcbdyn.fe import MassProperty, Model
 from pcbdyn.fe.generate import rectangle
 from pcbdyn.fe.modal import solve_modes
@@ -105,3 +107,17 @@ def test_a_mass_sized_to_the_shape_is_exact_where_the_stiffness_is_off_by_a_fact
     assert cand == "the point"
     assert mass == pytest.approx(truth, rel=1e-3)
     assert like == pytest.approx(1.0, abs=1e-9)
+
+
+def _pairing(mac, matched):
+    return SimpleNamespace(configs=[SimpleNamespace(mac=np.array(mac), matched=np.array(matched))])
+
+
+def test_an_effect_that_takes_another_modes_partner_away_is_not_kept():
+    """An effect placed to give test mode 4 a partner is kept when the modes paired before keep theirs
+    about as well; one that leaves mode 1 (MAC 0.99) without a partner is refused, though the modes
+    paired in both states resemble theirs a little better (dev seed 0)."""
+    before = _pairing([0.99, 0.95, 0.90, 0.20], [True, True, True, False])
+    assert shapes_kept(before, _pairing([0.99, 0.95, 0.91, 0.85], [True, True, True, True]))
+    assert not shapes_kept(before, _pairing([0.10, 0.96, 0.92, 0.85], [False, True, True, True]))
+    assert not shapes_kept(before, _pairing([0.90, 0.85, 0.80, 0.85], [True, True, True, True]))
