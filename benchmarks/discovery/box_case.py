@@ -18,7 +18,9 @@ Measured again (2026-11-30, load 0.2-0.4): the same figures but parameters only 
 search without the support placed from the relay's unpaired mode, and the diagnosis's own and update's fits of
 the declared parameters one after the other), 135 s with update's fit on the spare core beside the diagnosis's
 own; update 44-45 s. Again after the drilling rotations' stand-in inertia was lowered (bab79e3, load 0.6):
-the same figures; diagnose 120 s, update 42 s.
+the same figures; diagnose 120 s, update 42 s. Again with the truth's lumped parts corrected (0f3f95d; the box
+has none) and the support rule of d7a2f58: the same figures; diagnose 335 s, update 73 s at load 2.4 with three
+benchmark cases running beside it.
 """
 
 from __future__ import annotations
