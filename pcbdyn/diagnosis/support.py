@@ -180,5 +180,6 @@ def shapes_kept(before, after) -> bool:
     far off reshuffles them (dev seed 5)."""
     a = np.concatenate([cb.mac[cb.matched & ca.matched] for cb, ca in zip(before.configs, after.configs)])
     b = np.concatenate([ca.mac[cb.matched & ca.matched] for cb, ca in zip(before.configs, after.configs)])
-    lost = any(np.any(cb.matched & ~ca.matched & (cb.mac >= WELL_PAIRED)) for cb, ca in zip(before.configs, after.configs))
+    lost = any(np.any(cb.matched & ~ca.matched & (cb.mac >= WELL_PAIRED))
+               for cb, ca in zip(before.configs, after.configs))
     return not lost and (a.size == 0 or float(b.mean()) >= float(a.mean()) - MAC_SLACK)
