@@ -31,7 +31,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..domain import StructureError
-from ..updating.gauss_newton import gauss_newton, taken
+from ..updating.gauss_newton import DAMPING, gauss_newton, taken
 from . import conforming
 from .catalogue import kind
 from .fitting import UPPER, Fit, estimate
@@ -219,7 +219,7 @@ def _gauss_newton(base, observations, chosen, ribs, h, fit, bounds, runner, step
 
     y0 = np.r_[np.log(p), np.clip(np.asarray(fit.values, float), v_lo, v_hi), g0]
     gn = gauss_newton(evaluate, jacobian, y0, lower, upper, scale, steps,
-                      lambda y: np.r_[1e-4 * np.ones(npar), 1e-4 * scale[npar:npar + ne], 0.05 * step])
+                      lambda y: np.r_[1e-4 * np.ones(npar), 1e-4 * scale[npar:npar + ne], 0.05 * step], DAMPING)
     if gn.state is None:
         return None
     y, effects, (models, res, placed, st) = standing[0]

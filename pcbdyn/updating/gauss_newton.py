@@ -7,6 +7,7 @@ scale) and effect magnitudes with it; the bounded step and the covariance are th
 from __future__ import annotations
 
 from dataclasses import dataclass
+from itertools import chain
 
 import numpy as np
 
@@ -16,6 +17,10 @@ from .solvers import bounded_lsq, covariance
 HALVINGS = 4
 #: relative rise of chi^2 a step may make and still be taken (round-off)
 RISE_TOL = 1e-9
+#: Marquardt's damping factors (on the columns scaled to unit length) that :func:`gauss_newton` may try, in
+#: turn, where even the halved step does not lower chi^2: steps that turn from Gauss-Newton's towards
+#: steepest descent, for a start far from the minimum of a strongly nonlinear residual
+DAMPING = (1e-2, 1e-1, 1.0, 10.0)
 
 
 def taken(chi2_new: float, chi2_now: float) -> bool:
@@ -37,14 +42,15 @@ class GaussNewton:
         return np.inf if self.state is None else float(self.state.r @ self.state.r)
 
 
-def gauss_newton(evaluate, jacobian, y0, lower, upper, scale, steps: int, step_tol) -> GaussNewton:
+def gauss_newton(evaluate, jacobian, y0, lower, upper, scale, steps: int, step_tol, damping=()) -> GaussNewton:
     """Fit ``y`` from ``y0`` within [lower, upper].
 
     ``evaluate(y)``: the state at ``y`` (with ``r``, the residual rows in noise units), or None where
     the model cannot be evaluated; ``jacobian(state)``: dr/dy (n_rows, n_y) there (sign: the rows are
     data - prediction, so the step solves J dy = r); ``scale`` (n_y,): typical sizes of the variables,
     which condition the step; ``step_tol`` (n_y,): a step smaller than this in every variable ends the
-    fit. At most ``steps`` steps; a step that raises chi^2 is halved up to :data:`HALVINGS` times."""
+    fit. At most ``steps`` steps; a step that raises chi^2 is halved up to :data:`HALVINGS` times, and where
+    that fails, the steps damped by each of ``damping`` (Levenberg-Marquardt; e.g. :data:`DAMPING`) are tried."""
     y = np.asarray(y0, float)
     lower, upper, scale = (np.asarray(v, float) for v in (lower, upper, scale))
     st = evaluate(y)
@@ -57,12 +63,11 @@ def gauss_newton(evaluate, jacobian, y0, lower, upper, scale, steps: int, step_t
             break
         lo, hi = (lower - y) / scale, (upper - y) / scale
         dy = bounded_lsq(J, st.r, np.minimum(lo, 0.0), np.maximum(hi, 0.0)) * scale
-        for _half in range(HALVINGS):
+        for dy in chain((dy * 0.5**k for k in range(HALVINGS)), (_damped(J, st.r, lo, hi, mu) * scale for mu in damping)):
             y_new = np.clip(y + dy, lower, upper)
             trial = evaluate(y_new)
             if trial is not None and taken(float(trial.r @ trial.r), chi2):
                 break
-            dy = 0.5 * dy
         else:
             break
         small = np.all(np.abs(dy) <= step_tol(y))
@@ -71,3 +76,10 @@ def gauss_newton(evaluate, jacobian, y0, lower, upper, scale, steps: int, step_t
             break
     J = jacobian(st)
     return GaussNewton(y, st, covariance(J, st.r) if J.shape[1] else np.zeros((0, 0)))
+
+
+def _damped(J, r, lo, hi, mu: float) -> np.ndarray:
+    """The bounded step of (J^T J + mu diag(J^T J)) dy = J^T r (Marquardt), in ``J``'s variables."""
+    norms = np.linalg.norm(J, axis=0)
+    d = np.where(norms > 0, norms, 1.0)
+    return bounded_lsq(J / d, r, np.minimum(lo, 0.0) * d, np.maximum(hi, 0.0) * d, ridge=np.sqrt(mu)) / d
