@@ -1,7 +1,8 @@
 """Bounded Gauss-Newton on a residual in units of noise (thesis ch. 4 with the bounds of eqs.
 4.44-4.48): the nonlinear fit of parameters whose residual is re-solved at every trial, with each step
-halved while it does not lower chi^2 = |r|^2. Diagnosis estimates declared parameters (on a log
-scale) and effect magnitudes with it; the bounded step and the covariance are the updating solvers'.
+halved while it does not lower chi^2 = |r|^2 (and, where a caller asks, damped as Levenberg-Marquardt's
+where no halving does). Diagnosis estimates declared parameters (on a log scale), effect magnitudes and
+ribs' geometry with it; the bounded step and the covariance are the updating solvers'.
 """
 
 from __future__ import annotations
@@ -63,7 +64,8 @@ def gauss_newton(evaluate, jacobian, y0, lower, upper, scale, steps: int, step_t
             break
         lo, hi = (lower - y) / scale, (upper - y) / scale
         dy = bounded_lsq(J, st.r, np.minimum(lo, 0.0), np.maximum(hi, 0.0)) * scale
-        for dy in chain((dy * 0.5**k for k in range(HALVINGS)), (_damped(J, st.r, lo, hi, mu) * scale for mu in damping)):
+        damped = (_damped(J, st.r, lo, hi, mu) * scale for mu in damping)
+        for dy in chain((dy * 0.5**k for k in range(HALVINGS)), damped):
             y_new = np.clip(y + dy, lower, upper)
             trial = evaluate(y_new)
             if trial is not None and taken(float(trial.r @ trial.r), chi2):
