@@ -63,9 +63,10 @@ def gauss_newton(evaluate, jacobian, y0, lower, upper, scale, steps: int, step_t
         if J.shape[1] == 0:
             break
         lo, hi = (lower - y) / scale, (upper - y) / scale
-        dy = bounded_lsq(J, st.r, np.minimum(lo, 0.0), np.maximum(hi, 0.0)) * scale
+        full = bounded_lsq(J, st.r, np.minimum(lo, 0.0), np.maximum(hi, 0.0)) * scale
+        halved = (full * 0.5**k for k in range(HALVINGS))
         damped = (_damped(J, st.r, lo, hi, mu) * scale for mu in damping)
-        for dy in chain((dy * 0.5**k for k in range(HALVINGS)), damped):
+        for dy in chain(halved, damped):
             y_new = np.clip(y + dy, lower, upper)
             trial = evaluate(y_new)
             if trial is not None and taken(float(trial.r @ trial.r), chi2):

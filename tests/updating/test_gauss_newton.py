@@ -37,3 +37,18 @@ def test_a_step_the_halvings_cannot_take_is_taken_damped():
     plain, damped = _fit(()), _fit(DAMPING)
     assert plain.chi2 == pytest.approx(B @ B, rel=1e-12)  # stalled where it started
     assert damped.chi2 < 0.8 * B @ B
+
+
+def test_a_step_is_halved_in_turn_until_the_model_can_be_evaluated():
+    """r = 1 - y with the model unsolvable beyond y = 0.3 (None): the steps tried are 1, 1/2, 1/4 of
+    Gauss-Newton's, and the first evaluable one, 1/4, is taken."""
+    def evaluate(y):
+        if y[0] > 0.3:
+            return None
+        st = _State(y)
+        st.r = np.array([1.0]) - y
+        return st
+
+    gn = gauss_newton(evaluate, lambda st: np.ones((1, 1)), np.zeros(1), np.full(1, -10.0), np.full(1, 10.0),
+                      np.ones(1), 1, lambda y: np.full(1, 1e-12))
+    assert gn.y[0] == pytest.approx(0.25, abs=1e-12)
