@@ -23,7 +23,7 @@ ends and ln h with the declared parameters and magnitudes, the geometry's column
 differences an eighth of an element long (:data:`STEP`), each a re-mesh run as a job. Far from the bar
 those columns can point its step uphill, however halved: it then tries Marquardt's damped steps
 (:data:`pcbdyn.updating.gauss_newton.DAMPING`; a steel bar 25 mm short of where the search put it:
-chi^2 2.5e5 where it stopped without them, 9.9e4 with); where the mesh's noise still defeats it,
+chi^2 2.5e5 where it stopped without them, 1.6e4 with); where the mesh's noise still defeats it,
 the line searches start from the search's line.
 """
 
