@@ -62,8 +62,8 @@ def gauss_newton(evaluate, jacobian, y0, lower, upper, scale, steps: int, step_t
         J = jacobian(st) * scale
         if J.shape[1] == 0:
             break
-        lo, hi = (lower - y) / scale, (upper - y) / scale
-        full = bounded_lsq(J, st.r, np.minimum(lo, 0.0), np.maximum(hi, 0.0)) * scale
+        lo, hi = np.minimum((lower - y) / scale, 0.0), np.maximum((upper - y) / scale, 0.0)
+        full = bounded_lsq(J, st.r, lo, hi) * scale
         halved = (full * 0.5**k for k in range(HALVINGS))
         damped = (_damped(J, st.r, lo, hi, mu) * scale for mu in damping)
         for dy in chain(halved, damped):
@@ -82,7 +82,8 @@ def gauss_newton(evaluate, jacobian, y0, lower, upper, scale, steps: int, step_t
 
 
 def _damped(J, r, lo, hi, mu: float) -> np.ndarray:
-    """The bounded step of (J^T J + mu diag(J^T J)) dy = J^T r (Marquardt), in ``J``'s variables."""
+    """The step of (J^T J + mu diag(J^T J)) dy = J^T r (Marquardt) within [lo, hi] (``lo`` <= 0 <= ``hi``),
+    in ``J``'s variables."""
     norms = np.linalg.norm(J, axis=0)
     d = np.where(norms > 0, norms, 1.0)
-    return bounded_lsq(J / d, r, np.minimum(lo, 0.0) * d, np.maximum(hi, 0.0) * d, ridge=np.sqrt(mu)) / d
+    return bounded_lsq(J / d, r, lo * d, hi * d, ridge=np.sqrt(mu)) / d
