@@ -21,6 +21,8 @@ re-solves (:func:`.select.search`), which decide.
 
 from __future__ import annotations
 
+from functools import partial
+
 import numpy as np
 import scipy.linalg as sla
 
@@ -28,6 +30,8 @@ from .residual import ConfigState, State, beyond_basis, paired_state
 
 #: static-correction directions are compressed to the columns whose M-norm share exceeds this
 RANK_TOL = 1e-8
+#: a load's singular values below this share of its largest are dropped before its static solves
+COLUMN_TOL = 1e-12
 #: eigenvalues below this share of the state's first elastic one are rigid-body modes
 RIGID_SHARE = 1e-6
 
@@ -41,6 +45,21 @@ class _BasisModes:
         self.n_rigid, self.coef = n_rigid, coef
         self.omega2 = lam[n_rigid:]
         self.frequencies = np.sqrt(np.maximum(self.omega2, 0.0)) / (2.0 * np.pi)
+
+
+def _column_space(F) -> np.ndarray:
+    """``F``'s columns reduced to an orthogonal basis of their span, scaled by the singular values
+    (F = result V^T with orthonormal V^T rows): a local direction (a point's mass or spring) loads a
+    few DOFs, so its many paired modes' loads have a rank of 1-3, and the static solves that
+    follow are as many. Spans and the M-norms a compression reads are kept."""
+    rows = np.flatnonzero(np.any(F != 0.0, axis=1))
+    if rows.size == 0 or rows.size >= F.shape[1]:
+        return F
+    U, s, _ = np.linalg.svd(F[rows], full_matrices=False)
+    keep = s > COLUMN_TOL * s[0]
+    out = np.zeros((F.shape[0], int(keep.sum())))
+    out[rows] = U[:, keep] * s[keep]
+    return out
 
 
 class _Config:
@@ -63,8 +82,7 @@ class _Config:
         """The compressed static correction of direction ``key`` (dK, dM), kept."""
         if key in self.X:
             return
-        F = dK @ self.paired - (dM @ self.paired) * self.lam_p[None, :]
-        X = beyond_basis(self.cs, self.phi, F)
+        X = beyond_basis(self.cs, self.phi, _column_space(dK @ self.paired - (dM @ self.paired) * self.lam_p[None, :]))
         X -= self.phi @ (self.phi.T @ (self.cs.M @ X))  # M-orthogonal to the modes (to round-off already)
         d, U = np.linalg.eigh(X.T @ (self.cs.M @ X))
         keep = d > RANK_TOL * max(d.max(initial=0.0), 1e-300)
@@ -73,11 +91,15 @@ class _Config:
         self.read_X[key] = None if self.read_phi is None else np.asarray(self.ob.read @ X)
 
     def moved(self, key, dK, dM, keys) -> tuple:
-        """(B^T dK B, B^T dM B) of direction ``key`` on the basis [phi, X_k for k in ``keys``]."""
+        """(B^T dK B, B^T dM B) of direction ``key`` on the basis [phi, X_k for k in ``keys``], from
+        the rows the direction touches (a candidate's dK and dM are local)."""
         full = (key, tuple(keys))
         if full not in self._moved:
-            B = np.column_stack([self.phi] + [self.X[k] for k in keys])
-            self._moved[full] = (B.T @ (dK @ B), B.T @ (dM @ B))
+            coo = [D.tocoo() for D in (dK, dM)]
+            rows, cols = (np.union1d(*(getattr(D, ax) for D in coo)) for ax in ("row", "col"))
+            on = (lambda at: np.column_stack([self.phi[at]] + [self.X[k][at] for k in keys]))
+            B_rows, B_cols = on(rows), on(cols)
+            self._moved[full] = tuple(B_rows.T @ (D.tocsr()[rows][:, cols] @ B_cols) for D in (dK, dM))
         return self._moved[full]
 
     def moved_parameter(self, j: int, dK, dM, keys) -> tuple:
@@ -109,6 +131,19 @@ class _Config:
         return KB, MB, T, points
 
 
+class _Moves:
+    """The reduced pencil's change along each direction of a fit, each made when first asked for: a
+    screen at the state's own parameters and effects (:func:`.scan.saturated`) moves one direction."""
+
+    def __init__(self, makers: list):
+        self._makers, self._made = makers, {}
+
+    def __getitem__(self, i: int) -> tuple:
+        if i not in self._made:
+            self._made[i] = self._makers[i]()
+        return self._made[i]
+
+
 class Reanalysis:
     """Reduced evaluations of the residual ``res`` near its solved state ``st`` (module doc).
     ``evaluate(p, candidates, values)`` and ``effect_columns(state, candidates)`` stand in for the
@@ -126,6 +161,9 @@ class Reanalysis:
     def _derivative(self, k: int, c):
         return self.res.effects.derivative(k, self.st.configs[k].model, c, self.st.p)
 
+    def _moved_effect(self, k: int, c, names) -> tuple:
+        return self.configs[k].moved(c.name, *self._derivative(k, c), names)
+
     def _directions(self, candidates) -> list:
         """The candidates a fit moves: its own, then the solved state's effects it leaves out
         (they go back to zero)."""
@@ -142,9 +180,9 @@ class Reanalysis:
                 cfg.correction(c.name, *self._derivative(k, c))
             names = [c.name for c in dirs]
             KB, MB, T, points = cfg.basis(names)
-            moves = [cfg.moved_parameter(j, dK, dM, names) for j, (dK, dM) in enumerate(self.param_derivs[k])]
-            moves += [cfg.moved(c.name, *self._derivative(k, c), names) for c in dirs]
-            self._bases[key] = (KB, MB, T, points, moves)
+            params = [partial(cfg.moved_parameter, j, dK, dM, names) for j, (dK, dM) in enumerate(self.param_derivs[k])]
+            effects = [partial(self._moved_effect, k, c, names) for c in dirs]
+            self._bases[key] = (KB, MB, T, points, _Moves(params + effects))
         return self._bases[key]
 
     def evaluate(self, p, candidates=(), values=()) -> State:
@@ -157,8 +195,9 @@ class Reanalysis:
         steps = np.r_[p - self.st.p, [to.get(c.name, 0.0) - self.base.get(c.name, 0.0) for c in dirs]]
         for k, cfg in enumerate(self.configs):
             KB, MB, T, points, moves = self._basis(k, candidates)
-            K = KB + sum(a * GK for a, (GK, _) in zip(steps, moves) if a != 0.0)
-            M = MB + sum(a * GM for a, (_, GM) in zip(steps, moves) if a != 0.0)
+            moving = [(a, moves[i]) for i, a in enumerate(steps) if a != 0.0]
+            K = KB + sum(a * GK for a, (GK, _) in moving)
+            M = MB + sum(a * GM for a, (_, GM) in moving)
             lam, Z = sla.eigh(T.T @ K @ T, T.T @ M @ T)
             coef = T @ Z
             first = cfg.lam[cfg.cs.modes.n_rigid] if cfg.lam.size > cfg.cs.modes.n_rigid else 1.0
