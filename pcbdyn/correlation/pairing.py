@@ -17,7 +17,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.sparse as sp
 from scipy.optimize import linear_sum_assignment
+from scipy.sparse.csgraph import connected_components
 
 from .mac import automac, mac
 
@@ -66,22 +68,17 @@ def clusters(f_a, rel_tol: float) -> list:
 
 def aliased(groups, auto, alias: float) -> list:
     """The clusters ``groups`` joined where a mode of one and a mode of another have an AutoMAC ``auto`` at
-    or above ``alias``: lists of cluster indices, chained."""
-    parent = list(range(len(groups)))
-
-    def root(k):
-        while parent[k] != k:
-            parent[k] = parent[parent[k]]
-            k = parent[k]
-        return k
-
-    for a in range(len(groups)):
-        for b in range(a + 1, len(groups)):
-            if auto[np.ix_(groups[a], groups[b])].max() >= alias:
-                parent[root(b)] = root(a)
-    out = {}
+    or above ``alias``: lists of cluster indices, chained (each list ascending, the lists in the order of
+    their first cluster); a pair of clusters whose AutoMAC has an undefined (NaN) entry is not joined."""
+    member = np.zeros((len(groups), auto.shape[0]))
+    for k, g in enumerate(groups):
+        member[k, g] = 1.0
+    auto = np.asarray(auto)
+    linked = (member @ (auto >= alias) @ member.T > 0.0) & (member @ np.isnan(auto) @ member.T == 0.0)
+    _, label = connected_components(sp.csr_matrix(linked), directed=False)
+    out: dict = {}
     for k in range(len(groups)):
-        out.setdefault(root(k), []).append(k)
+        out.setdefault(label[k], []).append(k)
     return list(out.values())
 
 

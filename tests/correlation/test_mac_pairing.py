@@ -168,3 +168,21 @@ def test_a_pair_beyond_the_frequency_limit_is_reported_and_not_used_for_updating
     pairing = ShapePairing(0.5)
     assert pairing(f_a, phi_a, f_x, phi_x).tolist() == [0, -1]
     assert pairing.warnings() == p.warnings()
+
+
+def test_alias_groups_chain_through_shared_neighbours_and_skip_undefined_automac():
+    """Clusters join where any of their modes look alike (AutoMAC >= the limit), transitively: the
+    first and third of {0}, {1, 2}, {3} alias only through the second; an AutoMAC left undefined (a
+    mode with no motion at the points) joins nothing."""
+    from pcbdyn.correlation.pairing import aliased
+
+    auto = np.full((5, 5), 0.1)
+    np.fill_diagonal(auto, 1.0)
+    auto[0, 2] = auto[2, 0] = auto[2, 3] = auto[3, 2] = 0.95
+    groups = [[0], [1, 2], [3], [4]]
+    assert aliased(groups, auto, 0.9) == [[0, 1, 2], [3]]
+    assert aliased(groups, auto, 0.96) == [[0], [1], [2], [3]]
+    auto[3, 4] = auto[4, 3] = 0.99
+    auto[2, 4] = auto[4, 2] = np.nan
+    assert aliased(groups, auto, 0.9) == [[0, 1, 2, 3]]
+    assert aliased([[0], [1, 2], [4]], auto, 0.9) == [[0, 1], [2]]
