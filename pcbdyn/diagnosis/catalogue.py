@@ -179,6 +179,14 @@ class BlockCache:
     def __init__(self, size: int = 64):
         self.size, self._pools = size, (OrderedDict(), OrderedDict())
 
+    def __getstate__(self):
+        """Sent to a worker process or a Dask worker empty: the blocks are made again there when
+        asked for, rather than hundreds of MB pickled with every residual."""
+        return {"size": self.size}
+
+    def __setstate__(self, state):
+        self.__init__(state["size"])
+
     def __call__(self, model, name: str, cands) -> list:
         spec = kind(name)
         if getattr(spec, "uses_properties", False):

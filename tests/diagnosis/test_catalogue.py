@@ -289,3 +289,26 @@ def test_a_mass_placed_on_another_mesh_sits_at_its_point():
     tilt_x[2::6], tilt_y[2::6] = fine.nodes[:, 0], fine.nodes[:, 1]
     assert heave @ dM @ heave == pytest.approx(1.0, rel=1e-12)
     assert [heave @ dM @ tilt_x, heave @ dM @ tilt_y] == pytest.approx(c.at, abs=1e-12)
+
+
+def test_block_cache_keeps_a_kinds_group_through_a_screen_of_single_candidates_and_travels_empty(plate):
+    """Every stiffener's blocks (the search's columns, made once per search) are still kept after more
+    single-candidate asks than the cache holds (a screen's derivatives); a cache pickled to a worker
+    arrives empty and makes the same blocks again."""
+    import pickle
+
+    from pcbdyn.diagnosis.catalogue import BlockCache
+
+    m, _, cands, _, _ = plate
+    cache = BlockCache(size=4)
+    ribs = [c for c in cands if c.kind == "stiffener"]
+    masses = [c for c in cands if c.kind == "point_mass"][:10]
+    group = cache(m, "stiffener", ribs)
+    for c in masses:
+        cache(m, "point_mass", [c])
+    assert cache(m, "stiffener", ribs) is group
+    blob = pickle.dumps(cache)
+    assert len(blob) < 1000 < sum(b.Ke.nbytes for b in group)
+    sent = pickle.loads(blob)
+    again = sent(m, "stiffener", ribs)
+    assert again is not group and all(np.array_equal(a.Ke, b.Ke) for a, b in zip(again, group))
