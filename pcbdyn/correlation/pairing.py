@@ -70,10 +70,10 @@ def aliased(groups, auto, alias: float) -> list:
     """The clusters ``groups`` joined where a mode of one and a mode of another have an AutoMAC ``auto`` at
     or above ``alias``: lists of cluster indices, chained (each list ascending, the lists in the order of
     their first cluster); a pair of clusters whose AutoMAC has an undefined (NaN) entry is not joined."""
+    auto = np.asarray(auto)
     member = np.zeros((len(groups), auto.shape[0]))
     for k, g in enumerate(groups):
         member[k, g] = 1.0
-    auto = np.asarray(auto)
     linked = (member @ (auto >= alias) @ member.T > 0.0) & (member @ np.isnan(auto) @ member.T == 0.0)
     _, label = connected_components(sp.csr_matrix(linked), directed=False)
     out: dict = {}

@@ -97,8 +97,7 @@ class _Config:
         if full not in self._moved:
             coo = [D.tocoo() for D in (dK, dM)]
             rows, cols = (np.union1d(*(getattr(D, ax) for D in coo)) for ax in ("row", "col"))
-            on = (lambda at: np.column_stack([self.phi[at]] + [self.X[k][at] for k in keys]))
-            B_rows, B_cols = on(rows), on(cols)
+            B_rows, B_cols = (np.column_stack([self.phi[at]] + [self.X[k][at] for k in keys]) for at in (rows, cols))
             self._moved[full] = tuple(B_rows.T @ (D.tocsr()[rows][:, cols] @ B_cols) for D in (dK, dM))
         return self._moved[full]
 
