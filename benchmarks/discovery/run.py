@@ -75,8 +75,9 @@ def run_case(seed: int, options: dict, shared=None) -> dict:
 #: report seeds a session has read case by case (their files, their diagnosis step by step): no longer
 #: unseen, so the figures are printed without them too (kept here, not in :mod:`cases`, whose code is
 #: part of the cached cases' key). 1021: its failure followed into the search's start from the modes
-#: without a partner; 1022: its point mass beside a hinged edge (2026-11-30).
-SEEN = {1021, 1022}
+#: without a partner; 1022: its point mass beside a hinged edge (2026-11-30); 1023: a scan of the kept
+#: results for parameters fitted onto a bound listed it beside dev seeds 20 and 21 (2026-12-01).
+SEEN = {1021, 1022, 1023}
 
 
 def _pct(k: int, n: int) -> str:

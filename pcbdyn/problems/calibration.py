@@ -33,7 +33,7 @@ from ..updating.solvers import covariance
 from ..updating.weighting import NOISE_REDRAWS
 from .error_budget import measured_mesh_steps, noise_sigma
 from .fit import fit
-from .verdict import MIN_PAIRED
+from .verdict import MIN_PAIRED, at_bounds
 from .problem import UpdateProblem
 from .run import correlation_state
 
@@ -273,9 +273,7 @@ def calibrate(cal: Calibration, method: str = "freq", solver: str = "bounded", n
     cal.std_mesh = np.abs(p * g)
     cal.std[undetermined] = np.inf
     cal.undetermined = [cal.problem.names[j] for j in np.flatnonzero(undetermined)]
-    lo, hi = cal.problem.bounds
-    cal.at_bound = [n for n, v, a, b in zip(cal.problem.names, p, lo, hi) if np.isclose(v, a, rtol=1e-6)
-                    or np.isclose(v, b, rtol=1e-6)]
+    cal.at_bound = list(at_bounds(cal.problem.names, p, cal.problem.bounds))
     return cal
 
 

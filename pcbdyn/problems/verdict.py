@@ -52,14 +52,21 @@ def verdict(cfgs, p, problem) -> dict:
             "measured_modes": int(measured)}
 
 
+def at_bounds(names, p, bounds) -> dict:
+    """{name: "lower" | "upper"} of the parameters ``p`` that stopped on a side of ``bounds`` = (lower,
+    upper; the physical range of thesis section 4.8): a parameter held there is not fitted by the data,
+    and is often pulled there by what the model lacks."""
+    lo, hi = bounds
+    return {n: "lower" if np.isclose(v, a, rtol=1e-6) else "upper" for n, v, a, b in zip(names, p, lo, hi)
+            if np.isclose(v, a, rtol=1e-6) or np.isclose(v, b, rtol=1e-6)}
+
+
 def judge(out, cfgs) -> None:
     """``status`` and ``details`` of a finished :class:`.fit.Fit` (:mod:`.fit`'s docstring, step 5); the
     directions the data leave open from ``cfgs``, rows in noise units (None: from the rank of the last
     solve, for QMS and FBM)."""
     prob, res = out.problem, out.result
-    lo, hi = prob.bounds
-    out.at_bounds = {n: "lower" if np.isclose(v, a, rtol=1e-6) else "upper" for n, v, a, b in
-                     zip(prob.names, out.p, lo, hi) if np.isclose(v, a, rtol=1e-6) or np.isclose(v, b, rtol=1e-6)}
+    out.at_bounds = at_bounds(prob.names, out.p, prob.bounds)
     out.worse = worse_configurations(out.before, out.after)
     free = [j for j, n in enumerate(prob.names) if n not in out.at_bounds]
     if cfgs is None:
