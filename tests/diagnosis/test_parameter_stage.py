@@ -28,7 +28,8 @@ def residual():
     model lacks (frequencies alone, 0.2 %)."""
     m = guided_card(E=E0)
     layout = dg.from_model(m)
-    near = min(dg.generate(layout, kinds=["point_mass"]), key=lambda c: np.linalg.norm(np.subtract(c.at[:2], (0.07, 0.09))))
+    near = min(dg.generate(layout, kinds=["point_mass"]),
+               key=lambda c: np.linalg.norm(np.subtract(c.at[:2], (0.07, 0.09))))
     f = solve_modes(dg.add_effect(m, near, 0.020), n_modes=N_MODES).frequencies
     n = m.n_dof
     dK = assemble(guided_card(E=1.0), sets=["plate"])[0]
