@@ -10,7 +10,7 @@ child process, ``--json``), ``--jobs`` of them at once on local processes or on 
 its JSON is kept beside the case under a tag (``--tag``, default the git commit of pcbdyn) so that
 a split is judged again without running it twice. Prints one row per case and the figures the
 issue's acceptance names: effects of detectable size found, noise-only cases clean, effect cases
-with no invented effect, the median error after, 2-sigma coverage, and the wall time per case.
+with no invented effect, the median error after, 1- and 2-sigma coverage, and the wall time per case.
 """
 
 from __future__ import annotations
@@ -91,6 +91,7 @@ def summary(rows: list) -> dict:
     clean = [v for _, _, v in rows if v["noise_only_case"]]
     eff = [v for _, _, v in rows if not v["noise_only_case"]]
     cov = [a["covered"] for a in det if a.get("covered") is not None]
+    cov1 = [a["covered_1sigma"] for a in det if a.get("covered_1sigma") is not None]
     after = [v["after"] for _, _, v in rows if "after" in v]
     walls = [r["wall_s"] for _, r, _ in rows]
     return {
@@ -99,7 +100,7 @@ def summary(rows: list) -> dict:
         "placed_detectable": (sum(a["placed"] for a in det), len(det)),
         "clean_noise_only": (sum(not v["n_reported"] for v in clean), len(clean)),
         "no_invented": (sum(not v["invented"] for v in eff), len(eff)),
-        "covered_2sigma": (sum(cov), len(cov)),
+        "covered_2sigma": (sum(cov), len(cov)), "covered_1sigma": (sum(cov1), len(cov1)),
         "median_after_pct": float(np.median(after)) if after else None,
         "after_le_0.5": (sum(a <= 0.5 for a in after), len(after)),
         "median_wall_s": float(np.median(walls)) if walls else None, "max_wall_s": max(walls) if walls else None,
@@ -163,7 +164,8 @@ def _print(s: dict) -> None:
           f"placed: {_pct(*s['placed_detectable'])}")
     print(f"  noise-only cases clean: {_pct(*s['clean_noise_only'])}")
     print(f"  effect cases with no invented effect: {_pct(*s['no_invented'])}")
-    print(f"  2-sigma coverage of found magnitudes: {_pct(*s['covered_2sigma'])}")
+    print(f"  coverage of the magnitudes placed: 2-sigma {_pct(*s['covered_2sigma'])} (stated 95 %), "
+          f"1-sigma {_pct(*s['covered_1sigma'])} (stated 68 %)")
     print(f"  error after: median {s['median_after_pct']} %, <= 0.5 %: {_pct(*s['after_le_0.5'])}")
     print(f"  wall per case: median {s['median_wall_s']:.0f} s, slowest {s['max_wall_s']:.0f} s")
 

@@ -91,17 +91,19 @@ def distance(r: dict, geometry: dict) -> float:
     return float(np.linalg.norm(np.asarray(r["at_mm"], float) - p))
 
 
-def _covered(reported: dict, magnitude: float) -> bool:
-    """The true ``magnitude`` lies in the reported 2-sigma interval (``interval_2sigma``, its upper end
-    None where the data leave it open; results written before it: magnitude -+ 2 uncertainty)."""
+def _covered(reported: dict, magnitude: float, k: float = 2.0) -> bool:
+    """The true ``magnitude`` lies in the reported k-sigma interval: the 2-sigma one (``interval_2sigma``,
+    its upper end None where the data leave it open; results written before it: magnitude -+ 2
+    uncertainty) with its reach either side scaled by k / 2 (the 1-sigma interval of a linear magnitude)."""
+    m = reported["magnitude"]
     if "interval_2sigma" not in reported:
-        return abs(reported["magnitude"] - magnitude) <= 2.0 * (reported.get("uncertainty") or 0.0)
+        return abs(m - magnitude) <= k * (reported.get("uncertainty") or 0.0)
     lo, hi = reported["interval_2sigma"]
-    return lo <= magnitude and (hi is None or magnitude <= hi)
+    return m - k / 2.0 * (m - lo) <= magnitude and (hi is None or magnitude <= m + k / 2.0 * (hi - m))
 
 
 def judge(truth: dict, result: dict, detectable_chi2: float) -> dict:
-    """Per case: atoms (found or not, detectable or not, magnitude error, 2-sigma covered), the
+    """Per case: atoms (found or not, detectable or not, magnitude error, 1- and 2-sigma covered), the
     reported effects that match no atom (invented), noise-only cleanliness and the errors."""
     case = truth["case"]
     E_board = next((p["true"] for p in case["parameters"] if p["name"] == "E_board"), case["E"])
@@ -121,10 +123,11 @@ def judge(truth: dict, result: dict, detectable_chi2: float) -> dict:
             row["reported"] = r["magnitude"]
             row["sigma"] = r.get("uncertainty")
             if mag is None:
-                row.update(sized=True, covered=None)
+                row.update(sized=True, covered=None, covered_1sigma=None)
             else:
                 row["sized"] = abs(r["magnitude"] / mag - 1.0) <= MAGNITUDE
                 row["covered"] = _covered(r, mag)
+                row["covered_1sigma"] = _covered(r, mag, 1.0)
         row["found"] = bool(row["placed"] and row.get("sized", False))
         rows.append(row)
     invented = [r for j, r in enumerate(reported) if j not in used and not any(

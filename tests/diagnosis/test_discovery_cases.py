@@ -51,3 +51,15 @@ def test_handed_and_true_boards_load(tmp_path):
             assert len(board.components) == len(c.parts) + sum(e["kind"] == "heat_sink" for e in c.effects) * truth
             if not truth:
                 assert [p.name for p in board.parameters] == [p["name"] for p in c.parameters]
+
+
+def test_coverage_is_judged_on_the_reported_intervals():
+    """A magnitude reported as 10 with the 2-sigma interval [6, 12] (its profile wider below): the
+    1-sigma interval is [8, 11], and an open upper end covers every larger truth."""
+    from score import _covered
+
+    r = {"magnitude": 10.0, "interval_2sigma": [6.0, 12.0]}
+    assert [_covered(r, t) for t in (5.9, 6.1, 11.9, 12.1)] == [False, True, True, False]
+    assert [_covered(r, t, 1.0) for t in (7.9, 8.1, 10.9, 11.1)] == [False, True, True, False]
+    assert _covered({"magnitude": 10.0, "interval_2sigma": [6.0, None]}, 1e9, 1.0)
+    assert [_covered({"magnitude": 10.0, "uncertainty": 1.0}, t, 1.0) for t in (8.9, 10.9)] == [False, True]
