@@ -12,13 +12,8 @@ second moment) is tried as lines through that centre in four directions and seve
 best walked the same way; it must lower the criterion by one effect's penalty more, as its direction
 and length are two coordinates a point does not have, and end at least two elements long: a shorter
 line is not one the mesh resolves, and a mass between nodes fits it as well as a point (dev seed 0's
-50 g point mass had become a 7.8 mm line on 6 mm elements). A mass found spread over a rectangle (with
-the change of stiffness over the same rectangle, where one was found: a body glued over an area) is
-tried as the line along the rectangle's longer axis, walked the same way, and kept where it lowers the
-criterion: a rectangle and a line are both four coordinates and a mass, and the line drops the
-stiffness (dev seed 11: a 28 mm line of 4.5 g at 64 degrees had been found as 4.1 g and a -10 %
-stiffness over a 10 x 25 mm rectangle). The same walk places a mass or a spring to ground found on
-nodes at its point between them (:mod:`.at_points`)."""
+50 g point mass had become a 7.8 mm line on 6 mm elements). The same walk places a mass or a spring to
+ground found on nodes at its point between them (:mod:`.at_points`)."""
 
 from __future__ import annotations
 
@@ -30,7 +25,6 @@ from .catalogue import weighted_centre
 from .fitting import RANK_STEPS, estimate, pattern_search
 from .line_mass import KIND
 from .merge import groups
-from .moves import rectangle
 from .reanalysis import Reanalysis
 from .select import ALPHA, adopt, penalty
 
@@ -90,22 +84,6 @@ def _singles(candidates, sel, groups, h: float, reach: float) -> list:
             continue
         radius = max((chosen[k].data.get("radius", 0.0) for k in gm), default=0.0)
         out.append(([sel.chosen[k] for k in g], m, centre, max(np.sqrt(24.0) * radius, 2.0 * h)))
-    return out
-
-
-def _regions(candidates, sel) -> list:
-    """[(candidate indices of a mass found over a rectangle and of the stiffness change found over the
-    same one, if any; its mass; the ends (2, 2) [m] of the rectangle's longer axis)]."""
-    out = []
-    for i, m in zip(sel.chosen, sel.values):
-        box = rectangle(candidates[i]) if candidates[i].kind == "region_mass" else None
-        if box is None:
-            continue
-        body = [j for j in sel.chosen if candidates[j].kind == "region_stiffness"
-                and np.allclose(rectangle(candidates[j]) or np.inf, box)]
-        lo, hi = np.array(box[:2]), np.array(box[2:])
-        half = np.where(np.arange(2) == np.argmax(hi - lo), 0.5 * (hi - lo), 0.0)
-        out.append(([i] + body, float(m), np.array([0.5 * (lo + hi) - half, 0.5 * (lo + hi) + half])))
     return out
 
 
@@ -197,7 +175,4 @@ def as_lines(res, candidates: list, sel, reach: float, layout, step: float, boun
                                centre, length, layout, bounds)
         if ends is not None and chi2 < sel.chi2[-1]:  # else no line is worth walking
             _as_line(res, candidates, sel, single, m, ends, layout, step, bounds, newton_steps, pen, pen, 2.0 * h)
-    for region, m, ends in _regions(candidates, sel):
-        if set(region) <= set(sel.chosen) and m > 0:
-            _as_line(res, candidates, sel, region, m, ends, layout, step, bounds, newton_steps, pen, 0.0, 2.0 * h)
     return sel

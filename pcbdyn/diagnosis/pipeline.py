@@ -27,7 +27,7 @@ whether what remains is noise, and otherwise find, place and size the effects th
    best (:func:`.select.refine`, :class:`.moves.LocalMoves`), overlapping regions refitted as one
    (:mod:`.one_region`), a mass with an inertia beside it refitted as one body (:mod:`.bodies`), a mass
    or a spring on nodes placed at its point between them (:mod:`.at_points`), two masses apart, or one
-   alone, or one over a rectangle, as one mass along a line (:mod:`.mass_lines`). The masses (and supports) found
+   alone, as one mass along a line (:mod:`.mass_lines`). The masses (and supports) found
    are then put on the finer meshes and the mesh correction measured again (:func:`.budget.with_carried`:
    they change the shapes it depends on); where stiffeners were found, the structure is meshed along
    their lines first, every effect carried, and the ribs' ends and sections fitted there
@@ -306,7 +306,7 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
     if any(at_grid_node(cands[i]) for i in sel.chosen):
         say("placing the masses and springs found on nodes at their points between the nodes")
         sel = as_points(res, cands, sel, MERGE_REACH * h, layout, h / 2, models.bounds, alpha=alpha)
-    if any(cands[i].kind in ("point_mass", "region_mass") for i in sel.chosen):
+    if any(cands[i].kind == "point_mass" for i in sel.chosen):
         say("fitting masses found as masses along lines")
         sel = as_lines(res, cands, sel, MERGE_REACH * h, layout, h / 2, models.bounds, alpha=alpha)
     sel = without_vanished(res, cands, sel, models.bounds, alpha=alpha)
