@@ -33,9 +33,9 @@ from ..updating.solvers import covariance
 from ..updating.weighting import NOISE_REDRAWS
 from .error_budget import measured_mesh_steps, noise_sigma
 from .fit import fit
-from .verdict import MIN_PAIRED, at_bounds
+from .verdict import MIN_PAIRED
 from .problem import UpdateProblem
-from .run import correlation_state
+from .run import at_bounds, correlation_state
 
 #: a family parameter is bounded to [value / FAMILY_RANGE, value * FAMILY_RANGE]
 FAMILY_RANGE = 3.0

@@ -77,6 +77,15 @@ def worse_configurations(before, after) -> list:
             and a["max_freq_error_pct"] > b["max_freq_error_pct"] * (1 + 1e-9)]
 
 
+def at_bounds(names, p, bounds) -> dict:
+    """{name: "lower" | "upper"} of the parameters ``p`` that stopped on a side of ``bounds`` = (lower,
+    upper; the physical range of thesis section 4.8): a parameter held there is not fitted by the data,
+    and is often pulled there by what the model lacks."""
+    lo, hi = bounds
+    return {n: "lower" if np.isclose(v, a, rtol=1e-6) else "upper" for n, v, a, b in zip(names, p, lo, hi)
+            if np.isclose(v, a, rtol=1e-6) or np.isclose(v, b, rtol=1e-6)}
+
+
 def outcome(problem, res, before, after) -> dict:
     """What an update did, in the user's terms: ``status`` ("error grew", "on a bound", "not determined",
     "stalled", "not converged" or "converged": the first that applies), and ``details``: parameters at
@@ -84,9 +93,7 @@ def outcome(problem, res, before, after) -> dict:
     did not determine at the last solve, configurations set aside because no mode paired; ``warnings``:
     the pairing's before and after (:func:`pairing_warnings`). The fits of :func:`.fit.fit` judge more
     (the chi^2 verdict, the directions in units of the noise)."""
-    lo, hi = problem.bounds
-    bounds = {n: "lower" if np.isclose(v, a, rtol=1e-6) else "upper" for n, v, a, b in
-              zip(problem.names, res.p, lo, hi) if np.isclose(v, a, rtol=1e-6) or np.isclose(v, b, rtol=1e-6)}
+    bounds = at_bounds(problem.names, res.p, problem.bounds)
     worse = worse_configurations(before, after)
     sol = res.solution
     undetermined = [] if sol is None or not sol.rank_deficient else undetermined_directions(

@@ -10,7 +10,7 @@ from scipy.stats import chi2 as chi2_dist
 from ..updating.iteration import build_equations, objective_rows, unpaired
 from ..updating.solvers import choose_rank
 from ..units import from_si
-from .run import undetermined_directions, worse_configurations
+from .run import at_bounds, undetermined_directions, worse_configurations
 
 #: chi^2 with a smaller probability than this under the noise: the model cannot fit the test
 ALPHA_FIT = 1e-3
@@ -50,15 +50,6 @@ def verdict(cfgs, p, problem) -> dict:
         fits = False  # the test's modes are not the model's
     return {"chi2": chi2, "dof": dof, "p_value": pv, "fits": fits, "paired_modes": int(paired),
             "measured_modes": int(measured)}
-
-
-def at_bounds(names, p, bounds) -> dict:
-    """{name: "lower" | "upper"} of the parameters ``p`` that stopped on a side of ``bounds`` = (lower,
-    upper; the physical range of thesis section 4.8): a parameter held there is not fitted by the data,
-    and is often pulled there by what the model lacks."""
-    lo, hi = bounds
-    return {n: "lower" if np.isclose(v, a, rtol=1e-6) else "upper" for n, v, a, b in zip(names, p, lo, hi)
-            if np.isclose(v, a, rtol=1e-6) or np.isclose(v, b, rtol=1e-6)}
 
 
 def judge(out, cfgs) -> None:

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..problems.run import at_bounds
 from ..units import from_si, printed_unit
 from .files import save_figure
 
@@ -16,10 +17,10 @@ SI_UNITS = {"mm": "m", "g": "kg", "GPa": "Pa"}
 def parameter_rows(problem, p) -> list:
     """One dict per parameter: name, unit, initial/updated (in the unit printed for the board's,
     :func:`pcbdyn.units.printed_unit`: a modulus in GPa), change %, bound hit."""
-    lo, hi = problem.bounds
+    hits = at_bounds(problem.names, p, problem.bounds)
     rows = []
     for i, (par, v0, v) in enumerate(zip(problem.parameters, problem.p0, p)):
-        hit = "lower" if np.isclose(v, lo[i], rtol=1e-6) else "upper" if np.isclose(v, hi[i], rtol=1e-6) else ""
+        hit = hits.get(par.name, "")
         u = printed_unit(par.unit)
         rows.append({"name": par.name, "unit": u, "initial": from_si(v0, u), "updated": from_si(v, u),
                      "change_pct": 100.0 * (v / v0 - 1.0), "bound_hit": hit, "log_scale": i in problem.log_scale})
