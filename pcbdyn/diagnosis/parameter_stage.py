@@ -11,7 +11,7 @@ import numpy as np
 from scipy.stats import chi2 as chi2_dist
 
 from ..parallel import beside, spare
-from ..problems.run import at_bounds
+from ..updating.driver import at_bounds
 from .fitting import estimate
 from .residual import ModalResidual
 

@@ -28,6 +28,7 @@ from .. import targets
 from ..components.library import locate, read_package, search_path
 from ..domain import StructureError
 from ..testdata.noise import add_noise
+from ..updating.driver import at_bounds
 from ..updating.iteration import build_equations
 from ..updating.solvers import covariance
 from ..updating.weighting import NOISE_REDRAWS
@@ -35,7 +36,7 @@ from .error_budget import measured_mesh_steps, noise_sigma
 from .fit import fit
 from .verdict import MIN_PAIRED
 from .problem import UpdateProblem
-from .run import at_bounds, correlation_state
+from .run import correlation_state
 
 #: a family parameter is bounded to [value / FAMILY_RANGE, value * FAMILY_RANGE]
 FAMILY_RANGE = 3.0

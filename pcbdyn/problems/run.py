@@ -8,7 +8,7 @@ import warnings
 
 import numpy as np
 
-from ..updating.driver import update
+from ..updating.driver import at_bounds, update
 from ..updating.iteration import paired_states
 from ..updating.solvers import RankDeficiencyWarning
 
@@ -75,15 +75,6 @@ def worse_configurations(before, after) -> list:
     return [(b["configuration"], b["max_freq_error_pct"], a["max_freq_error_pct"]) for b, a in zip(before, after)
             if None not in (b["max_freq_error_pct"], a["max_freq_error_pct"])
             and a["max_freq_error_pct"] > b["max_freq_error_pct"] * (1 + 1e-9)]
-
-
-def at_bounds(names, p, bounds) -> dict:
-    """{name: "lower" | "upper"} of the parameters ``p`` that stopped on a side of ``bounds`` = (lower,
-    upper; the physical range of thesis section 4.8): a parameter held there is not fitted by the data,
-    and is often pulled there by what the model lacks."""
-    lo, hi = bounds
-    return {n: "lower" if np.isclose(v, a, rtol=1e-6) else "upper" for n, v, a, b in zip(names, p, lo, hi)
-            if np.isclose(v, a, rtol=1e-6) or np.isclose(v, b, rtol=1e-6)}
 
 
 def outcome(problem, res, before, after) -> dict:

@@ -7,10 +7,11 @@ from __future__ import annotations
 import numpy as np
 from scipy.stats import chi2 as chi2_dist
 
+from ..units import from_si
+from ..updating.driver import at_bounds
 from ..updating.iteration import build_equations, objective_rows, unpaired
 from ..updating.solvers import choose_rank
-from ..units import from_si
-from .run import at_bounds, undetermined_directions, worse_configurations
+from .run import undetermined_directions, worse_configurations
 
 #: chi^2 with a smaller probability than this under the noise: the model cannot fit the test
 ALPHA_FIT = 1e-3

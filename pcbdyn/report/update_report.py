@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..problems.run import at_bounds
+from ..updating.driver import at_bounds
 from ..units import from_si, printed_unit
 from .files import save_figure
 

@@ -252,3 +252,12 @@ def _safe(residue, q) -> float:
         return residue(q)
     except (np.linalg.LinAlgError, ValueError, ArithmeticError):
         return np.inf  # the trial model cannot be solved: not a candidate
+
+
+def at_bounds(names, p, bounds) -> dict:
+    """{name: "lower" | "upper"} of the parameters ``p`` that stopped on a side of ``bounds`` = (lower,
+    upper; the physical range of thesis section 4.8): a parameter held there is not fitted by the data,
+    and is often pulled there by what the model lacks."""
+    lo, hi = bounds
+    return {n: "lower" if np.isclose(v, a, rtol=1e-6) else "upper" for n, v, a, b in zip(names, p, lo, hi)
+            if np.isclose(v, a, rtol=1e-6) or np.isclose(v, b, rtol=1e-6)}
