@@ -25,6 +25,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ..correlation.close_modes import align_close, close_groups
 from ..correlation.mac import mac
 from ..correlation.pairing import pair_modes
 from ..fe.assembly import assemble
@@ -105,7 +106,9 @@ class ConfigState:
     observation's discretisation correction), ``mac``, the
     model shapes at the points ``u`` and scale factors ``s``, its rows ``r``; ``points``: the modes
     [rigid, elastic] at the measured points when they are not read from full-length shapes (a
-    state found by :mod:`.reanalysis`)."""
+    state found by :mod:`.reanalysis`); ``x``: the measured shapes the rows compare, ``close``: the
+    groups of close modes among them that were turned onto the model's
+    (:func:`pcbdyn.correlation.close_modes.align_close`)."""
 
     model: object
     K: object
@@ -119,6 +122,8 @@ class ConfigState:
     s: np.ndarray | None
     r: np.ndarray
     points: np.ndarray | None = None
+    x: np.ndarray | None = None  # the measured shapes as compared: each close group turned onto its model modes
+    close: tuple = ()  # the groups of close measured modes whose shapes were turned
     static: tuple | None = None  # (reduction, shift, factorisation) of :func:`beyond_basis`, made when first needed
 
     def at_points(self, read) -> np.ndarray:
@@ -151,7 +156,8 @@ class State:
         """Max |frequency error| [%] and mean MAC over all configurations, and per configuration, of
         the test modes paired with a model mode (``paired``; the others, with the nearest free
         frequency standing in, are listed in ``unpaired_test_modes``: a support's bounce on a free
-        model that lacks it, :mod:`.support`)."""
+        model that lacks it, :mod:`.support`; groups of close test modes compared as a plane, their
+        MAC after the turn, in ``close_test_modes``)."""
         per = []
         for ob, c in zip(observations, self.configs):
             df = 100.0 * (c.f_a / ob.f - 1.0)
@@ -165,6 +171,8 @@ class State:
                                for i in range(ob.f.size)]}
             if not c.matched.all():
                 entry["unpaired_test_modes"] = [int(n) for n in ob.numbers[~c.matched]]
+            if c.close:
+                entry["close_test_modes"] = [[int(ob.numbers[i]) for i in g] for g in c.close]
             per.append(entry)
         macs = [q["mean_mac"] for q in per if q["mean_mac"] is not None]
         return {"max_freq_error_pct": max(q["max_freq_error_pct"] for q in per),
@@ -196,15 +204,18 @@ def paired_state(ob: Observation, model, K, M, modes, U, points=None) -> ConfigS
             pairs[i] = k
             free.remove(k)
         u = U[:, pairs]
+        close = tuple(g for g in close_groups(ob.f, ob.sigma_f * ob.f) if matched[list(g)].all())
+        x = align_close(ob.shapes, u, close)
         with np.errstate(divide="ignore", invalid="ignore"):  # a paired mode the points miss: rows not finite,
-            s = np.sum(u * ob.shapes, axis=0) / np.sum(u * u, axis=0)  # a state the fits refuse (.fitting)
-        macs = paired_mac(u, ob.shapes)
+            s = np.sum(u * x, axis=0) / np.sum(u * u, axis=0)  # a state the fits refuse (.fitting)
+        macs = paired_mac(u, x)
     f_a = f_all[pairs] * ob.f_scale
     rows = [(ob.f - f_a) / (ob.sigma_f * ob.f)]
-    if u is not None:
-        rms = np.sqrt(np.mean(ob.shapes**2, axis=0))
-        rows.append(((ob.shapes - s * u) / (ob.sigma_s * rms)).T.ravel())
-    return ConfigState(model, K, M, modes, pairs, matched, f_a, macs, u, s, np.concatenate(rows), points)
+    if u is None:
+        return ConfigState(model, K, M, modes, pairs, matched, f_a, macs, u, s, rows[0], points)
+    rms = np.sqrt(np.mean(x**2, axis=0))
+    rows.append(((x - s * u) / (ob.sigma_s * rms)).T.ravel())
+    return ConfigState(model, K, M, modes, pairs, matched, f_a, macs, u, s, np.concatenate(rows), points, x, close)
 
 
 def paired_mac(a, b) -> np.ndarray:
@@ -311,6 +322,10 @@ class ModalResidual:
         modes = cs.modes
         nr = modes.n_rigid
         dlam, C = eigen_derivatives(BK, BM, np.r_[np.zeros(nr), modes.omega2], nr + cs.pairs)  # (n_col, m)
+        for g in cs.close:  # a turn within a close group's plane is met by turning its measured shapes:
+            for i in g:  # of a partner's coefficient only the part that keeps mass-orthogonality is left
+                k = nr + cs.pairs[[j for j in g if j != i]]
+                C[:, k, i] = -0.5 * BM[:, k, i]
         df = dlam * ob.f_scale**2 / (8.0 * np.pi**2 * cs.f_a)  # d(c f)/dp, f = f_a / c
         out = [(df / (ob.sigma_f * ob.f)).T]
         if cs.u is not None:
@@ -320,7 +335,7 @@ class ModalResidual:
                 dU = dU + dU_static
             uh = cs.u / np.linalg.norm(cs.u, axis=0)
             dU -= uh[:, :, None] * np.einsum("pi,pic->ic", uh, dU)[None]
-            rms = np.sqrt(np.mean(ob.shapes**2, axis=0))
+            rms = np.sqrt(np.mean(cs.x**2, axis=0))
             dU *= (cs.s / (ob.sigma_s * rms))[None, :, None]
             out.append(dU.transpose(1, 0, 2).reshape(-1, dU.shape[2]))
         return np.vstack(out)
