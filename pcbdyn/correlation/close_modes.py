@@ -11,11 +11,13 @@ CLOSE_SIGMAS = 3.0
 
 
 def close_groups(f, sd) -> list:
-    """Groups (index tuples) of the modes of frequencies ``f`` (standard deviations ``sd``, same unit)
-    that lie within :data:`CLOSE_SIGMAS` of their neighbours. A perturbation a model lacks, of the size
-    of the frequencies' uncertainty, couples two such modes about as strongly as their gap separates
-    them, so it turns them within their plane by an angle of order one (thesis eqs. 3.8-3.12: the
-    coupling over the eigenvalue gap): the test determines their plane, not each shape within it."""
+    """Groups (index tuples) of the modes of frequencies ``f`` (their measurement noise ``sd``, same
+    unit) that lie within :data:`CLOSE_SIGMAS` of their neighbours. A perturbation too small for the
+    frequencies to show couples two such modes about as strongly as their gap separates them, so it
+    turns them within their plane by an angle of order one (thesis eqs. 3.8-3.12: the coupling over
+    the eigenvalue gap): the test determines their plane, not each shape within it. The noise, not a
+    model's wider error budget: modes a few percent apart on a coarse mesh still differ in shape, and
+    their turn is what a local effect shows first (a stiffener's, dev seeds 9 and 14)."""
     f, sd = np.asarray(f, float), np.asarray(sd, float)
     order = np.argsort(f)
     apart = np.diff(f[order]) >= CLOSE_SIGMAS * np.hypot(sd[order][1:], sd[order][:-1])

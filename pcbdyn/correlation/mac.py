@@ -55,6 +55,11 @@ def mac(phi_x, phi_a) -> np.ndarray:
         return np.where(den > 0, num / np.where(den > 0, den, 1.0), 0.0)
 
 
+def paired_mac(phi_x, phi_a) -> np.ndarray:
+    """MAC of column i of ``phi_x`` with column i of ``phi_a``: the MAC of paired modes."""
+    return np.diagonal(mac(phi_x, phi_a)).copy()
+
+
 def automac(phi) -> np.ndarray:
     """MAC of a set with itself: off-diagonal terms show how distinguishable the modes are at these DOFs
     (spatial aliasing when a sensor set is too sparse)."""

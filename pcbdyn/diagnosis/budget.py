@@ -76,7 +76,7 @@ def _correct(ob, cs, solved, form: Form):
     ``form``'s ``plain`` and ``resolved``."""
     f_scale, df, ds, ok = discretisation(solved, ob, cs)
     form.plain, form.resolved = np.sqrt(form.measured**2 + df**2), ok.tolist()
-    return replace(ob, f_scale=f_scale, sigma_f=np.sqrt(form.plain**2 + form.shift**2)), ds
+    return replace(ob, f_scale=f_scale, sigma_f=np.sqrt(form.plain**2 + form.shift**2), noise_f=form.measured), ds
 
 
 def set_noise(models, h, obs, state, freq_pct, shape_pct, levels: int, runner, support=()) -> list:

@@ -12,10 +12,9 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..correlation.mac import mac
+from ..correlation.mac import mac, paired_mac
 from ..problems.error_budget import richardson
 from ..updating.solvers import covariance
-from .residual import paired_mac
 from .fitting import estimate
 from .select import ALPHA, adopt, penalty, worth
 

@@ -26,7 +26,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..correlation.close_modes import align_close, close_groups
-from ..correlation.mac import mac
+from ..correlation.mac import paired_mac
 from ..correlation.pairing import pair_modes
 from ..fe.assembly import assemble
 from ..fe.modal import solve_modes
@@ -55,7 +55,9 @@ class Observation:
     frequencies, and shapes that the model gives as ``read @ u``, ``read`` (n_pts, n_dof) on the full
     DOFs); relative standard deviations ``sigma_f`` (m,) of the frequencies and ``sigma_s`` (m,) of a
     shape component (per RMS of the mode's measured shape); ``f_scale`` (m,): the factor that takes the
-    paired model frequency to its converged-mesh value (a discretisation correction; 1 by default).
+    paired model frequency to its converged-mesh value (a discretisation correction; 1 by default);
+    ``noise_f`` (m,): the measurement's share of ``sigma_f``, which tells close modes apart (None
+    until the noise is known: no modes are then close).
     Without shapes the modes pair by order. Never changed once made: a new error budget is a new
     observation (``dataclasses.replace``) in a new residual (:meth:`ModalResidual.on`)."""
 
@@ -65,6 +67,7 @@ class Observation:
     read: object = None
     sigma_s: np.ndarray | None = None
     f_scale: np.ndarray | None = None
+    noise_f: np.ndarray | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "sigma_f", np.asarray(self.sigma_f, float))
@@ -91,7 +94,8 @@ class Observation:
         """The observation of the measured modes ``keep`` (a boolean mask or indices)."""
         k = np.asarray(keep)
         return Observation(self.name, self.modes.subset(k), self.sigma_f[k], self.read,
-                           None if self.sigma_s is None else self.sigma_s[k], self.f_scale[k])
+                           None if self.sigma_s is None else self.sigma_s[k], self.f_scale[k],
+                           None if self.noise_f is None else self.noise_f[k])
 
     @property
     def n_rows(self) -> int:
@@ -204,7 +208,8 @@ def paired_state(ob: Observation, model, K, M, modes, U, points=None) -> ConfigS
             pairs[i] = k
             free.remove(k)
         u = U[:, pairs]
-        close = tuple(g for g in close_groups(ob.f, ob.sigma_f * ob.f) if matched[list(g)].all())
+        groups = [] if ob.noise_f is None else close_groups(ob.f, ob.noise_f * ob.f)
+        close = tuple(g for g in groups if matched[list(g)].all())
         x = align_close(ob.shapes, u, close)
         with np.errstate(divide="ignore", invalid="ignore"):  # a paired mode the points miss: rows not finite,
             s = np.sum(u * x, axis=0) / np.sum(u * u, axis=0)  # a state the fits refuse (.fitting)
@@ -216,11 +221,6 @@ def paired_state(ob: Observation, model, K, M, modes, U, points=None) -> ConfigS
     rms = np.sqrt(np.mean(x**2, axis=0))
     rows.append(((x - s * u) / (ob.sigma_s * rms)).T.ravel())
     return ConfigState(model, K, M, modes, pairs, matched, f_a, macs, u, s, np.concatenate(rows), points, x, close)
-
-
-def paired_mac(a, b) -> np.ndarray:
-    """MAC of column i of ``a`` with column i of ``b`` (thesis eq. 2.3)."""
-    return np.diagonal(mac(a, b)).copy()
 
 
 class ModalResidual:

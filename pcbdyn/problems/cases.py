@@ -9,7 +9,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from ..correlation.mac import mac
+from ..correlation.mac import paired_mac
 from ..domain import MAX_MODES, StructureError
 from ..fe.assembly import element_matrices, scatter
 from ..fe.generate import rectangle
@@ -203,7 +203,7 @@ class StructureCase(StudyCase):
         K, M, dKs, dMs = sysm.model(self.p_a)
         lam_a, Phi_a = pencil_modes(K, M, nr + int(n_modes))
         self.omega_x, self.phi_x = np.sqrt(lam_x[el]), np.asarray(P @ phi_full[:, el])
-        paired = np.diag(mac(np.asarray(P @ Phi_a[:, el]), self.phi_x))
+        paired = paired_mac(np.asarray(P @ Phi_a[:, el]), self.phi_x)
         if np.any(paired < 0.8):
             raise CaseError(f"truth: the true board's modes do not pair in order with the model's (MAC "
                              f"{np.round(paired, 2).tolist()}); use smaller errors or fewer modes (n_modes)")

@@ -14,7 +14,7 @@ from typing import Callable
 
 import numpy as np
 
-from ..correlation.mac import mac
+from ..correlation.mac import mac, paired_mac
 from . import equations as eq
 from . import matching
 from .errors import UpdatingError
@@ -144,7 +144,7 @@ def paired_state(cfg: Configuration, lam, Phi, pairing=None) -> dict:
            "lam_all": lam, "Phi_all": Phi, "phi_am": phi_am[:, ia], "sigma": frequency_residue(f_a[ia], f_x[used]),
            "max_err_pct": float(np.max(np.abs(1 - f_a[ia] / f_x[used])) * 100)}
     if cfg.phi_x is not None:
-        out["mac"] = np.diag(mac(phi_am[:, ia], np.asarray(cfg.phi_x)[:, used]))
+        out["mac"] = paired_mac(phi_am[:, ia], np.asarray(cfg.phi_x)[:, used])
     return out
 
 

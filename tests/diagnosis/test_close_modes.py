@@ -7,7 +7,8 @@ import pytest
 import scipy.sparse as sp
 
 from pcbdyn.correlation.close_modes import align_close, close_groups
-from pcbdyn.diagnosis.residual import ModalResidual, Observation, paired_mac
+from pcbdyn.correlation.mac import paired_mac
+from pcbdyn.diagnosis.residual import ModalResidual, Observation
 from pcbdyn.fe import MassProperty, Model, ShellProperty
 from pcbdyn.fe.assembly import assemble
 from pcbdyn.fe.generate import rectangle, rectangle_edges
@@ -67,7 +68,7 @@ def square():
     test = solve_modes(build([22e9], mass=2e-5), n_modes=N)
     read = model_probe(build([22e9]), xyz, zdir).P
     ob = Observation(None, measured(test.frequencies, np.asarray(read @ test.shapes), xyz, zdir),
-                     np.full(N, SIGMA_F), read, np.full(N, SIGMA_S))
+                     np.full(N, SIGMA_F), read, np.full(N, SIGMA_S), noise_f=np.full(N, SIGMA_F))
 
     def derivatives(p, models):  # the patch's modulus enters its stiffness linearly
         n = models[0].n_dof
