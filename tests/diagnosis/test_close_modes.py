@@ -15,7 +15,7 @@ from pcbdyn.fe.generate import rectangle, rectangle_edges
 from pcbdyn.fe.modal import solve_modes
 from pcbdyn.fe.probe import model_probe
 
-from diagnosis_plates import measured
+from diagnosis_plates import check_parameter_columns, measured
 
 A, B, N = 0.12, 0.1201, 4  # plate sides [m], 0.1 % apart; modes read
 SIGMA_F, SIGMA_S = 2e-3, 1e-2
@@ -98,12 +98,5 @@ def test_columns_match_resolves_across_a_close_pair(square):
     central differences of the aligned residual (the turn within the pair left to the alignment)."""
     res, ob, _ = square
     p = np.array([22e9 * 1.03])
-    st = res.evaluate(p)
-    assert st.configs[0].close == ((1, 2),)
-    a = res.param_columns(st)[:, 0]
-    h = 1e-5
-    fd = -(res.evaluate(p * np.exp(h)).r - res.evaluate(p * np.exp(-h)).r) / (2 * h)
-    assert np.allclose(a[:N], fd[:N], rtol=1e-4)
-    s, sf = a[N:], fd[N:]
-    assert s @ sf / (np.linalg.norm(s) * np.linalg.norm(sf)) > 0.99
-    assert np.linalg.norm(s) == pytest.approx(np.linalg.norm(sf), rel=0.05)
+    assert res.evaluate(p).configs[0].close == ((1, 2),)
+    check_parameter_columns(res, p, N)
