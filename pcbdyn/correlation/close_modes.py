@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .pairing import clusters
+
 #: measured modes whose frequencies differ by less than this many standard deviations of their
 #: difference form a close group (:func:`close_groups`)
 CLOSE_SIGMAS = 3.0
@@ -18,10 +20,7 @@ def close_groups(f, sd) -> list:
     the eigenvalue gap): the test determines their plane, not each shape within it. The noise, not a
     model's wider error budget: modes a few percent apart on a coarse mesh still differ in shape, and
     their turn is what a local effect shows first (a stiffener's, dev seeds 9 and 14)."""
-    f, sd = np.asarray(f, float), np.asarray(sd, float)
-    order = np.argsort(f)
-    apart = np.diff(f[order]) >= CLOSE_SIGMAS * np.hypot(sd[order][1:], sd[order][:-1])
-    return [tuple(int(i) for i in g) for g in np.split(order, np.flatnonzero(apart) + 1) if g.size > 1]
+    return [tuple(g) for g in clusters(f, CLOSE_SIGMAS, sd) if len(g) > 1]
 
 
 def align_close(x, u, groups) -> np.ndarray:

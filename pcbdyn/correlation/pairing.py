@@ -50,20 +50,21 @@ def subspace_mac(phi_x, Phi_a):
     return float(mac(x, A @ u)[0, 0]), u
 
 
-def clusters(f_a, rel_tol: float) -> list:
-    """Groups of model mode indices whose frequencies chain within ``rel_tol`` of each other."""
+def clusters(f_a, rel_tol: float, sd=None) -> list:
+    """Groups of mode indices whose frequencies chain within ``rel_tol`` of each other (relative), or,
+    given each frequency's standard deviation ``sd``, within ``rel_tol`` standard deviations of their
+    difference (:func:`.close_modes.close_groups`)."""
     f = np.asarray(f_a, dtype=float)
+    if not f.size:
+        return []
     order = np.argsort(f)
-    groups, cur = [], [int(order[0])] if f.size else []
-    for a, b in zip(order[:-1], order[1:]):
-        if abs(f[b] - f[a]) <= rel_tol * max(abs(f[a]), abs(f[b])):
-            cur.append(int(b))
-        else:
-            groups.append(cur)
-            cur = [int(b)]
-    if cur:
-        groups.append(cur)
-    return groups
+    fs = f[order]
+    if sd is None:
+        reach = rel_tol * np.maximum(np.abs(fs[1:]), np.abs(fs[:-1]))
+    else:
+        s = np.asarray(sd, dtype=float)[order]
+        reach = rel_tol * np.hypot(s[1:], s[:-1])
+    return [[int(i) for i in g] for g in np.split(order, np.flatnonzero(np.diff(fs) > reach) + 1)]
 
 
 def aliased(groups, auto, alias: float) -> list:

@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..updating.driver import at_bounds
 from ..units import from_si, printed_unit
+from ..updating.driver import at_bounds
 from .files import save_figure
 
 #: SI unit of the JSON values for the display units the input files use (others are SI already)
