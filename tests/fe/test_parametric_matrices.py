@@ -1,0 +1,55 @@
+"""K(p), M(p) and their derivatives without re-assembly (:mod:`pcbdyn.fe.parametric_matrices`), on the
+six-part card (four parameters: three part thicknesses, which enter the shell's bending stiffness
+as t^3, and the laminate's E, which enters linearly): the interpolated sets equal a model built at
+the same values, and their derivatives equal central differences of such builds."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from pcbdyn.board.board import load_board
+from pcbdyn.fe.assembly import assemble
+from pcbdyn.problems.models import StructureModels
+
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "six_part_card" / "board.toml"
+
+
+@pytest.fixture(scope="module")
+def models():
+    return StructureModels(load_board(EXAMPLE), [None], mesh_size=10e-3, shared_mesh=True)
+
+
+def relative(a, b) -> float:
+    return float(abs(a - b).max() / abs(b).max())
+
+
+def test_interpolated_equals_assembled(models):
+    """K and M of the interpolated sets equal a model built at the same values (t^3 is interpolated
+    exactly by the cubic grid), away from the declared values and at them."""
+    p0 = models.p0.copy()
+    p1 = p0 * np.array([1.31, 0.83, 1.12, 0.91])
+    pmx = models.parametric[0]
+    assert all(s.coef is not None for s in pmx.sets), "every set of the card is interpolated"
+    built0, built1 = (assemble(models.build(p)[0]) for p in (p0, p1))
+    for got, (k, m) in ((pmx.matrices(p0), built0), (pmx.matrices(p1), built1)):
+        assert relative(got[0], k) < 1e-8
+        assert relative(got[1], m) < 1e-8
+
+
+def test_derivatives_match_central_differences(models):
+    """dK/dp and dM/dp of each parameter (exact, from the interpolant) equal central differences of
+    models built at p +- h; M does not depend on E."""
+    p = models.p0 * np.array([1.2, 0.9, 1.05, 1.1])
+    d = models.parametric[0].derivatives(p)
+    for j in range(p.size):
+        h = 1e-4 * p[j]
+        up, down = p.copy(), p.copy()
+        up[j] += h
+        down[j] -= h
+        for got, a, b in zip(d[j], assemble(models.build(up)[0]), assemble(models.build(down)[0])):
+            fd = (a - b) / (2 * h)
+            # round-off of the differences: 1e-13 of the matrix over the step
+            assert abs(got - fd).max() <= 1e-5 * abs(fd).max() + 1e-13 * abs(a).max() / h, models.names[j]
