@@ -140,7 +140,9 @@ def configurations(problem, tests, method: str, f_pct: float, shape_pct: float, 
     mode_configurations`); frequencies weighted by :func:`frequency_sigma`, shapes by their noise. ``model``:
     the model's own errors (frequencies [%], signed; shapes, relative, or None), per test configuration and
     measured mode (:func:`.error_budget.model_errors`), in the noise and, with ``corrected``, taken out of
-    the measured frequencies. ``limit``: pairs further apart in frequency are left out (relative)."""
+    the measured frequencies. ``limit``: pairs further apart in frequency are left out (relative). Test modes
+    the frequency noise alone cannot tell apart are compared as a plane (``noise_f``: in the "modal" shape
+    rows and in every MAC reported)."""
     out = []
     f_model, s_model = model if model is not None else ([None] * len(tests), [None] * len(tests))
     for (k, c, m), e, es in zip(tests, f_model, s_model):
@@ -151,9 +153,11 @@ def configurations(problem, tests, method: str, f_pct: float, shape_pct: float, 
         elif method == "modal":
             rel = noise_sigma(shape_pct)
             out.append(problem.configuration(c, m, "modal", min_mac=min_mac, structure=k, sigma=sig, limit=limit,
-                                             shape_noise=rel if es is None else np.hypot(rel, es[0])))
+                                             shape_noise=rel if es is None else np.hypot(rel, es[0]),
+                                             noise_f=frequency_sigma(m, f_pct)))
         else:
-            out.append(problem.configuration(c, m, "freq", min_mac=min_mac, structure=k, sigma=sig, limit=limit))
+            out.append(problem.configuration(c, m, "freq", min_mac=min_mac, structure=k, sigma=sig, limit=limit,
+                                             noise_f=frequency_sigma(m, f_pct)))
     return out
 
 

@@ -21,8 +21,10 @@ def correlation_state(configs, p) -> list:
     """Per configuration at ``p``: the pairs (as in ``pcbdyn correlate``: test_mode, model_mode
     (1-based, elastic modes), f_test_hz, f_model_hz, df_pct, mac), the max |df| in percent (None for
     a configuration none of whose modes pairs; also when none of any configuration's pairs: a test of
-    another structure is reported, not refused) and the pairing's warnings (model modes the test grid
-    cannot tell apart, pairs beyond the frequency limit: reported, not used)."""
+    another structure is reported, not refused), the pairing's warnings (model modes the test grid
+    cannot tell apart, pairs beyond the frequency limit: reported, not used) and the groups of test modes
+    compared as a plane (``close_test_modes``, :mod:`pcbdyn.correlation.close_modes`; their MACs are
+    after the turn)."""
     states = paired_states(configs, p)
     out = []
     for cfg, st in zip(configs, states):
@@ -36,6 +38,8 @@ def correlation_state(configs, p) -> list:
         out.append({"configuration": cfg.name, "pairs": pairs,
                     "max_freq_error_pct": max(abs(q["df_pct"]) for q in pairs) if pairs else None,
                     "warnings": said() if said else []})
+        if st.get("close"):
+            out[-1]["close_test_modes"] = [[int(st["used"][a]) + 1 for a in g] for g in st["close"]]
     return out
 
 

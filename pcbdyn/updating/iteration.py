@@ -14,6 +14,7 @@ from typing import Callable
 
 import numpy as np
 
+from ..correlation.close_modes import align_close, close_groups
 from ..correlation.mac import mac, paired_mac
 from . import equations as eq
 from . import matching
@@ -46,6 +47,9 @@ class Configuration:
         frequency methods one per measured frequency [Hz]); None gives unit-length rows (eq. 4.42).
     shape_noise: "modal": the standard deviation of a measured shape component as a fraction of its
         size (uniform bound / sqrt 3, eq. 5.73), one for all modes or one per measured mode.
+    noise_f: the measurement's own standard deviation [Hz] of each measured frequency (the noise alone,
+        not the model's share of ``sigma``): measured modes it cannot tell apart are compared as a plane
+        (:mod:`pcbdyn.correlation.close_modes`: their MACs, and the "modal" shape rows); None: none are.
     n_modes: analytical modes computed for pairing (default max(2 m, m + 4) for m measured
         modes; count the rigid-body modes of a free model in).
     pairing: callable (f_a, phi_a_measured, f_x, phi_x) -> analytical mode index per measured mode,
@@ -71,6 +75,7 @@ class Configuration:
     pairing: Callable | None = None
     n_rigid: int = 0
     shape_noise: float | None = None
+    noise_f: np.ndarray | None = None
 
     @property
     def frf_hz(self) -> np.ndarray | None:
@@ -130,8 +135,9 @@ def paired_state(cfg: Configuration, lam, Phi, pairing=None) -> dict:
     """The measured modes of ``cfg`` paired among the computed eigenpairs (lam, Phi): "pairs" (analytical
     index per measured mode, -1 unpaired), "used" (the paired measured modes), their partners' "lam",
     "Phi", "f_a", "phi_am" (read at the measured DOFs), "mac", the frequency residue "sigma" and
-    "max_err_pct"; all computed modes as "lam_all", "Phi_all" with the partners' "index"; "set_aside"
-    when nothing pairs."""
+    "max_err_pct"; all computed modes as "lam_all", "Phi_all" with the partners' "index"; with measured
+    shapes, "x" (the paired measured shapes as compared, each group of close ones turned onto its
+    partners') and "close" (those groups, as positions in "used"); "set_aside" when nothing pairs."""
     f_x = np.asarray(cfg.f_x, float)
     f_a = frequencies_hz(lam)
     phi_am = Phi if cfg.P is None else np.asarray(cfg.P @ Phi)
@@ -144,8 +150,20 @@ def paired_state(cfg: Configuration, lam, Phi, pairing=None) -> dict:
            "lam_all": lam, "Phi_all": Phi, "phi_am": phi_am[:, ia], "sigma": frequency_residue(f_a[ia], f_x[used]),
            "max_err_pct": float(np.max(np.abs(1 - f_a[ia] / f_x[used])) * 100)}
     if cfg.phi_x is not None:
-        out["mac"] = paired_mac(phi_am[:, ia], np.asarray(cfg.phi_x)[:, used])
+        close = _close(cfg, used)
+        x = align_close(np.asarray(cfg.phi_x)[:, used], phi_am[:, ia], close)
+        out.update(x=x, close=close, mac=paired_mac(phi_am[:, ia], x))
     return out
+
+
+def _close(cfg: Configuration, used) -> tuple:
+    """The groups of close measured modes of ``cfg`` all of whose members are paired, as positions in
+    ``used``."""
+    if cfg.noise_f is None:
+        return ()
+    at = {int(k): a for a, k in enumerate(used)}
+    groups = close_groups(np.asarray(cfg.f_x, float), np.asarray(cfg.noise_f, float))
+    return tuple(tuple(at[k] for k in g) for g in groups if all(k in at for k in g))
 
 
 def _frequency_sigma(cfg, st) -> np.ndarray:
@@ -169,7 +187,7 @@ def objective_rows(cfg: Configuration, st) -> np.ndarray | None:
     rows = [(np.asarray(cfg.f_x, float)[used] - st["f_a"]) / _frequency_sigma(cfg, st)]
     if cfg.method == "modal":
         for a, k in enumerate(used):
-            d = np.asarray(cfg.phi_x, float)[:, k]
+            d = np.asarray(st["x"][:, a], float)
             rows.append(shape_residual(d, st["phi_am"][:, a], shape_sigma(d, _shape_noise(cfg, k))))
     return np.concatenate(rows)
 
@@ -191,10 +209,10 @@ def _modal_block(cfg: Configuration, st, p) -> eq.Block:
     A_f, b_f = eq.frequency_equations(st["lam"], st["Phi"], np.asarray(cfg.f_x, float)[used], dKs, dMs, p)
     lam = st["lam_all"]
     shift = 0.0 if cfg.n_rigid == 0 else 0.1 * float(lam[min(cfg.n_rigid, lam.size - 1)])
-    dphi = shape_derivatives(K, M, lam, st["Phi_all"], st["index"], dKs, dMs, shift)
+    dphi = shape_derivatives(K, M, lam, st["Phi_all"], st["index"], dKs, dMs, shift, st["close"])
     A, b = [A_f / sig[:, None]], [b_f / sig]
     for a, k in enumerate(used):
-        d = np.asarray(cfg.phi_x, float)[:, k]
+        d = np.asarray(st["x"][:, a], float)
         du = dphi[:, :, a].T if cfg.P is None else np.asarray(cfg.P @ dphi[:, :, a].T)
         A_s, b_s = shape_rows(d, st["phi_am"][:, a], du, shape_sigma(d, _shape_noise(cfg, k)), p)
         A.append(A_s)

@@ -32,12 +32,15 @@ def _solver(K, M, shift: float):
     return lambda B: np.linalg.solve(np.asarray(A), B)
 
 
-def shape_derivatives(K, M, lam, Phi, index, dKs, dMs, shift: float = 0.0) -> np.ndarray:
+def shape_derivatives(K, M, lam, Phi, index, dKs, dMs, shift: float = 0.0, close=()) -> np.ndarray:
     """d phi_i / d p_j (n_params, n_dof, m) of the modes ``index`` of the computed (lam, Phi) (mass
     normalised): the modal sum over Phi (:func:`.sensitivity.eigen_derivatives`, with the normalisation's
     -phi_i^T dM phi_i / 2 along phi_i, eq. 3.13) plus sum over the modes beyond Phi of
     phi_k phi_k^T G / (lambda_i - lambda_k) ~ -phi_k phi_k^T G / (lambda_k + shift), G = (dK - lambda_i dM)
-    phi_i. ``shift`` > 0 makes K + shift M regular for a free structure."""
+    phi_i. ``shift`` > 0 makes K + shift M regular for a free structure. ``close``: groups (positions in
+    ``index``) of modes compared as a plane: their turn within it (eqs. 3.8-3.12, the coupling over their
+    gap) is met by turning the measured shapes, so of a partner's coefficient only the part that keeps
+    mass-orthogonality, -phi_b^T dM phi_a / 2, is left."""
     index = np.asarray(index, int)
     lam = np.asarray(lam, float)
     n_par = len(dKs)
@@ -48,6 +51,10 @@ def shape_derivatives(K, M, lam, Phi, index, dKs, dMs, shift: float = 0.0) -> np
     _, C = eigen_derivatives(BK, BM, lam, index)
     for a, i in enumerate(index):
         C[:, i, a] = -0.5 * BM[:, i, a]
+    for g in close:
+        for a in g:
+            partners = index[[b for b in g if b != a]]
+            C[:, partners, a] = -0.5 * BM[:, partners, a]
     solve = _solver(K, M, shift)
     G = np.stack([np.asarray(dK @ phi) - np.asarray(dM @ phi) * lam[index][None, :] for dK, dM in zip(dKs, dMs)])
     G2 = np.moveaxis(G, 0, 1).reshape(Phi.shape[0], -1)  # (n_dof, n_par * m)
