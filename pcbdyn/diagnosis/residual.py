@@ -321,11 +321,7 @@ class ModalResidual:
         ``dU_static`` (n_pts, m, n_col): the shape derivatives' part from the modes beyond the basis."""
         modes = cs.modes
         nr = modes.n_rigid
-        dlam, C = eigen_derivatives(BK, BM, np.r_[np.zeros(nr), modes.omega2], nr + cs.pairs)  # (n_col, m)
-        for g in cs.close:  # a turn within a close group's plane is met by turning its measured shapes:
-            for i in g:  # of a partner's coefficient only the part that keeps mass-orthogonality is left
-                k = nr + cs.pairs[[j for j in g if j != i]]
-                C[:, k, i] = -0.5 * BM[:, k, i]
+        dlam, C = eigen_derivatives(BK, BM, np.r_[np.zeros(nr), modes.omega2], nr + cs.pairs, cs.close)  # (n_col, m)
         df = dlam * ob.f_scale**2 / (8.0 * np.pi**2 * cs.f_a)  # d(c f)/dp, f = f_a / c
         out = [(df / (ob.sigma_f * ob.f)).T]
         if cs.u is not None:

@@ -157,13 +157,10 @@ def paired_state(cfg: Configuration, lam, Phi, pairing=None) -> dict:
 
 
 def _close(cfg: Configuration, used) -> tuple:
-    """The groups of close measured modes of ``cfg`` all of whose members are paired, as positions in
-    ``used``."""
+    """The groups of close modes among the paired measured modes of ``cfg``, as positions in ``used``."""
     if cfg.noise_f is None:
         return ()
-    at = {int(k): a for a, k in enumerate(used)}
-    groups = close_groups(np.asarray(cfg.f_x, float), np.asarray(cfg.noise_f, float))
-    return tuple(tuple(at[k] for k in g) for g in groups if all(k in at for k in g))
+    return tuple(close_groups(np.asarray(cfg.f_x, float)[used], np.asarray(cfg.noise_f, float)[used]))
 
 
 def _frequency_sigma(cfg, st) -> np.ndarray:

@@ -55,7 +55,7 @@ def bilinear_forms(basis, shapes, dKs, dMs):
     return BK, BM
 
 
-def eigen_derivatives(BK, BM, lam_basis, index):
+def eigen_derivatives(BK, BM, lam_basis, index, close=()):
     """Eigenvalue derivatives and the modal-expansion coefficients of the eigenvector derivatives from
     bilinear forms over a basis of modes (:func:`bilinear_forms`; ``lam_basis`` their eigenvalues,
     ``index`` the basis position of each mode i whose derivatives are wanted):
@@ -65,6 +65,11 @@ def eigen_derivatives(BK, BM, lam_basis, index):
       another eigenvalue, 0 for k of the same (eqs. 3.8-3.12), (n_params, n_basis, m): d phi_i / dp_j is
       sum_k C_jki phi_k plus a multiple of phi_i (the mass normalisation's, eq. 3.13, added by the
       caller that needs it).
+
+    ``close``: groups (positions in ``index``) of modes compared with a test as a plane
+    (:mod:`pcbdyn.correlation.close_modes`): their turn within it (the coupling over their gap) is met by
+    turning the measured shapes, so between them C keeps only the part that keeps mass-orthogonality,
+    -phi_k^T dM_j phi_i / 2.
 
     One formula for updating and for the diagnosis's candidate effects (their forms come from
     element blocks instead of assembled dK, dM)."""
@@ -76,6 +81,10 @@ def eigen_derivatives(BK, BM, lam_basis, index):
     gap = lam[None, :] - lam_basis[:, None]
     same = np.abs(gap) <= 1e-9 * np.maximum(np.abs(lam)[None, :], 1.0)
     C = np.where(same[None], 0.0, B / np.where(same, 1.0, gap)[None])
+    for g in close:
+        for a in g:
+            partners = index[[b for b in g if b != a]]
+            C[:, partners, a] = -0.5 * BM[:, partners, a]
     return dlam, C
 
 

@@ -38,9 +38,7 @@ def shape_derivatives(K, M, lam, Phi, index, dKs, dMs, shift: float = 0.0, close
     -phi_i^T dM phi_i / 2 along phi_i, eq. 3.13) plus sum over the modes beyond Phi of
     phi_k phi_k^T G / (lambda_i - lambda_k) ~ -phi_k phi_k^T G / (lambda_k + shift), G = (dK - lambda_i dM)
     phi_i. ``shift`` > 0 makes K + shift M regular for a free structure. ``close``: groups (positions in
-    ``index``) of modes compared as a plane: their turn within it (eqs. 3.8-3.12, the coupling over their
-    gap) is met by turning the measured shapes, so of a partner's coefficient only the part that keeps
-    mass-orthogonality, -phi_b^T dM phi_a / 2, is left."""
+    ``index``) of modes compared as a plane (:func:`.sensitivity.eigen_derivatives`)."""
     index = np.asarray(index, int)
     lam = np.asarray(lam, float)
     n_par = len(dKs)
@@ -48,13 +46,9 @@ def shape_derivatives(K, M, lam, Phi, index, dKs, dMs, shift: float = 0.0, close
         return np.zeros((n_par, Phi.shape[0], index.size))
     phi = Phi[:, index]
     BK, BM = bilinear_forms(Phi, phi, dKs, dMs)
-    _, C = eigen_derivatives(BK, BM, lam, index)
+    _, C = eigen_derivatives(BK, BM, lam, index, close)
     for a, i in enumerate(index):
         C[:, i, a] = -0.5 * BM[:, i, a]
-    for g in close:
-        for a in g:
-            partners = index[[b for b in g if b != a]]
-            C[:, partners, a] = -0.5 * BM[:, partners, a]
     solve = _solver(K, M, shift)
     G = np.stack([np.asarray(dK @ phi) - np.asarray(dM @ phi) * lam[index][None, :] for dK, dM in zip(dKs, dMs)])
     G2 = np.moveaxis(G, 0, 1).reshape(Phi.shape[0], -1)  # (n_dof, n_par * m)
