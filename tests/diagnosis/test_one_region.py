@@ -10,7 +10,7 @@ from pcbdyn.diagnosis.moves import LocalMoves, rectangle
 from pcbdyn.diagnosis.one_region import as_one_region, starts
 from pcbdyn.diagnosis.region_stiffness import KIND
 from pcbdyn.diagnosis.residual import ModalResidual, Observation
-from pcbdyn.diagnosis.select import Selection, estimate, penalty
+from pcbdyn.diagnosis.select import Selection, estimate, penalty, refine
 from pcbdyn.fe.modal import solve_modes
 from pcbdyn.testdata import MeasuredModes
 
@@ -61,6 +61,25 @@ def test_a_region_between_two_grid_rectangles_becomes_one(card):
     assert np.abs(np.subtract(rectangle(cands[sel.chosen[0]]), truth)).max() < 0.5 * DX
     assert sel.values[0] == pytest.approx(-0.5, rel=0.05)
     assert sel.chi2[-1] < min(pair, 4 * N_MODES)
+
+
+def test_refine_narrows_a_region_from_both_sides_to_the_truth(card):
+    """A 4 x 4 element region 50 % softer, found over a rectangle twice as wide (one element more on each
+    side in x): the rectangle one element wider than the truth on both sides is a local minimum for
+    moves of one side (each raises chi^2), and the local search reaches the truth only by moving both
+    sides of an axis at once (:func:`pcbdyn.diagnosis.moves._rect_moves`): the truth's cells, the change
+    within 2 %, at the noise's chi^2."""
+    m, layout = card
+    truth = (3 * DX, 4 * DY, 7 * DX, 8 * DY)
+    res, cands, moves, sel = _pair_fitted(m, layout, [(truth, -0.5)], [(2 * DX, 4 * DY, 8 * DX, 8 * DY)], [-0.3])
+    one_side = [j for j in moves(sel.chosen[0])
+                if np.count_nonzero(np.abs(np.subtract(rectangle(cands[j]), rectangle(cands[sel.chosen[0]]))) > 1e-9) == 1]
+    assert len(one_side) == 8
+    assert min(estimate(res, sel.p, [cands[j]], sel.values, 8).chi2 for j in one_side) > sel.chi2[-1]
+    out = refine(res, cands, sel, moves, None)
+    assert np.abs(np.subtract(rectangle(cands[out.chosen[0]]), truth)).max() < 0.5 * DX
+    assert out.values[0] == pytest.approx(-0.5, rel=0.02)
+    assert out.chi2[-1] < 2 * N_MODES
 
 
 def test_two_overlapping_regions_stay_two(card):
