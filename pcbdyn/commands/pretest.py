@@ -48,7 +48,8 @@ def _quantities(text: str, unit: str, option: str) -> list:
 @click.option("--parameters", "names", default=None,
               help="parameters the configurations are designed for, comma-separated (default: all [[parameters]])")
 @click.option("--configurations", "n_configs", type=click.IntRange(0, 20), default=2, show_default=True,
-              help="perturbed configurations to design (0: none)")
+              help="perturbed configurations to design (0: none; the parameters' 1-sigma with the base test and "
+                   "the structure's own configurations is still given)")
 @click.option("--masses", default="5 g,10 g,20 g", show_default=True, help="added masses on offer")
 @click.option("--noise", default="f=0.2", show_default=True,
               help="frequency noise of the test in percent (uniform bounds, thesis eq. 5.72)")
@@ -108,8 +109,9 @@ def command(structure_toml, candidates_csv, spacing, n_sensors, directions, n_mo
         suspension = choose_suspension(model, cand, suspension_share) if model.free else None
         done(t0)
         designed, entries = None, []
-        if n_configs and params:
-            t0 = step(f"weighing {len(mass_set)} added masses at the candidate places for {n_configs} configurations")
+        if params and f_pct > 0:
+            t0 = step(f"weighing {len(mass_set)} added masses at the candidate places for {n_configs} configurations"
+                      if n_configs else "predicting the parameters' 1-sigma with the base test and the own configurations")
             designed = design_configurations(model, cand, mass_set, n_configs, f_pct, max_places,
                                              progress=lambda k, total: k % 20 == 0 and click.echo(
                                                  f"    {k} of {total} places", err=True))

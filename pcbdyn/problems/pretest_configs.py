@@ -70,7 +70,8 @@ def design_configurations(model: PretestModel, cand: Candidates, masses, k: int,
                           max_places: int | None = None, progress=None) -> Design:
     """Choose ``k`` configurations of one added mass each (module docstring). ``frequency_pct``: the stated
     frequency noise (uniform bounds, eq. 5.72: 1-sigma = pct / sqrt 3). ``progress(done, total)`` is
-    called as candidates are solved."""
+    called as candidates are solved. With ``k`` 0 nothing is weighed: the identifiability of the base test
+    and of the structure's own configurations (``after`` is then ``before``)."""
     if not model.names:
         raise StructureError(f"{model.structure.path.name}: no parameters to design configurations for; name "
                              "them with --parameters or declare [[parameters]]")
@@ -79,7 +80,7 @@ def design_configurations(model: PretestModel, cand: Candidates, masses, k: int,
     base = frequency_block(model.lam, model.phi, model, dKs, dMs, sigma)
     where = places(cand, max_places)
     blocks, which = [], []
-    for n, i in enumerate(where):
+    for n, i in enumerate(where if k else []):
         unit = model.point_mass(cand.xyz[i], 1.0)
         for m in masses:
             lam, phi = model.modes(extra_M=m * unit)
@@ -93,7 +94,7 @@ def design_configurations(model: PretestModel, cand: Candidates, masses, k: int,
         raise StructureError(f"{model.structure.path.name}: only {len({i for i, _ in which})} candidate places move "
                              f"a target mode by more than {NOT_TOLD:g} sigma of the frequency noise with the masses "
                              f"offered; offer heavier --masses, more places (--max-places), or fewer --configurations")
-    pick = design.d_optimal(base.T @ base, np.stack([A.T @ A for A in blocks]), k, [i for i, _ in which])
+    pick = design.d_optimal(base.T @ base, np.stack([A.T @ A for A in blocks]), k, [i for i, _ in which]) if k else []
     existing = None
     names = model.structure.configuration_names()
     if names:

@@ -85,15 +85,16 @@ def summary(data: dict) -> str:
                      f"up to {max(sp['suspension_hz']):.2f} Hz ({100 * sp['suspension_share_of_first_elastic']:.1f} % "
                      f"of the first elastic mode), elastic modes shifted <= {sp['elastic_shift_max_pct']:.3f} %")
     if "identifiability" in data:
-        idf = data["identifiability"]
+        idf, designed = data["identifiability"], bool(data["configurations"])
         lines.append("parameter      1-sigma [%]: base test" + ("   with own configs" if "existing" in idf else "")
-                     + "   with designed")
+                     + ("   with designed" if designed else ""))
         for name, before in idf["before"]["std_pct"].items():
             own = f"   {idf['existing']['std_pct'][name]:17.3g}" if "existing" in idf else ""
-            lines.append(f"  {name:<24} {before:10.3g}{own}   {idf['after']['std_pct'][name]:13.3g}")
+            after = f"   {idf['after']['std_pct'][name]:13.3g}" if designed else ""
+            lines.append(f"  {name:<24} {before:10.3g}{own}{after}")
         lines.append(f"  condition number          {idf['before']['condition']:10.3g}"
                      + (f"   {idf['existing']['condition']:17.3g}" if "existing" in idf else "")
-                     + f"   {idf['after']['condition']:13.3g}")
+                     + (f"   {idf['after']['condition']:13.3g}" if designed else ""))
         for c in data["configurations"]:
             m = c["masses"][0]
             lines.append(f"  [[configurations]] {c['name']}: {m['mass_kg'] * 1e3:g} g at "
@@ -173,7 +174,8 @@ def pretest_page(out: Path, toml_path, data: dict, written: list) -> Path:
         idf = data["identifiability"]
         rows = [{"parameter": n, "base test [%]": v, **({"with own configurations [%]": idf["existing"]["std_pct"][n]}
                                                          if "existing" in idf else {}),
-                 "with designed [%]": idf["after"]["std_pct"][n]} for n, v in idf["before"]["std_pct"].items()]
+                 **({"with designed [%]": idf["after"]["std_pct"][n]} if data["configurations"] else {})}
+                for n, v in idf["before"]["std_pct"].items()]
         page.table("Predicted 1-sigma of each parameter", pd.DataFrame(rows),
                    note="frequency equations with the stated noise, linear at the starting values")
     pngs = [out / n for n in written if n.endswith(".png")]
