@@ -165,13 +165,13 @@ def main() -> None:
           f"{F_PCT:g} % / {SHAPE_PCT:g} %, frequency updating (bounded)")
     print(f"{'configurations':<16} {'median |error| [%]':>19} {'mean |error| [%]':>17}")
     for label, ps in found.items():
-        err = np.abs(np.array(ps) / np.array(TRUE_T) - 1) * 100
+        err = np.abs(np.array(ps) / TRUE_T - 1) * 100
         print(f"{label:<16} {np.median(err):19.3f} {np.mean(err):17.3f}")
     where = "at 3.5 mm" if args.design_at == "declared" else "at the base test's thicknesses"
     print("\nper thickness: observed spread over the seeds (std; robust: 1.4826 x median absolute deviation) / "
           f"predicted 1-sigma {where} / at the truth [%]")
     for label, ps in found.items():
-        x = np.array(ps) / np.array(TRUE_T)
+        x = np.array(ps) / TRUE_T
         spread = np.std(x, axis=0, ddof=1) * 100
         robust = 1.4826 * np.median(np.abs(x - np.median(x, axis=0)), axis=0) * 100
         cells = [f"{n} {s:.3g} ({r:.3g}) / {predicted[label][n]:.3g} / {at_truth[label][n]:.3g}"

@@ -78,9 +78,9 @@ def design_configurations(model: PretestModel, cand: Candidates, masses, k: int,
     sigma = noise_sigma(frequency_pct)
     _, _, dKs, dMs = model.matrices()
     base = frequency_block(model.lam, model.phi, model, dKs, dMs, sigma)
-    where = places(cand, max_places)
+    where = places(cand, max_places) if k else np.zeros(0, dtype=np.int64)
     blocks, which = [], []
-    for n, i in enumerate(where if k else []):
+    for n, i in enumerate(where):
         unit = model.point_mass(cand.xyz[i], 1.0)
         for m in masses:
             lam, phi = model.modes(extra_M=m * unit)

@@ -2,13 +2,17 @@
 card of issue 41's configuration design (tests/problems/test_pretest_configs.py and
 benchmarks/bench_pretest_configs.py)."""
 
-import re
 from pathlib import Path
+
+import numpy as np
+import tomlkit
+
+from pcbdyn.board import load_board
 
 CARD = Path(__file__).resolve().parents[2] / "examples/six_part_card"
 NAMES = [f"t_U{i}" for i in range(1, 7)]
 #: the part thicknesses [m] of the card "tested" (the library's are 3.5 mm)
-TRUE_T = (4.2e-3, 3.0e-3, 4.0e-3, 2.9e-3, 3.9e-3, 4.4e-3)
+TRUE_T = np.array([4.2, 3.0, 4.0, 2.9, 3.9, 4.4]) * 1e-3
 
 
 def six_thickness_card(path: Path) -> Path:
@@ -22,12 +26,11 @@ def six_thickness_card(path: Path) -> Path:
 
 
 def with_thicknesses(card: Path, t, path: Path, mesh_size: str | None = None) -> Path:
-    """``card`` (parts at the library's thickness) with the parts' thicknesses ``t`` [m], and ``mesh_size``
-    where given, written to ``path``."""
-    text = card.read_text()
+    """``card`` (with the parameters :data:`NAMES`) with the parts' thicknesses ``t`` [m] written into their
+    targets as ``pcbdyn update`` writes them, and ``mesh_size`` where given, to ``path``."""
+    load_board(card).write_updated(dict(zip(NAMES, t)), path, source="the test's truth")
     if mesh_size is not None:
-        text = re.sub(r'mesh_size = ".*"', f'mesh_size = "{mesh_size}"', text)
-    for i, ti in enumerate(t):
-        text = text.replace(f'ref = "U{i + 1}"\n', f'ref = "U{i + 1}"\nthickness = "{ti * 1e3:.6g} mm"\n')
-    path.write_text(text)
+        doc = tomlkit.parse(path.read_text())
+        doc["board"]["mesh_size"] = mesh_size
+        path.write_text(tomlkit.dumps(doc))
     return path

@@ -73,8 +73,7 @@ def test_designed_configurations_recover_the_thicknesses_better_than_the_base_te
     0.2 % / 2 % noise at the 81 points, three seeds, frequency updating from 3.5 mm: the median error of the
     six thicknesses with the designed configurations is under half that of the base test alone."""
     _, _, _, path = designed
-    true_t = np.array(TRUE_T)
-    truth = load_board(with_thicknesses(path, true_t, tmp_path / "truth.toml"))
+    truth = load_board(with_thicknesses(path, TRUE_T, tmp_path / "truth.toml"))
     prob = UpdateProblem(load_board(path), NAMES)
     points, dofs = read_points_csv(CARD / "points.csv")
     solved = {c: (bm, solve_modes(bm.model, n_modes=7)) for c in (None, "pretest1", "pretest2")
@@ -86,7 +85,7 @@ def test_designed_configurations_recover_the_thicknesses_better_than_the_base_te
         for configs in ([None], [None, "pretest1", "pretest2"]):
             cfgs = [prob.configuration(c, meas[c], "freq", sigma=SIGMA * meas[c].frequencies) for c in configs]
             res, _, _ = run(prob, cfgs, "bounded", max_iter=30, tol_freq_pct=1e-3, tol_param_pct=1e-3)
-            errors[len(configs)].append(np.abs(res.p / true_t - 1))
+            errors[len(configs)].append(np.abs(res.p / TRUE_T - 1))
     base, with_designed = np.median(errors[1]), np.median(errors[3])
     print(f"median |error|: base test {100 * base:.2f} %, with the designed configurations {100 * with_designed:.2f} %")
     assert with_designed < 0.5 * base and with_designed < 0.015
