@@ -149,7 +149,7 @@ def main(argv=None):
     unseen = [r for r in rows if r[0]["case"]["seed"] not in SEEN]
     s = summary(rows)
     _print(s)
-    if len(unseen) < len(rows):
+    if 0 < len(unseen) < len(rows):
         print(f"without the report seeds read case by case ({', '.join(map(str, sorted(SEEN)))}: SEEN):")
         _print(summary(unseen))
     if a.json:
