@@ -64,16 +64,17 @@ def _segment_gap(s, t) -> float:
     return min([_to_segment(p, t) for p in s] + [_to_segment(p, s) for p in t])
 
 
-def groups(chosen, reach: float) -> list:
-    """Groups of chosen effects linked (:func:`linked`) directly or through others, reported as one."""
+def groups(chosen, reach: float, link=linked) -> list:
+    """Groups of chosen effects linked (``link(a, b, reach)``, by default :func:`linked`: reported as
+    one) directly or through others."""
     from scipy.sparse.csgraph import connected_components
 
     n = len(chosen)
-    link = np.eye(n, dtype=bool)
+    joined = np.eye(n, dtype=bool)
     for a in range(n):
         for b in range(a + 1, n):
-            link[a, b] = link[b, a] = linked(chosen[a], chosen[b], reach)
-    _, label = connected_components(link, directed=False)
+            joined[a, b] = joined[b, a] = link(chosen[a], chosen[b], reach)
+    _, label = connected_components(joined, directed=False)
     return [np.flatnonzero(label == g).tolist() for g in dict.fromkeys(label.tolist())]
 
 

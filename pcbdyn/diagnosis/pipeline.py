@@ -297,7 +297,7 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
             "and where masses sit")
         sel = refine(res, cands, sel, moves, models.bounds, alpha=alpha, runner=runner)
     if sum(cands[i].kind in REGION_KINDS for i in sel.chosen) > 1:
-        say("fitting overlapping regions found as one region")
+        say("fitting overlapping or side-by-side regions found as one region")
         sel = as_one_region(res, cands, sel, moves, MERGE_REACH * h, models.bounds, alpha=alpha, runner=runner)
     if {"point_mass", "point_inertia"} <= {cands[i].kind for i in sel.chosen}:
         say("fitting a part found as a mass with an inertia beside it as one body")
