@@ -25,6 +25,9 @@ plugin module of this package that registers an object (:func:`register`, into :
   pin or a clamp (a support), so that the search screens more of its candidates at large magnitudes
   (:func:`.scan.saturated`; its optional ``saturated_values`` (multiples of ``scale``) and
   ``saturated_screen`` (how many) replace the screen's defaults);
+- ``moved_value(old, new, value) -> float`` (optional; the same value by default): the magnitude a
+  trial of candidate ``new`` in place of ``old`` at ``value`` starts from, a step of the local search
+  (:func:`.select.refine`): a region's stiffness change keeps its integral over the board;
 - ``coarse`` (optional, False by default): True when the kind's candidates lie on a grid coarser than
   the mesh (a region's patches of 20 and 40 mm), so that an addition the held-out folds refuse may be
   a real effect the grid misplaces: the search walks it before refusing it (:func:`.select.search`).

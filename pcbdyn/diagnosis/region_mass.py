@@ -32,6 +32,11 @@ class _RegionMass(SpreadMass, _RegionStiffness):
         return super().generate(layout, patch) if layout.planar else []
 
     @staticmethod
+    def moved_value(old, new, value: float) -> float:
+        """A mass moved to another region (a step of the local search) starts at the same mass."""
+        return value
+
+    @staticmethod
     def weights(model, candidate) -> np.ndarray:
         """The share of the mass at each of ``candidate.nodes`` (sum 1)."""
         return area_weights(model.nodes[:, :2], list(candidate.data["cells"].values()), candidate.nodes)

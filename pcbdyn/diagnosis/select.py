@@ -275,8 +275,8 @@ def refine(res, candidates, sel: Selection, neighbours, bounds=None, newton_step
         swaps = [idx[:k] + [j] + idx[k + 1:] for k, i in enumerate(idx) if k not in halves
                  for j in neighbours(i) if j not in idx]
         swaps += body_moves(candidates, idx, found, neighbours)
-        trials = rank(res, fit.state, [([candidates[t] for t in sw], fit.values) for sw in swaps], fit.p, bounds, P,
-                      runner)
+        trials = rank(res, fit.state, [([candidates[t] for t in sw], moved_values(candidates, idx, sw, fit.values))
+                                       for sw in swaps], fit.p, bounds, P, runner)
         for trial_idx, trial in zip(swaps, trials):
             if trial is not None and trial.chi2 < (fit.chi2 if best is None else best[1].chi2) * (1 - 1e-6):
                 best = (trial_idx, trial)
@@ -287,6 +287,17 @@ def refine(res, candidates, sel: Selection, neighbours, bounds=None, newton_step
     if idx == list(sel.chosen):
         return sel
     return adopt(sel, *_prune(res, candidates, idx, fit, newton_steps, bounds, pen, n_par, runner), pen)
+
+
+def moved_values(candidates, idx, swap, values) -> np.ndarray:
+    """The magnitudes a swap of the effects ``idx`` for ``swap`` starts from: ``values``, each effect
+    that moved at its kind's ``moved_value`` (:mod:`.catalogue`) where it has one."""
+    out = np.array(values, float)
+    for k, (i, j) in enumerate(zip(idx, swap)):
+        move = getattr(candidates[j].spec, "moved_value", None)
+        if i != j and move is not None:
+            out[k] = move(candidates[i], candidates[j], out[k])
+    return out
 
 
 def worth(chi2_before, chi2_after, n, k, pen) -> bool:

@@ -1,5 +1,6 @@
 """A region found as two overlapping or side-by-side rectangles refitted as one
-(:mod:`pcbdyn.diagnosis.one_region`), and two regions that are two left as they are. The card of
+(:mod:`pcbdyn.diagnosis.one_region`), two regions that are two left as they are, and a region walked to
+its extent by the local search (:func:`pcbdyn.diagnosis.select.refine`). The card of
 :func:`diagnosis_plates.guided_card` (13.3 x 12.9 mm elements), frequencies with 0.2 % noise."""
 
 import numpy as np
@@ -111,6 +112,33 @@ def test_refine_narrows_a_region_from_both_sides_to_the_truth(card):
     assert np.abs(np.subtract(rectangle(cands[out.chosen[0]]), truth)).max() < 0.5 * DX
     assert out.values[0] == pytest.approx(-0.5, rel=0.02)
     assert out.chi2[-1] < 2 * N_MODES
+
+
+def test_a_stiffening_found_too_small_grows_to_the_truth(card):
+    """A 4 x 4 element region 1.3 stiffer, found first over its middle 2 x 2 elements (where it fits at a
+    change of about 4): each step of the local search starts the change at the one that keeps its
+    integral over the board (``moved_value``), so that the growing region is not left far too stiff,
+    and the search reaches the truth's cells, the change within 2 %, at the noise's chi^2. Started at
+    the change held, the search had stopped over 2 x 4 elements at 4.3, chi^2 66."""
+    m, layout = card
+    truth = (3 * DX, 4 * DY, 7 * DX, 8 * DY)
+    res, cands, moves, sel = _pair_fitted(m, layout, [(truth, 1.3)], [(4 * DX, 5 * DY, 6 * DX, 7 * DY)], [0.5])
+    out = refine(res, cands, sel, moves, None)
+    assert np.abs(np.subtract(rectangle(cands[out.chosen[0]]), truth)).max() < 0.5 * DX
+    assert out.values[0] == pytest.approx(1.3, rel=0.02)
+    assert out.chi2[-1] < 2 * N_MODES
+
+
+def test_a_moved_region_starts_at_the_same_integral(card):
+    """A stiffness change moved to a region of twice the cells' area starts at half the change; a mass
+    moved keeps its mass."""
+    _, layout = card
+    a = KIND.rectangle(layout, 2 * DX, 2 * DY, 4 * DX, 4 * DY)
+    b = KIND.rectangle(layout, 2 * DX, 2 * DY, 6 * DX, 4 * DY)
+    assert b.data["area"] == pytest.approx(2 * a.data["area"], rel=1e-9)
+    assert a.data["area"] == pytest.approx(4 * DX * DY, rel=1e-9)
+    assert KIND.moved_value(a, b, 0.8) == pytest.approx(0.4)
+    assert dg.KINDS["region_mass"].moved_value(a, b, 0.01) == 0.01
 
 
 def test_two_overlapping_regions_stay_two(card):
