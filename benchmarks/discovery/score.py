@@ -50,7 +50,11 @@ def atoms(case: dict, E_board: float) -> list:
 
 def judged_as(r: dict) -> str:
     """The atom type a reported effect is judged as: a mass spread over a region (``region_mass``) is a
-    mass at its place, judged as a ``point_mass`` (its distance: 0 where its polygon holds the atom)."""
+    mass at its place, judged as a ``point_mass`` (its distance: 0 where its polygon holds the atom); a
+    ``point_mass`` whose parameter is its rotary inertia [kg m^2] is not a mass (no drawn effect has
+    one): ``point_inertia``, which matches no atom (dev seed 22 reports one alone)."""
+    if r.get("type") == "point_mass" and r.get("parameter") == "inertia":
+        return "point_inertia"
     return "point_mass" if r.get("type") == "region_mass" else r.get("type")
 
 

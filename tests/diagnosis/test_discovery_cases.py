@@ -63,3 +63,20 @@ def test_coverage_is_judged_on_the_reported_intervals():
     assert [_covered(r, t, 1.0) for t in (7.9, 8.1, 10.9, 11.1)] == [False, True, True, False]
     assert _covered({"magnitude": 10.0, "interval_2sigma": [6.0, None]}, 1e9, 1.0)
     assert [_covered({"magnitude": 10.0, "uncertainty": 1.0}, t, 1.0) for t in (8.9, 10.9)] == [False, True]
+
+
+def test_a_rotary_inertia_is_not_judged_as_a_mass():
+    """A point mass's rotary inertia reported at a drawn point mass's place (kg m^2, not kg) neither
+    finds that mass nor stands in for it: the mass reported beside it does, and the inertia is invented
+    only where no atom of its type exists."""
+    from score import judge
+
+    case = {"effects": [{"kind": "point_mass", "at": [50.0, 40.0], "mass": 0.01}], "parameters": [], "E": 2e10}
+    truth = {"case": case, "signal_chi2": [1e4]}
+    inertia = {"type": "point_mass", "parameter": "inertia", "at_mm": [50.0, 40.0], "magnitude": 2e-7}
+    mass = {"type": "point_mass", "parameter": "mass", "at_mm": [51.0, 40.0], "magnitude": 0.0105}
+    both = judge(truth, {"effects": [inertia, mass]}, 100.0)
+    assert both["atoms"][0]["found"] and both["atoms"][0]["reported"] == 0.0105
+    assert both["invented"] == [("point_mass", [50.0, 40.0])]
+    alone = judge(truth, {"effects": [inertia]}, 100.0)
+    assert not alone["atoms"][0]["placed"]
