@@ -12,7 +12,7 @@ import shapely
 
 from ..fe.probe import segment_parameter
 from .catalogue import kind, weighted_centre
-from .moves import REGION_KINDS, rectangle
+from .moves import REGION_KINDS, overlap, rectangle
 from .uncertainty import interval, jackknife_cov, parts, place_cov, profile_interval
 
 #: kinds that act at one node: an effect between nodes is shared by its neighbours
@@ -32,7 +32,7 @@ def linked(a, b, reach: float) -> bool:
     if a.kind == b.kind and a.kind in POINT_KINDS:
         return math.dist(a.at, b.at) <= reach
     if a.kind == b.kind and a.kind in REGION_KINDS and None not in (ra := rectangle(a), rb := rectangle(b)):
-        return min(ra[2], rb[2]) > max(ra[0], rb[0]) and min(ra[3], rb[3]) > max(ra[1], rb[1])  # they overlap
+        return min(overlap(ra, rb)) > 0.0
     if a.kind == b.kind == "stiffener":
         da, db = (np.diff(np.asarray(c.geometry["path"], float)[[0, -1]], axis=0)[0] for c in (a, b))
         parallel = abs(da[0] * db[1] - da[1] * db[0]) <= 1e-6 * np.linalg.norm(da) * np.linalg.norm(db)

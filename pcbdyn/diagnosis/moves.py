@@ -60,6 +60,12 @@ def rectangle(cand):
     return (*lo, *hi) if len(poly) == 4 and on_box else None
 
 
+def overlap(ra, rb) -> list:
+    """[m] how far the rectangles ``ra`` and ``rb`` (x0, y0, x1, y1) overlap along x and along y (< 0:
+    the gap between them)."""
+    return [min(ra[k + 2], rb[k + 2]) - max(ra[k], rb[k]) for k in (0, 1)]
+
+
 class LocalMoves:
     """neighbours(i) for :func:`.select.refine`: for a run of pieces of a side, the runs of the
     same kind and side that start and end at most one piece from its own; for a stiffener, its line

@@ -16,7 +16,7 @@ import numpy as np
 import shapely
 
 from .merge import groups, linked
-from .moves import REGION_KINDS, rectangle
+from .moves import REGION_KINDS, overlap, rectangle
 from .fitting import estimate
 from .select import ALPHA, Selection, adopt, penalty, refine
 
@@ -68,7 +68,7 @@ def side_by_side(a, b) -> bool:
     beside one of 1.4)."""
     if a.kind != b.kind or a.kind not in REGION_KINDS or None in (ra := rectangle(a), rb := rectangle(b)):
         return False
-    common = [min(ra[k + 2], rb[k + 2]) - max(ra[k], rb[k]) for k in (0, 1)]  # [m] their overlap along x, y
+    common = overlap(ra, rb)
     return min(common) >= -TOUCH and max(common) > TOUCH
 
 
