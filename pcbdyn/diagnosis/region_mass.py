@@ -33,7 +33,8 @@ class _RegionMass(SpreadMass, _RegionStiffness):
 
     @staticmethod
     def moved_value(old, new, value: float) -> float:
-        """A mass moved to another region (a step of the local search) starts at the same mass."""
+        """A mass moved to another region (a step of the local search) starts at the same mass (the
+        catalogue's default, restated: the stiffness change this kind inherits from scales by area)."""
         return value
 
     @staticmethod
