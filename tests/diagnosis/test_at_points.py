@@ -48,3 +48,25 @@ def test_an_effect_found_on_a_node_is_placed_at_its_point(card, kind, value, xy)
     assert np.linalg.norm(np.subtract(placed.at[:2], xy)) < 0.002
     assert sel.values[0] == pytest.approx(value, rel=0.03)
     assert sel.chi2[-1] < fit.chi2
+
+
+def test_springs_on_a_node_on_an_edge_and_in_a_cell_are_derived_together_as_alone(card):
+    """Springs to ground at a node, at a point on a cell's edge (two nodes) and inside a cell (four)
+    asked for at once (as the evidence map asks for every spring the walks made): each one's dK/dk is
+    the one it has alone, and a unit force at the point is shared by the nodes' weights (they sum to 1)."""
+    from pcbdyn.diagnosis.catalogue import derivatives
+
+    m, layout = card
+    on_node = dg.generate(layout, kinds=["ground_spring"])[40]
+    x, y = on_node.at[:2]
+    dx, dy = 0.16 / 12, 0.18 / 14
+    made = [on_node] + [spec("ground_spring").at_point(layout, on_node, p) for p in ((x + dx / 3, y), (x + dx / 3, y + dy / 4))]
+    assert [c.nodes.size for c in made] == [1, 2, 4]
+    together = dg.KINDS["ground_spring"].blocks(m, made)
+    assert sorted(b.conn.shape[1] for b in together) == [1, 2, 4]
+    for b in together:
+        for row, k in enumerate(b.owner):
+            K, _ = derivatives(m, made[k])
+            dofs = (6 * b.conn[row][:, None] + np.arange(6)).ravel()
+            assert np.allclose(K[np.ix_(dofs, dofs)].toarray(), b.Ke[row])
+    assert sum(made[2].data["point_weights"]) == pytest.approx(1.0)
