@@ -13,7 +13,7 @@ import shapely
 from ..fe.probe import segment_parameter
 from .catalogue import kind, weighted_centre
 from .moves import REGION_KINDS, overlap, rectangle
-from .uncertainty import interval, jackknife_cov, parts, place_cov, profile_interval
+from .uncertainty import interval, jackknife_cov, parts, place_cov, place_range, profile_interval
 
 #: kinds that act at one node: an effect between nodes is shared by its neighbours
 POINT_KINDS = ("point_mass", "point_inertia", "ground_spring")
@@ -78,14 +78,15 @@ def groups(chosen, reach: float, link=linked) -> list:
     return [np.flatnonzero(label == g).tolist() for g in dict.fromkeys(label.tolist())]
 
 
-def merged(chosen, values, cov, cov_jack, cov_place, group, profile=None) -> dict:
+def merged(chosen, values, cov, cov_jack, cov_place, group, profile=None, places=None) -> dict:
     """One effect entry (JSON-ready) for a group: the magnitudes summed at their weighted centre (on
     line masses: the place and extent of the largest; parallel stiffeners: their weighted mean
     path; overlapping regions: the mean stiffness change over the area they cover, their union, which
     keeps the change's integral over the board, or their masses summed over it), the uncertainty of
     that combination from the fit's covariance ``cov``, the jackknife's ``cov_jack``, what the places
     leave open ``cov_place`` and the model-form budget (:func:`.uncertainty.parts`), and its 2-sigma
-    interval (:func:`.uncertainty.interval`; ``profile``: the chi^2 profile's of a group of one)."""
+    interval (:func:`.uncertainty.interval`; ``profile``: the chi^2 profile's of a group of one; ``places``:
+    its magnitudes over the places the data do not tell apart, :func:`.uncertainty.place_range`)."""
     lines = [k for k in group if chosen[k].kind == "line_mass"]
     c = chosen[max(lines, key=lambda k: values[k]) if lines else group[0]]
     d = c.describe()
@@ -109,7 +110,7 @@ def merged(chosen, values, cov, cov_jack, cov_place, group, profile=None) -> dic
         d["mass_kg"] = float(sum(chosen[k].spec.mass(chosen[k], values[k]) for k in group))
         d["section_height_mm"] = round(1e3 * c.spec.section_of(c).h, 4)
     sub = np.ix_(group, group)
-    u = parts(float(w @ v), w, cov[sub] if cov.size else cov, cov_jack[sub], cov_place[sub])
+    u = parts(float(w @ v), w, cov[sub] if cov.size else cov, cov_jack[sub], cov_place[sub], places)
     d["interval_2sigma"] = interval(float(w @ v), u, profile, c.spec.lower)
     d.update(magnitude=float(w @ v), uncertainty=u.pop("total"), uncertainty_parts=u, kind=c.kind)
     return d
@@ -118,8 +119,9 @@ def merged(chosen, values, cov, cov_jack, cov_place, group, profile=None) -> dic
 def reported(res, sel, chosen, neighbours, reach: float, bounds=None) -> list:
     """The effects entries (JSON-ready) of the selection ``sel`` of effects ``chosen``: shares within
     ``reach`` [m] as one (:func:`groups`, :func:`merged`), each with its uncertainty (:mod:`.uncertainty`:
-    the fit's covariance, the jackknife over the folds, what the places leave open, ``neighbours(j)``
-    giving effect j's places one step away) and its 2-sigma interval, from the chi^2 profile where one
+    the fit's covariance, the jackknife over the folds, what the places leave open, ``neighbours(c)``
+    giving candidate c's places one step away, and for an effect alone the profile over its places,
+    :func:`.uncertainty.place_range`) and its 2-sigma interval, from the chi^2 profile where one
     effect alone is of a kind that saturates (:func:`.uncertainty.profile_interval`)."""
     scale = np.array([c.spec.scale for c in chosen])
     cov_jack = jackknife_cov(res, sel.state, chosen, scale)
@@ -127,9 +129,11 @@ def reported(res, sel, chosen, neighbours, reach: float, bounds=None) -> list:
     out = []
     for g in groups(chosen, reach):
         spec = kind(chosen[g[0]].kind)
-        alone = len(g) == 1 and getattr(spec, "saturates", False) and getattr(spec, "reanalysed", True)
-        profile = profile_interval(res, sel.state, chosen, g[0], bounds) if alone and sel.values[g[0]] > 0 else None
-        out.append(merged(chosen, sel.values, sel.cov, cov_jack, cov_place, g, profile))
+        alone = len(g) == 1 and getattr(spec, "reanalysed", True)
+        saturates = alone and getattr(spec, "saturates", False) and sel.values[g[0]] > 0
+        profile = profile_interval(res, sel.state, chosen, g[0], bounds) if saturates else None
+        places = place_range(res, sel.state, chosen, g[0], neighbours, bounds) if alone else None
+        out.append(merged(chosen, sel.values, sel.cov, cov_jack, cov_place, g, profile, places))
     return out
 
 

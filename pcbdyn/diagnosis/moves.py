@@ -118,6 +118,14 @@ class LocalMoves:
         made = kind(name).rectangle(self.layout, *box)
         return None if made is None else self._add([made])[0]
 
+    def around(self, c) -> list:
+        """The candidates one step from candidate ``c`` (``self(k)`` for its index, found by its name; one
+        made since, by a later stage, is taken in)."""
+        if c.name not in self.index:
+            self.index.update({d.name: k for k, d in enumerate(self.cands) if d.name not in self.index})
+        k = self.index[c.name] if c.name in self.index else self._add([c])[0]
+        return [self.cands[i] for i in self(k)]
+
     def __call__(self, k) -> list:
         c = self.cands[k]
         if "run" in c.data:

@@ -32,7 +32,8 @@ whether what remains is noise, and otherwise find, place and size the effects th
    they change the shapes it depends on); where stiffeners were found, the structure is meshed along
    their lines first, every effect carried, and the ribs' ends and sections fitted there
    (:func:`_on_lines`, :mod:`.conforming`, :mod:`.geometry_fit`). Last, the plate theory's share is
-   fitted with the effects found (:func:`.model_form.fit_plate_share`; kept only where significant).
+   fitted with the effects found (:func:`.model_form.fit_plate_share`; kept only where significant), and
+   the effects walked again in the residual it leaves (its noise units differ from the search's).
 """
 
 from __future__ import annotations
@@ -329,6 +330,10 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
     sel, theta, theta_sigma, res = fit_plate_share(res, cands, sel, [f.shift for f in forms], [f.plain for f in forms],
                                               models.bounds, alpha=alpha)
     stats.update(plate_theory_share=theta, plate_theory_share_sigma=theta_sigma)
+    near = moves if lined is None else LocalMoves(from_structure(models.models[0]), cands, h)
+    if any(movable(cands[i]) for i in sel.chosen):  # the residual's weights have changed since the walk
+        say("walking the effects' places again with the plate theory's share fitted")
+        sel = refine(res, cands, sel, near, models.bounds, alpha=alpha, runner=runner)
     if sel.chosen:
         say("checking that the data notice each effect's removal")
         found = len(sel.chosen)
@@ -338,9 +343,7 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
     for n, v in zip(names, sel.p):
         out["parameters"][n]["final"] = float(v)
     chosen = [cands[i] for i in sel.chosen]
-    near = moves if lined is None else LocalMoves(from_structure(models.models[0]), cands, h)
-    effects = reported(res, sel, chosen, lambda j: [cands[i] for i in near(sel.chosen[j])], MERGE_REACH * h,
-                       models.bounds)
+    effects = reported(res, sel, chosen, near.around, MERGE_REACH * h, models.bounds)
     if effects:
         msg = f"{len(effects)} effect(s) the model lacks: " + "; ".join(
             f"{e['type']} ({e['parameter']}) at {e['at_mm']} mm" for e in effects)

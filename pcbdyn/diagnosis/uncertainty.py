@@ -28,6 +28,7 @@ from ..updating.solvers import covariance
 from .fitting import RANK_STEPS, UPPER, estimate
 from .held_out import fit_without, folds
 from .reanalysis import Reanalysis
+from .select import moved_values
 
 #: the model-form budget: one standard deviation as a share of the magnitude, for every reported type.
 #: Calibrated with ``benchmarks/bench_coverage.py --calibrate`` on the bench and hold-out cases other
@@ -40,6 +41,8 @@ MODEL_FORM = 0.07
 TWO_SIGMA_RISE = 4.0
 #: a profile holds the magnitude at the fitted one times sqrt 2 per step, at most this many steps each way
 PROFILE_STEPS = 12
+#: a profile over places (:func:`place_range`) tries at most this many places of an effect
+PLACE_WALK = 60
 
 
 def jackknife_cov(res, state, effects, scale) -> np.ndarray:
@@ -63,8 +66,8 @@ def place_cov(res, state, effects, scale, neighbours) -> np.ndarray:
     """Covariance (k, k) [SI] that the places of ``effects`` (fitted at ``state``; ``scale``: their
     columns' scales) add to their magnitudes (module doc): the magnitudes' covariance
     (:func:`pcbdyn.updating.solvers.covariance`) with a column per move of an effect to each of
-    ``neighbours(j)`` (candidates one step of the local search from effect j: the residual's change at
-    the same magnitudes, on the reanalysis of ``state``) less that without them. Zeros where no
+    ``neighbours(c)`` (candidates one step of the local search from candidate c: the residual's change
+    at the same magnitudes, on the reanalysis of ``state``) less that without them. Zeros where no
     effect moves."""
     k = len(effects)
     if k == 0:
@@ -74,7 +77,7 @@ def place_cov(res, state, effects, scale, neighbours) -> np.ndarray:
     G = []
     for j in range(k):
         try:
-            moved = neighbours(j)
+            moved = neighbours(effects[j])
         except ValueError:  # no place beside it on this mesh (a model error, a probe off the shell)
             continue
         for n in moved:
@@ -92,11 +95,58 @@ def place_cov(res, state, effects, scale, neighbours) -> np.ndarray:
     return np.outer(scale, scale) * grown
 
 
-def parts(magnitude: float, w: np.ndarray, cov: np.ndarray, cov_jack: np.ndarray, cov_place: np.ndarray) -> dict:
+def place_range(res, state, effects, j: int, neighbours, bounds=None) -> tuple:
+    """(lo, hi) [SI]: the magnitudes of ``effects[j]`` (fitted at ``state``) over the places the data do
+    not tell from its own, a profile over places: from it, step by step (``neighbours(c)``: the
+    candidates one step of the local search from candidate c), every place where the magnitudes and the
+    declared parameters refitted (quick fits on the reanalysis of ``state``, started as the search starts
+    a move, :func:`.select.moved_values`) leave chi^2 within the 2-sigma rise (:data:`TWO_SIGMA_RISE`, as
+    :func:`profile_interval` counts it) of the fitted place's, at most :data:`PLACE_WALK` places tried.
+    Where the data trade a place for a size the first-order part (:func:`place_cov`) is far too narrow:
+    dev seed 5's stiffening of 0.62 over 29 x 33 mm, found as 1.95 over 12 x 33 mm with a first-order
+    interval of [0.84, 3.07], has places within the rise at 0.35 to 2.64."""
+    rx, P = Reanalysis(res, state), res.param_columns(state)
+    v = np.asarray(state.values, float)
+    s2 = _variance(res, state, effects)
+
+    def fit(c, start):
+        trial = effects[:j] + [c] + effects[j + 1:]
+        return estimate(res, state.p, trial, np.r_[v[:j], start, v[j + 1:]], RANK_STEPS, bounds, param_columns=P,
+                        reduced=rx)
+
+    c0 = fit(effects[j], v[j]).chi2
+    seen, todo, kept, tried = {effects[j].name}, [(effects[j], v[j])], [v[j]], 0
+    while todo and tried < PLACE_WALK:
+        here, value = todo.pop(0)
+        try:
+            moved = [c for c in neighbours(here) if c.name not in seen][:PLACE_WALK - tried]
+        except ValueError:  # no place beside it on this mesh
+            continue
+        for c in moved:
+            seen.add(c.name)
+            tried += 1
+            f = fit(c, moved_values([here, c], [0], [1], [value])[0])
+            if f.state is not None and (f.chi2 - c0) / s2 < TWO_SIGMA_RISE:
+                kept.append(f.values[j])
+                todo.append((c, f.values[j]))
+    return min(kept), max(kept)
+
+
+def _variance(res, state, effects) -> float:
+    """The variance the fit at ``state`` leaves per row, at least the stated noise's (1)."""
+    return max(1.0, state.chi2 / max(res.n_rows - np.size(state.p) - len(effects), 1))
+
+
+def parts(magnitude: float, w: np.ndarray, cov: np.ndarray, cov_jack: np.ndarray, cov_place: np.ndarray,
+          places=None) -> dict:
     """The reported standard deviation of the combination ``w`` of magnitudes and its parts: ``noise``
     (fit covariance ``cov``), ``across_folds`` (jackknife ``cov_jack``), ``place`` (``cov_place``,
-    :func:`place_cov`), ``model_form`` (:data:`MODEL_FORM` times the magnitude)."""
+    :func:`place_cov`; where the magnitudes over the places within the 2-sigma rise, ``places`` (lo, hi)
+    of :func:`place_range`, lie further from ``magnitude``, half that reach), ``model_form``
+    (:data:`MODEL_FORM` times the magnitude)."""
     noise, across, place = (float(np.sqrt(max(w @ c @ w, 0.0))) if c.size else 0.0 for c in (cov, cov_jack, cov_place))
+    if places is not None:
+        place = max(place, max(abs(e - magnitude) for e in places) / 2.0)
     form = MODEL_FORM * abs(magnitude)
     return {"total": float(np.sqrt(max(noise, across) ** 2 + place**2 + form**2)), "noise": noise,
             "across_folds": across, "place": place, "model_form": form}
@@ -117,7 +167,7 @@ def profile_interval(res, state, effects, j: int, bounds=None) -> tuple:
     v = np.asarray(state.values, float)
     others, rest = effects[:j] + effects[j + 1:], np.delete(v, j)
     spec = effects[j].spec
-    s2 = max(1.0, state.chi2 / max(res.n_rows - np.size(state.p) - len(effects), 1))
+    s2 = _variance(res, state, effects)
 
     def chi2(x):
         fit = estimate(res, state.p, others, rest, RANK_STEPS, bounds, param_columns=P, reduced=rx,

@@ -162,3 +162,22 @@ def test_the_starts_keep_the_change_where_regions_overlap():
     masses = dict(starts([a, b], [0.002, 0.004], "region_mass"))
     assert masses[(0.0, 0.0, 0.03, 0.02)] == pytest.approx(0.006)
     assert masses[(0.01, 0.0, 0.02, 0.02)] == pytest.approx(0.003)
+
+
+def test_the_places_the_data_do_not_tell_apart_widen_a_region_s_magnitude(card):
+    """A 4 x 4 element region 1.3 stiffer, fitted over 3 x 3 of its elements (one in from two sides), where
+    it fits at a change of about 2.8: the data fix the change times the area, so the profile over places
+    (:func:`pcbdyn.diagnosis.uncertainty.place_range`) walks to larger regions at smaller changes and to
+    smaller ones at larger changes within the 2-sigma rise, and its range holds the truth's 1.3, which the
+    fit at its place excludes by its own profile."""
+    from pcbdyn.diagnosis.uncertainty import place_range, profile_interval
+
+    m, layout = card
+    truth = (3 * DX, 4 * DY, 7 * DX, 8 * DY)
+    res, cands, moves, sel = _pair_fitted(m, layout, [(truth, 1.3)], [(4 * DX, 4 * DY, 7 * DX, 7 * DY)], [0.5])
+    chosen = [cands[i] for i in sel.chosen]
+    assert sel.values[0] > 2.0
+    lo, hi = profile_interval(res, sel.state, chosen, 0)
+    assert lo > 1.3  # at its place, the change is known to exclude the truth's
+    lo, hi = place_range(res, sel.state, chosen, 0, moves.around)
+    assert lo < 1.3 < hi and hi > sel.values[0]

@@ -104,7 +104,7 @@ def test_a_mass_whose_place_the_modes_cannot_tell_has_a_wide_interval(xy, wide):
     fit = estimate(res, np.array([26e9]), [truth], [0.020], 8)
     cands = [truth]
     near = LocalMoves(layout, cands, 13.3e-3)
-    cov = place_cov(res, fit.state, [truth], np.array([MASS.scale]), lambda j: [cands[i] for i in near(0)])
+    cov = place_cov(res, fit.state, [truth], np.array([MASS.scale]), lambda c: [cands[i] for i in near(0)])
     place, noise = np.sqrt(cov[0, 0]), np.sqrt(fit.cov[-1, -1])
     if not wide:
         assert place < 0.05 * fit.values[0] and noise < 0.05 * fit.values[0]
