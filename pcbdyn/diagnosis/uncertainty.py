@@ -9,10 +9,12 @@ reported standard deviation combines, in quadrature,
   time, to first order at the fitted state): when the modes or configurations disagree on a
   magnitude, the spread between them is the better measure;
 - what the effects' places leave open (:func:`place_cov`): the magnitudes fitted with the places as
-  further unknowns, to first order. A fit at a fixed place says how well the size is known there, not
-  how well it is known; where the data trade one for the other the second is far wider (a mass beside
-  a hinged edge: the modes are linear in the distance from it there, and they feel m x^2, so a mass
-  at half the distance and four times the size fits as well; a region's extent against its change);
+  further unknowns, to first order; for an effect alone, at least half the reach of its magnitudes
+  over the places within the 2-sigma rise (:func:`place_range`). A fit at a fixed place says how well
+  the size is known there, not how well it is known; where the data trade one for the other the
+  second is far wider (a mass beside a hinged edge: the modes are linear in the distance from it
+  there, and they feel m x^2, so a mass at half the distance and four times the size fits as well; a
+  region's extent against its change);
 - a model-form budget, a fixed share of the magnitude (:data:`MODEL_FORM`), measured on the
   diagnosis bench: the magnitudes found from tests meshed four times finer than the model and from
   tests computed by another FE code (OpenSees).
