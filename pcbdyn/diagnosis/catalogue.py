@@ -154,6 +154,13 @@ def kind(name: str):
         raise CatalogueError(f"unknown effect kind '{name}' (use one of {', '.join(KINDS)})") from None
 
 
+def moved_value(old, new, value: float) -> float:
+    """The magnitude an effect at ``value`` on candidate ``old`` starts from on candidate ``new`` (a step of
+    a local search): its kind's ``moved_value`` where it has one, else ``value``."""
+    move = getattr(new.spec, "moved_value", None)
+    return value if move is None or old is new else move(old, new, value)
+
+
 def _by_kind(candidates):
     groups: dict = {}
     for i, c in enumerate(candidates):

@@ -39,7 +39,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.stats import chi2 as chi2_dist
 
-from .catalogue import kind
+from .catalogue import kind, moved_value
 from .fitting import RANK_STEPS, UPPER, Fit, estimate  # noqa: F401  (re-exported)
 from .halves import Halves, bodies, body_moves, per_kind
 from .held_out import predicts, secant
@@ -291,13 +291,9 @@ def refine(res, candidates, sel: Selection, neighbours, bounds=None, newton_step
 
 def moved_values(candidates, idx, swap, values) -> np.ndarray:
     """The magnitudes a swap of the effects ``idx`` for ``swap`` starts from: ``values``, each effect
-    that moved at its kind's ``moved_value`` (:mod:`.catalogue`) where it has one."""
-    out = np.array(values, float)
-    for k, (i, j) in enumerate(zip(idx, swap)):
-        move = getattr(candidates[j].spec, "moved_value", None)
-        if i != j and move is not None:
-            out[k] = move(candidates[i], candidates[j], out[k])
-    return out
+    that moved at its kind's (:func:`.catalogue.moved_value`)."""
+    return np.array([v if i == j else moved_value(candidates[i], candidates[j], v)
+                     for i, j, v in zip(idx, swap, values)], float)
 
 
 def worth(chi2_before, chi2_after, n, k, pen) -> bool:

@@ -27,10 +27,10 @@ from __future__ import annotations
 import numpy as np
 
 from ..updating.solvers import covariance
+from .catalogue import moved_value
 from .fitting import RANK_STEPS, UPPER, estimate
 from .held_out import fit_without, folds
 from .reanalysis import Reanalysis
-from .select import moved_values
 
 #: the model-form budget: one standard deviation as a share of the magnitude, for every reported type.
 #: Calibrated with ``benchmarks/bench_coverage.py --calibrate`` on the bench and hold-out cases other
@@ -102,7 +102,7 @@ def place_range(res, state, effects, j: int, neighbours, bounds=None) -> tuple:
     not tell from its own, a profile over places: from it, step by step (``neighbours(c)``: the
     candidates one step of the local search from candidate c), every place where the magnitudes and the
     declared parameters refitted (quick fits on the reanalysis of ``state``, started as the search starts
-    a move, :func:`.select.moved_values`) leave chi^2 within the 2-sigma rise (:data:`TWO_SIGMA_RISE`, as
+    a move, :func:`.catalogue.moved_value`) leave chi^2 within the 2-sigma rise (:data:`TWO_SIGMA_RISE`, as
     :func:`profile_interval` counts it) of the fitted place's, at most :data:`PLACE_WALK` places tried.
     Where the data trade a place for a size the first-order part (:func:`place_cov`) is far too narrow:
     dev seed 5's stiffening of 0.62 over 29 x 33 mm, found as 1.95 over 12 x 33 mm with a first-order
@@ -127,7 +127,7 @@ def place_range(res, state, effects, j: int, neighbours, bounds=None) -> tuple:
         for c in moved:
             seen.add(c.name)
             tried += 1
-            f = fit(c, moved_values([here, c], [0], [1], [value])[0])
+            f = fit(c, moved_value(here, c, value))
             if f.state is not None and (f.chi2 - c0) / s2 < TWO_SIGMA_RISE:
                 kept.append(f.values[j])
                 todo.append((c, f.values[j]))
