@@ -68,10 +68,11 @@ def command(board_toml, test_uff, configs, noise, kinds, max_effects, mesh_size,
         bad = [k for k in chosen if k not in KINDS]
         if bad:
             raise click.BadParameter(f"unknown kind(s) {bad}; use {', '.join(KINDS)}", param_hint="--kinds")
-    with input_errors(KeyError, ValueError):
+    with input_errors(KeyError, ValueError):  # the readers' own errors; past them a ValueError is a bug
         board = load_structure(board_toml)
         tests = measured_configurations(board, test_uff, configs)
         ms = to_si(mesh_size, "mm", "--mesh-size") if mesh_size else None
+    with input_errors():
         t0 = step("diagnosing")
         record: dict = {}
         try:

@@ -30,7 +30,8 @@ def test_an_internal_error_still_writes_what_was_computed(tmp_path, monkeypatch)
     """A bug in a later step (here: the candidates cannot be generated) ends the command with the
     one-line internal error, and the JSON holds what was computed before it (the correlation as given
     and with the declared parameters fitted), marked incomplete, with the error; so does a model error
-    met on the way (discovery report seed 1001 had stopped on an indefinite stiffness with no JSON)."""
+    met on the way (discovery report seed 1001 had stopped on an indefinite stiffness with no JSON). A
+    ValueError raised inside the diagnosis is a bug too, not bad input (it used to exit 2 as if it were)."""
     import json
 
     from pcbdyn.board import load_board
@@ -49,7 +50,7 @@ def test_an_internal_error_still_writes_what_was_computed(tmp_path, monkeypatch)
     write_uff(tmp_path / "t.uff", simulate_on_model(truth, solve_modes(truth, n_modes=7), points, dofs,
                                                    noise=Noise(frequency_pct=0.2, shape_pct=2.0), seed=3))
 
-    for error, code in ((RuntimeError("a bug in the candidates"), 3),
+    for error, code in ((RuntimeError("a bug in the candidates"), 3), (ValueError("a candidate misses the plate"), 3),
                         (ModelError("negative eigenvalue -2.3e+08: the stiffness matrix is not positive"), 2)):
         def broken(*args, **kwargs):
             raise error
