@@ -274,9 +274,9 @@ def refine(res, candidates, sel: Selection, neighbours, bounds=None, newton_step
         halves = {k for pair in found for k in pair}
         swaps = [idx[:k] + [j] + idx[k + 1:] for k, i in enumerate(idx) if k not in halves
                  for j in neighbours(i) if j not in idx]
-        swaps += body_moves(candidates, idx, found, neighbours)
+        swaps = [list(sw) for sw in dict.fromkeys(map(tuple, swaps + body_moves(candidates, idx, found, neighbours)))]
         trials = rank(res, fit.state, [([candidates[t] for t in sw], moved_values(candidates, idx, sw, fit.values))
-                                       for sw in swaps], fit.p, bounds, P, runner)
+                                       for sw in swaps], fit.p, bounds, P, runner, beat=fit.chi2 * (1 - 1e-6))
         for trial_idx, trial in zip(swaps, trials):
             if trial is not None and trial.chi2 < (fit.chi2 if best is None else best[1].chi2) * (1 - 1e-6):
                 best = (trial_idx, trial)
