@@ -340,7 +340,8 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
         sel = noticed(res, cands, sel, models.bounds, alpha=alpha)
         stats["effects_not_noticed"] = found - len(sel.chosen)
     stats.update(chi2_after=sel.chi2[-1], candidates=len(cands))
-    for n, v in zip(names, sel.p):
+    bare = not sel.chosen and theta == 0.0  # nothing added to the model: it is the parameters-only one reported
+    for n, v in zip(names, told.p if bare else sel.p):
         out["parameters"][n]["final"] = float(v)
     chosen = [cands[i] for i in sel.chosen]
     effects = reported(res, sel, chosen, near.around, MERGE_REACH * h, models.bounds)
@@ -359,7 +360,7 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
                 + ", ".join(c.kind for c, _ in support) + "), placed and sized from them")
     if any(left.values()):
         msg += f"; test modes with no model partner (MAC < 0.3), left out of the fit: {left}"
-    after = sel.state.summary(res.observations)
+    after = out["parameters_only"] if bare else sel.state.summary(res.observations)
     po, worse = worst_on_common(out["parameters_only"], after)
     stats["after_worse_than_parameters_only"] = bool(worse > po)
     msg += worse_note(po, worse, bool(effects), theta)
