@@ -9,6 +9,24 @@ from pcbdyn.cli import main
 CARD = Path(__file__).resolve().parents[2] / "examples" / "six_part_card"
 
 
+def heavy_card_test(path):
+    """A modal test of the six-part card (88 g) carrying an undeclared 40 g mass, written to ``path`` (UFF):
+    seven modes at the card's points, noise 0.2 % on the frequencies and 2 % on the shapes."""
+    from pcbdyn.board import load_board
+    from pcbdyn.fe.modal import solve_modes
+    from pcbdyn.testdata import read_points_csv, write_uff
+    from pcbdyn.testdata.noise import Noise
+    from pcbdyn.testdata.simulate import simulate_on_model
+
+    heavy = path.with_suffix(".toml")
+    heavy.write_text((CARD / "board.toml").read_text() + '\n[[masses]]\nname = "extra"\nat = ["120 mm", "150 mm"]\n'
+                                                          'mass = "40 g"\n')
+    truth = load_board(heavy).build().model
+    points, dofs = read_points_csv(CARD / "points.csv")
+    write_uff(path, simulate_on_model(truth, solve_modes(truth, n_modes=7), points, dofs,
+                                      noise=Noise(frequency_pct=0.2, shape_pct=2.0), seed=3))
+
+
 def run(*args):
     return CliRunner().invoke(main, ["diagnose", *map(str, args)])
 
@@ -34,21 +52,10 @@ def test_an_internal_error_still_writes_what_was_computed(tmp_path, monkeypatch)
     ValueError raised inside the diagnosis is a bug too, not bad input (it used to exit 2 as if it were)."""
     import json
 
-    from pcbdyn.board import load_board
     from pcbdyn.diagnosis import pipeline
-    from pcbdyn.fe.modal import solve_modes
     from pcbdyn.fe.model import ModelError
-    from pcbdyn.testdata import read_points_csv, write_uff
-    from pcbdyn.testdata.noise import Noise
-    from pcbdyn.testdata.simulate import simulate_on_model
 
-    heavy = tmp_path / "heavy.toml"
-    heavy.write_text((CARD / "board.toml").read_text() + '\n[[masses]]\nname = "extra"\nat = ["120 mm", "150 mm"]\n'
-                                                          'mass = "40 g"\n')
-    truth = load_board(heavy).build().model
-    points, dofs = read_points_csv(CARD / "points.csv")
-    write_uff(tmp_path / "t.uff", simulate_on_model(truth, solve_modes(truth, n_modes=7), points, dofs,
-                                                   noise=Noise(frequency_pct=0.2, shape_pct=2.0), seed=3))
+    heavy_card_test(tmp_path / "t.uff")
 
     for error, code in ((RuntimeError("a bug in the candidates"), 3), (ValueError("a candidate misses the plate"), 3),
                         (ModelError("negative eigenvalue -2.3e+08: the stiffness matrix is not positive"), 2)):

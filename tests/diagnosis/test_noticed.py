@@ -6,8 +6,6 @@ moved the model in between (:func:`pcbdyn.diagnosis.pipeline.worse_note`), on th
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
@@ -17,6 +15,7 @@ from pcbdyn.diagnosis.select import Selection, estimate, noticed
 from pcbdyn.fe.modal import solve_modes
 from pcbdyn.testdata import MeasuredModes
 
+from test_diagnose_command import CARD, heavy_card_test
 from test_select import N_MODES, SIGMA, card  # noqa: F401  (the free card with its candidates)
 
 
@@ -75,20 +74,10 @@ def test_with_nothing_added_after_is_the_parameters_only_model(tmp_path):
     search's own refit, which weighs the shapes, while 'parameters only' was update's fit)."""
     from pcbdyn.board import load_board
     from pcbdyn.diagnosis.pipeline import diagnose
-    from pcbdyn.testdata import read_points_csv, write_uff
     from pcbdyn.testdata.measured import read_tests
-    from pcbdyn.testdata.noise import Noise
-    from pcbdyn.testdata.simulate import simulate_on_model
 
-    card = Path(__file__).resolve().parents[2] / "examples" / "six_part_card"
-    heavy = tmp_path / "heavy.toml"
-    heavy.write_text((card / "board.toml").read_text() + '\n[[masses]]\nname = "extra"\nat = ["120 mm", "150 mm"]\n'
-                                                          'mass = "40 g"\n')
-    truth = load_board(heavy).build().model
-    points, dofs = read_points_csv(card / "points.csv")
-    write_uff(tmp_path / "t.uff", simulate_on_model(truth, solve_modes(truth, n_modes=7), points, dofs,
-                                                   noise=Noise(frequency_pct=0.2, shape_pct=2.0), seed=3))
-    board = load_board(card / "board.toml")
+    heavy_card_test(tmp_path / "t.uff")
+    board = load_board(CARD / "board.toml")
     d = diagnose(board, read_tests(board, tmp_path / "t.uff"), 0.2, 2.0, max_effects=0, quick=True, workers=1)
     assert not d.effects and not d.noise_only and d.statistics["plate_theory_share"] == 0.0
     assert d.after == d.parameters_only and d.parameters_only["max_freq_error_pct"] > 1.0
