@@ -77,9 +77,9 @@ def _options(kinds) -> set:
 @dataclass
 class Diagnosis:
     """The outcome: ``effects`` (JSON-ready dicts), ``noise_only``, ``message`` (plain words),
-    correlation summaries ``before`` (model as given), ``parameters_only`` (declared parameters
-    fitted) and ``after`` (with the effects), the declared parameter values and the test
-    statistics; ``evidence``: {kind: (node xy (n, 2) [m], chi^2 a candidate there removes)} at the
+    correlation summaries ``before`` (model as given), ``parameters_only`` (declared parameters fitted)
+    and ``after`` (with the effects; ``parameters_only`` where nothing is added), the declared parameter
+    values and the test statistics; ``evidence``: {kind: (node xy (n, 2) [m], chi^2 a candidate there removes)} at the
     parameters-only state, the map of where the residual points."""
 
     effects: list
