@@ -13,7 +13,7 @@ import shapely
 from ..fe.probe import segment_parameter
 from .catalogue import kind, weighted_centre
 from .moves import REGION_KINDS, overlap, rectangle
-from .uncertainty import interval, jackknife_cov, parts, place_cov, place_range, profile_interval
+from .uncertainty import at_state, interval, jackknife_cov, parts, place_cov, place_range, profile_interval
 
 #: kinds that act at one node: an effect between nodes is shared by its neighbours
 POINT_KINDS = ("point_mass", "point_inertia", "ground_spring")
@@ -125,14 +125,15 @@ def reported(res, sel, chosen, neighbours, reach: float, bounds=None) -> list:
     effect alone is of a kind that saturates (:func:`.uncertainty.profile_interval`)."""
     scale = np.array([c.spec.scale for c in chosen])
     cov_jack = jackknife_cov(res, sel.state, chosen, scale)
-    cov_place = place_cov(res, sel.state, chosen, scale, neighbours)
+    at = at_state(res, sel.state) if chosen else None  # one reanalysis for every quick fit below
+    cov_place = place_cov(res, sel.state, chosen, scale, neighbours, at)
     out = []
     for g in groups(chosen, reach):
         spec = kind(chosen[g[0]].kind)
         alone = len(g) == 1 and getattr(spec, "reanalysed", True)
         saturates = alone and getattr(spec, "saturates", False) and sel.values[g[0]] > 0
-        profile = profile_interval(res, sel.state, chosen, g[0], bounds) if saturates else None
-        places = place_range(res, sel.state, chosen, g[0], neighbours, bounds) if alone else None
+        profile = profile_interval(res, sel.state, chosen, g[0], bounds, at) if saturates else None
+        places = place_range(res, sel.state, chosen, g[0], neighbours, bounds, at) if alone else None
         out.append(merged(chosen, sel.values, sel.cov, cov_jack, cov_place, g, profile, places))
     return out
 

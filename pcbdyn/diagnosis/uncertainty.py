@@ -64,17 +64,24 @@ def jackknife_cov(res, state, effects, scale) -> np.ndarray:
     return (g - 1) / g * d.T @ d
 
 
-def place_cov(res, state, effects, scale, neighbours) -> np.ndarray:
+def at_state(res, state) -> tuple:
+    """(the reanalysis of ``state``, the declared parameters' columns there): what :func:`place_cov`,
+    :func:`place_range` and :func:`profile_interval` of one fitted state share (``at``), made once; the
+    reanalysis keeps the static corrections of the places they move the effects to."""
+    return Reanalysis(res, state), res.param_columns(state)
+
+
+def place_cov(res, state, effects, scale, neighbours, at=None) -> np.ndarray:
     """Covariance (k, k) [SI] that the places of ``effects`` (fitted at ``state``; ``scale``: their
     columns' scales) add to their magnitudes (module doc): the magnitudes' covariance
     (:func:`pcbdyn.updating.solvers.covariance`) with a column per move of an effect to each of
     ``neighbours(c)`` (candidates one step of the local search from candidate c: the residual's change
     at the same magnitudes, on the reanalysis of ``state``) less that without them. Zeros where no
-    effect moves."""
+    effect moves. ``at``: :func:`at_state` of ``state`` where already made."""
     k = len(effects)
     if k == 0:
         return np.zeros((0, 0))
-    rx = Reanalysis(res, state)
+    rx, P = at or at_state(res, state)
     r0 = rx.evaluate(state.p, effects, state.values).r
     G = []
     for j in range(k):
@@ -91,13 +98,13 @@ def place_cov(res, state, effects, scale, neighbours) -> np.ndarray:
                 G.append(r - r0)
     if not G:
         return np.zeros((k, k))
-    J = np.hstack([res.param_columns(state), res.effect_columns(state, effects) * scale])
+    J = np.hstack([P, res.effect_columns(state, effects) * scale])
     m = slice(J.shape[1] - k, J.shape[1])
     grown = covariance(np.column_stack([J] + G), state.r)[m, m] - covariance(J, state.r)[m, m]
     return np.outer(scale, scale) * grown
 
 
-def place_range(res, state, effects, j: int, neighbours, bounds=None) -> tuple:
+def place_range(res, state, effects, j: int, neighbours, bounds=None, at=None) -> tuple:
     """(lo, hi) [SI]: the magnitudes of ``effects[j]`` (fitted at ``state``) over the places the data do
     not tell from its own, a profile over places: from it, step by step (``neighbours(c)``: the
     candidates one step of the local search from candidate c), every place where the magnitudes and the
@@ -106,8 +113,8 @@ def place_range(res, state, effects, j: int, neighbours, bounds=None) -> tuple:
     :func:`profile_interval` counts it) of the fitted place's, at most :data:`PLACE_WALK` places tried.
     Where the data trade a place for a size the first-order part (:func:`place_cov`) is far too narrow:
     dev seed 5's stiffening of 0.62 over 29 x 33 mm, found as 1.95 over 12 x 33 mm with a first-order
-    interval of [0.84, 3.07], has places within the rise at 0.35 to 2.64."""
-    rx, P = Reanalysis(res, state), res.param_columns(state)
+    interval of [0.84, 3.07], has places within the rise at 0.35 to 2.64. ``at``: :func:`at_state`."""
+    rx, P = at or at_state(res, state)
     v = np.asarray(state.values, float)
     s2 = _variance(res, state, effects)
 
@@ -154,7 +161,7 @@ def parts(magnitude: float, w: np.ndarray, cov: np.ndarray, cov_jack: np.ndarray
             "across_folds": across, "place": place, "model_form": form}
 
 
-def profile_interval(res, state, effects, j: int, bounds=None) -> tuple:
+def profile_interval(res, state, effects, j: int, bounds=None, at=None) -> tuple:
     """(lo, hi) [SI]: the 2-sigma interval of the magnitude of ``effects[j]`` (fitted at ``state``) by the
     profile of chi^2: the magnitude held at the fitted one times sqrt 2 per step, the other magnitudes
     and the declared parameters refitted at each (quick fits on the reanalysis of ``state``), each end
@@ -164,8 +171,9 @@ def profile_interval(res, state, effects, j: int, bounds=None) -> tuple:
     covariance's symmetric interval misleads: a spring much stiffer than the plate around it pins it,
     and any stiffer one fits about as well (a 30 MN/m spring on the guided card is fitted at the kind's
     bound, 10 MN/m, +- 2.1 MN/m: test_uncertainty). It does not mend a biased fit: dev seed 13's 651 kN/m,
-    found as 413 kN/m, lies outside its profile's [298, 537] kN/m, as the model's own mesh puts it."""
-    rx, P = Reanalysis(res, state), res.param_columns(state)
+    found as 413 kN/m, lies outside its profile's [298, 537] kN/m, as the model's own mesh puts it.
+    ``at``: :func:`at_state` of ``state`` where already made."""
+    rx, P = at or at_state(res, state)
     v = np.asarray(state.values, float)
     others, rest = effects[:j] + effects[j + 1:], np.delete(v, j)
     spec = effects[j].spec
