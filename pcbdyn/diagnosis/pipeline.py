@@ -339,8 +339,8 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
         found = len(sel.chosen)
         sel = noticed(res, cands, sel, models.bounds, alpha=alpha)
         stats["effects_not_noticed"] = found - len(sel.chosen)
-    stats.update(chi2_after=sel.chi2[-1], candidates=len(cands))
     bare = not sel.chosen and theta == 0.0  # nothing added to the model: it is the parameters-only one reported
+    stats.update(chi2_after=res.evaluate(told.p).chi2 if bare else sel.chi2[-1], candidates=len(cands))
     for n, v in zip(names, told.p if bare else sel.p):
         out["parameters"][n]["final"] = float(v)
     chosen = [cands[i] for i in sel.chosen]
