@@ -5,10 +5,15 @@ pcbdyn dies, even by SIGKILL (Linux's parent-death signal), so a killed run leav
 from __future__ import annotations
 
 import ctypes
+import importlib
 import os
 import pickle
 import select
 import signal
+import struct
+import subprocess
+import sys
+import threading
 import time
 
 _PR_SET_PDEATHSIG = 1
@@ -26,73 +31,130 @@ def die_with_parent(parent: int | None = None) -> None:
         os._exit(1)
 
 
-def run_forked(fn, args=(), timeout: float = 300.0, what: str = "the work"):
-    """``fn(*args)`` run in a forked child and its result returned (pickled back); an exception raised in
-    the child is raised here. After ``timeout`` seconds the child is killed and a TimeoutError says so;
-    a child that dies without a result (a crash in a C library) gives a RuntimeError naming how. Where
-    fork is missing, ``fn`` runs in this process without a limit."""
-    if not hasattr(os, "fork"):
-        return fn(*args)
-    parent = os.getpid()
-    r, w = os.pipe()
-    pid = os.fork()
-    if pid == 0:  # the child: never returns into the caller's stack
+#: this process's fork server (:func:`run_forked`), started when first needed
+_SERVER: dict = {}
+_SERVER_LOCK = threading.Lock()
+
+
+def run_forked(fn, args=(), timeout: float = 300.0, what: str = "the work", preload=()):
+    """``fn(*args)`` run in a child forked from a fork server and its result returned (pickled back); an
+    exception raised in the child is raised here. After ``timeout`` seconds the child is killed and a
+    TimeoutError says so; a child that dies without a result (a crash in a C library) gives a
+    RuntimeError naming how. The server is a fresh interpreter (one per process, on this one's import
+    path, with the modules ``preload`` imported and a fixed hash seed) that forks a child per call and reads nothing itself,
+    so every child starts from the same memory: gmsh breaks ties by where its objects lie in memory,
+    and forked from a long run it gave one board one of two meshes run to run."""
+    with _SERVER_LOCK:
+        server = _server(tuple(preload))
+        data = pickle.dumps((fn, args), protocol=pickle.HIGHEST_PROTOCOL)
         try:
-            os.close(r)
-            die_with_parent(parent)
-            try:
-                out = (True, fn(*args))
-            except BaseException as exc:  # noqa: BLE001 - everything goes back to the parent
-                out = (False, _picklable(exc))
-            with os.fdopen(w, "wb") as fh:
-                fh.write(pickle.dumps(out, protocol=pickle.HIGHEST_PROTOCOL))
-        finally:
-            os._exit(0)
-    os.close(w)
-    try:
-        data = _read_all(r, time.monotonic() + timeout)
-    finally:
-        os.close(r)
-        status = _reap(pid, kill=True)
-    if data is None:
-        raise TimeoutError(f"{what} did not finish within {timeout:g} s")
-    if not data:
-        raise RuntimeError(f"{what} stopped without a result ({_how(status)})")
-    ok, value = pickle.loads(data)
+            _write(server["job"], b"G" + struct.pack("<Q", len(data)) + data)
+            records = _records(server["out"], time.monotonic() + timeout)
+        except (OSError, TimeoutError, EOFError) as exc:
+            _stop(server)
+            if isinstance(exc, TimeoutError):
+                raise TimeoutError(f"{what} did not finish within {timeout:g} s") from None
+            raise RuntimeError(f"{what}: its fork server stopped ({exc})") from None
+        if "R" not in records:
+            _stop(server)
+            raise RuntimeError(f"{what} stopped without a result ({_how(records['S'])})")
+    ok, value = pickle.loads(records["R"])
     if ok:
         return value
     raise value
 
 
-def _read_all(fd: int, deadline: float) -> bytes | None:
-    """Everything written to ``fd`` until it closes; None when ``deadline`` passes first."""
-    chunks = []
-    while True:
-        left = deadline - time.monotonic()
-        if left <= 0:
-            return None
-        ready, _, _ = select.select([fd], [], [], min(left, 1.0))
-        if ready:
-            chunk = os.read(fd, 1 << 20)
-            if not chunk:
-                return b"".join(chunks)
-            chunks.append(chunk)
+def _server(preload) -> dict:
+    """This process's fork server (a new one in a forked child of it, or after the last one stopped)."""
+    server = _SERVER.get("now")
+    if server is not None and server["pid"] == os.getpid() and server["proc"].poll() is None:
+        return server
+    job_r, job_w = os.pipe()
+    out_r, out_w = os.pipe()
+    code = f"from pcbdyn.children import serve; serve({job_r}, {out_w}, {list(preload)!r})"
+    proc = subprocess.Popen([sys.executable, "-c", code], pass_fds=(job_r, out_w), preexec_fn=die_with_parent,
+                            env=dict(os.environ, PYTHONHASHSEED="0", PYTHONPATH=os.pathsep.join(filter(None, sys.path))))
+    os.close(job_r)
+    os.close(out_w)
+    _SERVER["now"] = {"pid": os.getpid(), "proc": proc, "job": job_w, "out": out_r}
+    return _SERVER["now"]
 
 
-def _reap(pid: int, kill: bool) -> int:
-    """The wait status of child ``pid``, killed first when ``kill`` and still running."""
-    done, status = os.waitpid(pid, os.WNOHANG)
-    if done == 0:
-        if kill:
-            os.kill(pid, signal.SIGKILL)
+def _stop(server) -> None:
+    server["proc"].kill()
+    server["proc"].wait()
+    os.close(server["job"])
+    os.close(server["out"])
+    _SERVER.pop("now", None)
+
+
+def serve(job: int, out: int, preload) -> None:
+    """The fork server's loop: for each job announced on ``job``, a child that reads the job ((fn, args),
+    pickled) from it, runs it and writes its result to ``out`` (an "R" record); then the child's exit
+    code (an "S" record)."""
+    for name in preload:
+        importlib.import_module(name)
+    while os.read(job, 1):
+        pid = os.fork()
+        if pid == 0:
+            try:
+                die_with_parent()
+                (size,) = struct.unpack("<Q", _read(job, 8))
+                try:
+                    fn, args = pickle.loads(_read(job, size))
+                    result = (True, fn(*args))
+                except BaseException as exc:  # noqa: BLE001 - everything goes back to the caller
+                    result = (False, _picklable(exc))
+                data = pickle.dumps(result, protocol=pickle.HIGHEST_PROTOCOL)
+                _write(out, b"R" + struct.pack("<Q", len(data)) + data)
+            finally:
+                os._exit(0)
         _, status = os.waitpid(pid, 0)
-    return status
+        _write(out, b"S" + struct.pack("<q", os.waitstatus_to_exitcode(status)))
 
 
-def _how(status: int) -> str:
-    if os.WIFSIGNALED(status):
-        return f"killed by signal {signal.Signals(os.WTERMSIG(status)).name}"
-    return f"exit status {os.waitstatus_to_exitcode(status)}"
+def _records(fd: int, deadline: float) -> dict:
+    """The records a job's child and the server write to ``fd``, up to the server's: {"R": the result's
+    bytes (missing where the child died without one), "S": the child's exit code}."""
+    records: dict = {}
+    while "S" not in records:
+        tag = _read(fd, 1, deadline)
+        if tag == b"S":
+            (records["S"],) = struct.unpack("<q", _read(fd, 8, deadline))
+        else:
+            (size,) = struct.unpack("<Q", _read(fd, 8, deadline))
+            records["R"] = _read(fd, size, deadline)
+    return records
+
+
+def _read(fd: int, n: int, deadline: float | None = None) -> bytes:
+    """``n`` bytes from the pipe ``fd``: TimeoutError once ``deadline`` passes, EOFError where it closes."""
+    chunks, left = [], n
+    while left:
+        if deadline is not None:
+            wait = deadline - time.monotonic()
+            if wait <= 0:
+                raise TimeoutError
+            if not select.select([fd], [], [], min(wait, 1.0))[0]:
+                continue
+        chunk = os.read(fd, min(left, 1 << 20))
+        if not chunk:
+            raise EOFError("the pipe closed")
+        chunks.append(chunk)
+        left -= len(chunk)
+    return b"".join(chunks)
+
+
+def _write(fd: int, data: bytes) -> None:
+    view = memoryview(data)
+    while view:
+        view = view[os.write(fd, view):]
+
+
+def _how(exitcode: int) -> str:
+    if exitcode < 0:
+        return f"killed by signal {signal.Signals(-exitcode).name}"
+    return f"exit status {exitcode}"
 
 
 def _picklable(exc: BaseException) -> BaseException:

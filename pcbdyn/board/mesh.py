@@ -1,16 +1,16 @@
-"""Quad-dominant shell meshes of a board with gmsh (OpenCASCADE kernel, quiet, in a child process with a
-time limit: :func:`run_gmsh`).
+"""Quad-dominant shell meshes of a board with gmsh (OpenCASCADE kernel, quiet, each pass in a child process
+with a time limit: :func:`run_quad_mesh`, :func:`run_gmsh`).
 
 The board face is fragmented by every region that must own its own elements (part footprints)
 or whose outline element edges must follow (wedge-lock contact strips), and by the points that
 must be nodes (standoffs, point masses, part centres, measurement points). Triangles are
 recombined into quads (frontal-Delaunay triangles + blossom recombination), which gives an
 all-quad mesh for most layouts (gmsh's "frontal-Delaunay for quads", algorithm 8, folded a few
-elements at small standoff pads, so algorithm 6 is used); when some triangles remain, the board is meshed at twice the size and every cell is
-split into quads (gmsh's all-quad subdivision), so the result is all-quad at ``size``. Where either
-pass folds an element (recombination can, in slivers between close footprints), the surfaces that
-folded keep their triangles: a mixed mesh rather than a refusal.
-"""
+elements at small standoff pads, so algorithm 6 is used); when some triangles remain, the board is
+meshed at twice the size and every cell is split into quads (gmsh's all-quad subdivision), so the
+result is all-quad at ``size``; where that folds an element, the first mesh stays, with its few
+triangles. Where the first pass folds (recombination can, in slivers between close footprints), the
+surfaces that folded keep their triangles: a mixed mesh rather than a refusal."""
 
 from __future__ import annotations
 
@@ -91,13 +91,11 @@ def run_gmsh(fn, args):
     crash in gmsh cannot take pcbdyn down. gmsh's own errors come back as RuntimeError."""
     import os
 
-    import gmsh  # noqa: F401 - loaded once here, inherited by every child
-
     from ..children import run_forked
 
     timeout = float(os.environ.get("PCBDYN_MESH_TIMEOUT", MESH_TIMEOUT))
     try:
-        return run_forked(fn, args, timeout, "gmsh")
+        return run_forked(fn, args, timeout, "gmsh", preload=["pcbdyn.board.mesh", "pcbdyn.box.mesh"])
     except TimeoutError as exc:
         raise RuntimeError(f"{exc}; use a larger mesh size or simpler geometry, or raise PCBDYN_MESH_TIMEOUT "
                            f"(now {timeout:g} s)") from None
@@ -126,32 +124,61 @@ def gmsh_session(name: str):
             gmsh.finalize()
 
 
-def generate_quads(gmsh, size: float) -> None:
-    """Quads at ``size`` (frontal-Delaunay triangles recombined by blossom); where triangles remain, the
-    mesh twice as coarse with every cell split into quads, by the frontal-Delaunay for quads (algorithm
-    6 on this pass gave other meshes run to run). Where either folds an element (recombination can, in
-    the slivers between close footprints), the surfaces that folded keep the triangles of the first pass
-    and the others its quads: a mixed mesh, never a folded one."""
+#: the first pass of :func:`run_quad_mesh`: triangles recombined into quads at the size asked
+QUADS = "quads"
+#: its second pass: a mesh twice as coarse, every cell split into quads
+SUBDIVIDED = "subdivided"
+
+
+def run_quad_mesh(fn, args, what: str):
+    """A quad mesh made by ``fn(*args, plan)`` (a function that meshes in :func:`quad_pass` and returns
+    (the surfaces that folded, its plain arrays (xyz, cells, point nodes), or None where some folded)),
+    one pass per child process (:func:`run_gmsh`). Quads come from frontal-Delaunay triangles
+    recombined by blossom (:data:`QUADS`); where triangles remain, the mesh twice as coarse with every
+    cell split into quads by the frontal-Delaunay for quads (:data:`SUBDIVIDED`; algorithm 6 on this
+    pass gave other meshes run to run); where that folds an element, the first mesh with its few
+    triangles. Where the first folds (recombination can, in the slivers between close footprints), the
+    surfaces that folded keep their triangles and the others are recombined: a mixed mesh, never a
+    folded one. Each pass starts in a fresh process: gmsh breaks ties between equal recombinations by
+    where its objects lie in memory, and a second session in one process (or a pass after
+    ``mesh.clear()``) gave one board one of two meshes run to run (frequencies 1e-6 apart, and a
+    diagnosis that turned on them); a first session gave the same mesh every time."""
+    folded, out = run_gmsh(fn, (*args, QUADS))
+    if not folded:
+        if not any("tri3" in c for c in out[1].values()):
+            return out
+        refolded, subdivided = run_gmsh(fn, (*args, SUBDIVIDED))
+        return out if refolded else subdivided
+    refolded, mixed = run_gmsh(fn, (*args, frozenset(folded)))
+    if refolded:
+        raise RuntimeError(f"gmsh folded elements of {what} where it recombined triangles into quads; "
+                           "change mesh_size slightly")
+    return mixed
+
+
+@contextmanager
+def quad_pass(name: str, build, size: float, plan):
+    """A :func:`gmsh_session` holding the geometry ``build(gmsh)`` makes, meshed by one pass of
+    :func:`run_quad_mesh`'s ``plan`` (:data:`QUADS`, :data:`SUBDIVIDED`, or the surfaces left in
+    triangles); yields (gmsh, what ``build`` returned, the surfaces that folded)."""
+    with gmsh_session(name) as gmsh:
+        built = build(gmsh)
+        if plan == QUADS:
+            _generate(gmsh, size, 6, recombine=True)
+        elif plan == SUBDIVIDED:
+            _generate(gmsh, 2.0 * size, 8, recombine=True, subdivide=True)
+        else:
+            _generate(gmsh, size, 6, recombine=[t for _, t in gmsh.model.getEntities(2) if t not in plan])
+        yield gmsh, built, folded_surfaces(gmsh)
+
+
+def _generate(gmsh, size: float, algorithm: int, recombine, subdivide: bool = False) -> None:
+    """A 2-D mesh at ``size`` by gmsh's ``algorithm``, its triangles recombined into quads (blossom) on
+    every surface (``recombine`` True) or on the surfaces listed, and every cell split into quads where
+    ``subdivide``."""
     gmsh.option.setNumber("Mesh.MeshSizeMin", 0.0)
     gmsh.option.setNumber("Mesh.RecombinationAlgorithm", 1)
-    _generate(gmsh, size, 6, recombine=True)
-    folded = folded_surfaces(gmsh)
-    if 2 not in gmsh.model.mesh.getElementTypes(2) and not folded:
-        return
-    if not folded:
-        gmsh.model.mesh.clear()
-        gmsh.option.setNumber("Mesh.SubdivisionAlgorithm", 1)
-        _generate(gmsh, 2.0 * size, 8, recombine=True)
-        gmsh.option.setNumber("Mesh.SubdivisionAlgorithm", 0)
-        if not folded_surfaces(gmsh):
-            return
-    gmsh.model.mesh.clear()
-    _generate(gmsh, size, 6, recombine=[t for _, t in gmsh.model.getEntities(2) if t not in folded])
-
-
-def _generate(gmsh, size: float, algorithm: int, recombine) -> None:
-    """A 2-D mesh at ``size`` by gmsh's ``algorithm``, its triangles recombined into quads on every surface
-    (``recombine`` True) or on the surfaces listed."""
+    gmsh.option.setNumber("Mesh.SubdivisionAlgorithm", 1 if subdivide else 0)
     gmsh.option.setNumber("Mesh.Algorithm", algorithm)
     gmsh.option.setNumber("Mesh.MeshSizeMax", size)
     gmsh.option.setNumber("Mesh.RecombineAll", 1 if recombine is True else 0)
@@ -261,8 +288,8 @@ def mesh_board(outline, regions, points, size: float, strips=(), lines=()) -> Bo
 
 def _mesh_board(outline, regions, points, size: float, strips=(), lines=()) -> BoardMesh:
     """The mesh itself: gmsh in a child process under :func:`run_gmsh`'s time limit."""
-    xyz, cells, point_nodes = run_gmsh(_board_cells, (outline.vertices, outline.holes, regions, points, size, strips,
-                                                      lines))
+    xyz, cells, point_nodes = run_quad_mesh(_board_cells, (outline.vertices, outline.holes, regions, points, size, strips,
+                                                           lines), "the board")
     nodes, new = used_nodes(xyz, cells)
     for c in cells.values():
         for k in c:
@@ -279,9 +306,13 @@ def _mesh_board(outline, regions, points, size: float, strips=(), lines=()) -> B
     return BoardMesh(nodes, cells, pn)
 
 
-def _board_cells(vertices, holes, regions, points, size, strips, lines) -> tuple:
-    """(node xyz, cells {label: {etype: [conn, ...]}}, node row of each point) of the board meshed by gmsh."""
-    with gmsh_session("board") as gmsh:
+def _board_cells(vertices, holes, regions, points, size, strips, lines, plan) -> tuple:
+    """The board meshed by gmsh in one pass of ``plan`` (:func:`run_quad_mesh`): (the surfaces that folded,
+    (node xyz, cells {label: {etype: [conn, ...]}}, node row of each point) or None where some folded)."""
+
+    def build(gmsh):
+        """The board's face fragmented by its regions, strips, lines and points: (the surfaces on the
+        board, their region labels, the point entities)."""
         occ = gmsh.model.occ
         board = _polygon(occ, vertices)
         if holes:
@@ -310,22 +341,19 @@ def _board_cells(vertices, holes, regions, points, size, strips, lines) -> tuple
         if extra:
             gmsh.model.removeEntities(extra, recursive=True)
         point_tags = [out_map[-len(points) + i] for i in range(len(points))] if len(points) else []
-        generate_quads(gmsh, size)
+        return on_board, label_of, point_tags
+
+    with quad_pass("board", build, size, plan) as (gmsh, (on_board, label_of, point_tags), folded):
+        if folded:
+            return folded, None
         xyz, index = mesh_nodes(gmsh)
         cells: dict = {}
         for t in sorted(on_board):
             label = label_of.get(t, "board")
             for conn in surface_cells(gmsh, t, index):
-                npc = conn.shape[1]
-                area = _signed_area(xyz, conn)
-                if area.min() < 0 < area.max():
-                    raise RuntimeError(
-                        f"gmsh folded {int(min((area < 0).sum(), (area > 0).sum()))} elements of surface {t}; "
-                        "change mesh_size slightly"
-                    )
-                key = "quad4" if npc == 4 else "tri3"
+                key = "quad4" if conn.shape[1] == 4 else "tri3"
                 cells.setdefault(label, {}).setdefault(key, []).append(conn)
-        return xyz, cells, tagged_nodes(gmsh, point_tags, index)
+        return folded, (xyz, cells, tagged_nodes(gmsh, point_tags, index))
 
 
 def used_nodes(xyz, cells) -> tuple:

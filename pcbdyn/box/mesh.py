@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..board.mesh import generate_quads, gmsh_session, mesh_nodes, run_gmsh, surface_cells, tagged_nodes, used_nodes
+from ..board.mesh import mesh_nodes, quad_pass, run_quad_mesh, surface_cells, tagged_nodes, used_nodes
 from ..fe.model import SHELL_TYPES
 
 
@@ -74,13 +74,18 @@ def mesh_box(plates, lines, points, size: float) -> BoxMesh:
     """Mesh ``plates`` (:class:`.entries.Plate`) at element size ``size`` [m] with the straight ``lines``
     [(p0, p1)] [m] (ribs) as element edges and ``points`` (k, 3) [m] as nodes."""
     points = np.asarray(points, dtype=float).reshape(-1, 3)
-    xyz, cells, point_nodes = run_gmsh(_box_cells, (plates, lines, points, size))
+    xyz, cells, point_nodes = run_quad_mesh(_box_cells, (plates, lines, points, size), "the box")
     return _compact(xyz, cells, point_nodes, points)
 
 
-def _box_cells(plates, lines, points, size) -> tuple:
-    """(node xyz, cells {plate: {etype: [conn, ...]}}, node row of each point) of the box meshed by gmsh."""
-    with gmsh_session("box") as gmsh:
+def _box_cells(plates, lines, points, size, plan) -> tuple:
+    """The box meshed by gmsh in one pass of ``plan`` (:func:`.board.mesh.run_quad_mesh`): (the surfaces
+    that folded, (node xyz, cells {plate: {etype: [conn, ...]}}, node row of each point) or None where
+    some folded)."""
+
+    def build(gmsh):
+        """The plates fragmented by the ribs' lines and the points: (each plate's surfaces, the point
+        entities)."""
         occ = gmsh.model.occ
         objects = [(2, _surface(occ, p.corners())) for p in plates]
         tools = [(1, occ.addLine(occ.addPoint(*map(float, a)), occ.addPoint(*map(float, b)))) for a, b in lines]
@@ -91,8 +96,11 @@ def _box_cells(plates, lines, points, size) -> tuple:
             out_map = [objects]
         occ.synchronize()
         surfaces = [[t for d, t in m if d == 2] for m in out_map[:len(plates)]]
-        point_tags = out_map[len(out_map) - len(points):] if len(points) else []
-        generate_quads(gmsh, size)
+        return surfaces, out_map[len(out_map) - len(points):] if len(points) else []
+
+    with quad_pass("box", build, size, plan) as (gmsh, (surfaces, point_tags), folded):
+        if folded:
+            return folded, None
         xyz, index = mesh_nodes(gmsh)
         cells: dict = {}
         for plate, tags_p in zip(plates, surfaces):
@@ -100,18 +108,15 @@ def _box_cells(plates, lines, points, size) -> tuple:
                 for conn in surface_cells(gmsh, t, index):
                     key = "quad4" if conn.shape[1] == 4 else "tri3"
                     cells.setdefault(plate.name, {}).setdefault(key, []).append(_oriented(xyz, conn, plate))
-        return xyz, cells, tagged_nodes(gmsh, point_tags, index)
+        return folded, (xyz, cells, tagged_nodes(gmsh, point_tags, index))
 
 
 def _oriented(xyz, conn, plate) -> np.ndarray:
-    """The cells of one surface ordered counter-clockwise about the plate's normal; an error where gmsh
-    folded some."""
+    """The cells of one surface (none folded: :func:`.board.mesh.folded_surfaces`) ordered
+    counter-clockwise about the plate's normal."""
     p = xyz[conn]
     area = np.einsum("ck,k->c", sum(np.cross(p[:, i], p[:, (i + 1) % p.shape[1]]) for i in range(p.shape[1])),
                      plate.normal)
-    if area.min() < 0 < area.max():
-        raise RuntimeError(f"gmsh folded {int(min((area < 0).sum(), (area > 0).sum()))} elements of plate "
-                           f"'{plate.name}'; change mesh_size slightly")
     conn = conn.copy()
     conn[area < 0] = conn[area < 0][:, ::-1]
     return conn
