@@ -1,5 +1,6 @@
-"""Child processes that end with pcbdyn: work run in a forked child under a time limit (gmsh, which runs
-in-process and cannot be interrupted from Python), and the rule that every child pcbdyn starts dies when
+"""Child processes that end with pcbdyn: work run in a child of a fork server under a time limit (gmsh,
+which runs in-process and cannot be interrupted from Python, and whose result depends on where its objects
+lie in memory), and the rule that every child pcbdyn starts dies when
 pcbdyn dies, even by SIGKILL (Linux's parent-death signal), so a killed run leaves no orphan behind."""
 
 from __future__ import annotations
@@ -41,9 +42,12 @@ def run_forked(fn, args=(), timeout: float = 300.0, what: str = "the work", prel
     exception raised in the child is raised here. After ``timeout`` seconds the child is killed and a
     TimeoutError says so; a child that dies without a result (a crash in a C library) gives a
     RuntimeError naming how. The server is a fresh interpreter (one per process, on this one's import
-    path, with the modules ``preload`` imported and a fixed hash seed) that forks a child per call and reads nothing itself,
-    so every child starts from the same memory: gmsh breaks ties by where its objects lie in memory,
-    and forked from a long run it gave one board one of two meshes run to run."""
+    path, with the modules ``preload`` imported and a fixed hash seed) that forks a child per call and
+    reads nothing itself, so every child starts from the same memory: gmsh breaks ties by where its
+    objects lie in memory, and forked from a long run it gave one board one of two meshes run to run.
+    Where fork is missing, ``fn`` runs in this process without a limit."""
+    if not hasattr(os, "fork"):
+        return fn(*args)
     with _SERVER_LOCK:
         server = _server(tuple(preload))
         data = pickle.dumps((fn, args), protocol=pickle.HIGHEST_PROTOCOL)

@@ -66,7 +66,7 @@ def run_case(seed: int, options: dict, shared=None) -> dict:
     t0 = time.perf_counter()
     p = subprocess.run(cmd, capture_output=True, text=True, env=env)
     wall = time.perf_counter() - t0
-    (folder / f"diagnose-{options['tag']}.log").write_text(p.stdout + p.stderr)  # every step, to read one case by
+    (folder / f"diagnose-{options['tag']}.log").write_text(p.stdout + p.stderr)  # the whole progress log
     result = {"seed": seed, "wall_s": wall, "exit": p.returncode, "stderr_tail": p.stderr[-2000:],
               "diagnosis": json.loads(js.read_text()) if js.exists() else None}
     out.write_text(json.dumps(result, indent=1))

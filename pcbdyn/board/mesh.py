@@ -139,10 +139,11 @@ def run_quad_mesh(fn, args, what: str):
     pass gave other meshes run to run); where that folds an element, the first mesh with its few
     triangles. Where the first folds (recombination can, in the slivers between close footprints), the
     surfaces that folded keep their triangles and the others are recombined: a mixed mesh, never a
-    folded one. Each pass starts in a fresh process: gmsh breaks ties between equal recombinations by
-    where its objects lie in memory, and a second session in one process (or a pass after
-    ``mesh.clear()``) gave one board one of two meshes run to run (frequencies 1e-6 apart, and a
-    diagnosis that turned on them); a first session gave the same mesh every time."""
+    folded one. Each pass runs in a child of its own, forked from the same memory
+    (:func:`pcbdyn.children.run_forked`): gmsh breaks ties between equal recombinations by where its
+    objects lie in memory, and forked from a long run, or meshing again in one process after
+    ``mesh.clear()``, it gave one board one of two meshes run to run (frequencies 1e-6 apart, and a
+    diagnosis that turned on them)."""
     folded, out = run_gmsh(fn, (*args, QUADS))
     if not folded:
         if not any("tri3" in c for c in out[1].values()):
