@@ -90,30 +90,18 @@ def parameter_stage(plain, own, update, models, say) -> tuple:
     from both: a lower chi^2 of the declared parameters alone can be another compromise with the
     missing effect, one that hides it from the linearised search (a 15 g line mass on the six-part
     card: chi^2 2.6 % lower from update's fit, nothing found from there), unless the two are one fit
-    (:data:`SAME_FIT_REL`). Reported: :func:`reported` of those and update's fit as it ended; the
-    search starts from it too where it is none of the others (issue 37: every later stage starts from
-    the parameters-only fit reported; report seed 1002 found nothing from the lowest chi^2, whose own
-    refit then left 8.7 % on the frequencies against the reported fit's 3.7 %)."""
+    (:data:`SAME_FIT_REL`). Reported: :func:`reported` of those and update's fit as it ended."""
     if update is None:
         return own, [own], own
     at = np.array([update.values[n] for n in models.names])
     alt = estimate(plain, at, [], [], 4, models.bounds)
     shown = reported(plain, [own, alt, estimate(plain, at, [], [], 0, models.bounds)])
-    base, origins = own, [own]
-    if alt.chi2 < own.chi2:
-        base, origins = alt, [alt] if _same(alt, own) else [alt, own]
-        if len(origins) > 1:
-            say(f"  update's fit leaves the lower chi^2 ({alt.chi2:.5g} against {own.chi2:.5g}): the search starts "
-                "from both")
-    if not any(_same(shown, o) for o in origins):
-        say("  the search also starts from the parameters-only fit reported, which pairs the frequencies best")
-        origins.append(shown)
-    return base, origins, shown
-
-
-def _same(a, b) -> bool:
-    """Whether two fits of the declared parameters are one (:data:`SAME_FIT_REL`)."""
-    return bool(np.all(np.abs(a.p - b.p) <= SAME_FIT_REL * np.abs(b.p)))
+    if not alt.chi2 < own.chi2:
+        return own, [own], shown
+    if np.all(np.abs(alt.p - own.p) <= SAME_FIT_REL * np.abs(own.p)):
+        return alt, [alt], shown
+    say(f"  update's fit leaves the lower chi^2 ({alt.chi2:.5g} against {own.chi2:.5g}): the search starts from both")
+    return alt, [alt, own], shown
 
 
 def reported(plain, fits):
