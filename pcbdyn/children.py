@@ -95,7 +95,9 @@ def _stop(server) -> None:
 def serve(job: int, out: int, preload) -> None:
     """The fork server's loop: for each job announced on ``job``, a child that reads the job ((fn, args),
     pickled) from it, runs it and writes its result to ``out`` (an "R" record); then the child's exit
-    code (an "S" record)."""
+    code (an "S" record). Raw pipes, not :mod:`multiprocessing.connection`: receiving through it allocates
+    in the server's heap at each job, and the children's memory then differed from call to call
+    (tests/fuzz/test_children.py fails with it)."""
     for name in preload:
         importlib.import_module(name)
     while os.read(job, 1):
