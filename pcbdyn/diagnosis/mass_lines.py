@@ -3,7 +3,7 @@ the board; issue 37). A uniform line of mass m and length L has the mass, the ce
 the second moments about its centre of two masses m / 2 at L / (2 sqrt 3) either side of the centre
 (the two-point Gauss rule of the line), so the low modes hardly tell the two apart, and forward
 selection, which adds one point at a time, finds the pair (or one of them as a body with an inertia,
-:mod:`.bodies`). Each two masses found are tried as the line through them, sqrt 3 times as long as
+:mod:`.bodies`, or a mass over a patch of the regions' grid). Each two masses found are tried as the line through them, sqrt 3 times as long as
 they are apart, carrying their summed mass; its ends are then walked to where the data put them (the
 pair stood on nodes), and the line replaces the pair where it lowers the information criterion of
 :mod:`.select` (one effect instead of two or three; two unequal masses apart fit the line worse, and
@@ -32,16 +32,20 @@ from .select import ALPHA, adopt, penalty
 SPREAD = np.sqrt(3.0)
 #: lengths a line standing for one mass is first tried at (each sqrt 2 times the one before)
 LENGTHS = 7
+#: the kinds of mass found that may stand for a line: a point (or its shares), and a mass spread over a
+#: region, the catalogue's other spread mass, which the search picks for a short line across the plate
+#: (dev seed 11: a 4.5 g line 28 mm long across a card came out as 4.2 g over a 20 mm patch at its middle)
+LINE_LIKE = ("point_mass", "region_mass")
 
 
 def masses_found(chosen, values, groups) -> list:
-    """[(positions in ``chosen`` of one mass found: a group of point-mass shares, or a body of
-    :mod:`.bodies` with its inertia (the two share the body's ``centre``), positions of its mass, the
-    mass, its centre (2,) [m])]; ``values``: the chosen effects' magnitudes."""
+    """[(positions in ``chosen`` of one mass found: a group of point-mass shares, a mass over a region,
+    or a body of :mod:`.bodies` with its inertia (the two share the body's ``centre``), positions of its
+    mass, the mass, its centre (2,) [m])]; ``values``: the chosen effects' magnitudes."""
     v = np.asarray(values, float)
     out = []
     for g in groups:
-        if not all(chosen[k].kind == "point_mass" for k in g):
+        if not all(chosen[k].kind in LINE_LIKE for k in g):
             continue
         bodies = {chosen[k].data["centre"] for k in g if "radius" in chosen[k].data}
         inertias = [k for k, c in enumerate(chosen) if c.kind == "point_inertia" and c.data.get("centre") in bodies]
@@ -148,8 +152,8 @@ def walked_in(res, candidates, sel, replaced, m, first, x, build, step, bounds, 
 
 def as_lines(res, candidates: list, sel, reach: float, layout, step: float, bounds=None, newton_steps: int = 8,
              alpha: float = ALPHA):
-    """``sel`` with each pair of chosen point-mass groups (effects within ``reach`` [m], reported as
-    one: :func:`.merge.groups`) refitted as one line mass across ``layout``'s plate (module doc), its
+    """``sel`` with each pair of chosen masses (:data:`LINE_LIKE`; groups of effects within ``reach`` [m],
+    reported as one: :func:`.merge.groups`) refitted as one line mass across ``layout``'s plate (module doc), its
     ends walked from steps of ``step`` [m] (half the model's element size), where that lowers the
     criterion; then each mass left alone tried as lines through its centre, the best walked where it
     already fits better than the mass and kept where the criterion drops by one effect's penalty more

@@ -53,7 +53,7 @@ from .catalogue import KINDS, generate, kind
 from .evidence import evidence
 from .fitting import estimate
 from .layout import from_structure
-from .mass_lines import as_lines
+from .mass_lines import LINE_LIKE, as_lines
 from .merge import MERGE_REACH, groups, mean_path, reported
 from .model_form import MESH_LEVELS, fit_plate_share
 from .moves import REGION_KINDS, LocalMoves, at_grid_node, movable, on_node
@@ -307,7 +307,7 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
     if any(at_grid_node(cands[i]) for i in sel.chosen):
         say("placing the masses and springs found on nodes at their points between the nodes")
         sel = as_points(res, cands, sel, MERGE_REACH * h, layout, h / 2, models.bounds, alpha=alpha)
-    if any(cands[i].kind == "point_mass" for i in sel.chosen):
+    if any(cands[i].kind in LINE_LIKE for i in sel.chosen):
         say("fitting masses found as masses along lines")
         sel = as_lines(res, cands, sel, MERGE_REACH * h, layout, h / 2, models.bounds, alpha=alpha)
     sel = without_vanished(res, cands, sel, models.bounds, alpha=alpha)

@@ -166,3 +166,45 @@ def test_a_point_mass_between_the_nodes_is_no_short_line(card, xy):
     sel = as_lines(res, cands, sel, 0.02, layout, 0.0065)
     assert [cands[i].kind for i in sel.chosen] == ["point_mass"]
     assert sel.values == pytest.approx(fit.values, rel=1e-12)
+
+
+def _region_selection(m, layout, f_test, centre, mass):
+    """The region mass of the catalogue's patch whose centre lies nearest ``centre`` (x, y) [m], fitted to
+    ``f_test`` from ``mass`` [kg], then :func:`as_lines` on it: (candidates, the region's index, its fit,
+    the selection after, the penalty)."""
+    cands = list(dg.generate(layout, kinds=["region_mass"]))
+    near = min(range(len(cands)), key=lambda i: np.linalg.norm(np.subtract(cands[i].at[:2], centre)))
+    res = ModalResidual([Observation(None, MeasuredModes.frequencies_only(f_test), np.full(N_MODES, SIGMA))],
+                        lambda p: [m])
+    fit = estimate(res, np.zeros(0), [cands[near]], [mass], 8)
+    pen = penalty(res.n_rows, len(cands))
+    sel = Selection(chosen=[near], values=fit.values, p=fit.p, chi2=[fit.chi2], criterion=[fit.chi2 + pen],
+                    state=fit.state)
+    return cands, near, fit, as_lines(res, cands, sel, 0.02, layout, 0.0065), pen
+
+
+def test_a_region_mass_standing_in_for_a_line_becomes_the_line(card):
+    """The 12 g line found as a mass over the patch of the regions' grid nearest its centre (the search's
+    other spread mass): tried as lines through that patch's centre and walked, it becomes the line, its
+    mass within 5 %, its ends within 15 mm, its frequencies fitted within the noise and better than the
+    patch's by more than the penalty a line's direction and length pay."""
+    m, layout = card
+    f_test = solve_modes(dg.add_effect(m, KIND.across(layout, *ENDS), 0.012), n_modes=N_MODES).frequencies
+    cands, near, fit, sel, pen = _region_selection(m, layout, f_test, ENDS.mean(axis=0), 0.012)
+    assert [cands[i].kind for i in sel.chosen] == ["line_mass"]
+    assert np.linalg.norm(cands[sel.chosen[0]].geometry["segment"] - ENDS, axis=1).max() < 0.015
+    assert sel.values[0] == pytest.approx(0.012, rel=0.05)
+    assert sel.chi2[-1] < N_MODES and sel.chi2[-1] + pen < fit.chi2
+
+
+def test_a_mass_over_a_region_stays_a_region(card):
+    """A 30 g mass spread over a 40 mm patch (a shield can), found on that patch: no line through it fits
+    the frequencies better by a line's extra penalty, and the region stays with its mass."""
+    m, layout = card
+    cands = list(dg.generate(layout, kinds=["region_mass"]))
+    big = [i for i, c in enumerate(cands) if np.ptp(np.asarray(c.geometry["polygon"])[:, 0]) > 0.035]
+    true = min(big, key=lambda i: np.linalg.norm(np.subtract(cands[i].at[:2], (0.08, 0.09))))
+    f_test = solve_modes(dg.add_effect(m, cands[true], 0.030), n_modes=N_MODES).frequencies
+    cands, near, fit, sel, _ = _region_selection(m, layout, f_test, cands[true].at[:2], 0.030)
+    assert cands[near].name == cands[true].name and fit.chi2 < 1e-6
+    assert [cands[i].kind for i in sel.chosen] == ["region_mass"] and sel.values[0] == pytest.approx(0.030, rel=1e-6)
