@@ -1,19 +1,19 @@
-"""Point masses found that are one mass spread along a line (a cable, a harness, a bar's mass across
-the board; issue 37). A uniform line of mass m and length L has the mass, the centre and
-the second moments about its centre of two masses m / 2 at L / (2 sqrt 3) either side of the centre
-(the two-point Gauss rule of the line), so the low modes hardly tell the two apart, and forward
-selection, which adds one point at a time, finds the pair (or one of them as a body with an inertia,
-:mod:`.bodies`, or a mass over a patch of the regions' grid). Each two masses found are tried as the line through them, sqrt 3 times as long as
-they are apart, carrying their summed mass; its ends are then walked to where the data put them (the
-pair stood on nodes), and the line replaces the pair where it lowers the information criterion of
-:mod:`.select` (one effect instead of two or three; two unequal masses apart fit the line worse, and
-stay). A line the search found as one mass (its centre; a body whose inertia stands for the line's
-second moment) is tried as lines through that centre in four directions and several lengths, the
-best walked the same way; it must lower the criterion by one effect's penalty more, as its direction
-and length are two coordinates a point does not have, and end at least two elements long: a shorter
-line is not one the mesh resolves, and a mass between nodes fits it as well as a point (dev seed 0's
-50 g point mass had become a 7.8 mm line on 6 mm elements). The same walk places a mass or a spring to
-ground found on nodes at its point between them (:mod:`.at_points`)."""
+"""Point masses found that are one mass spread along a line (a cable, a harness, a bar's mass across the
+board; issue 37). A uniform line of mass m and length L has the mass, the centre and the second moments
+about its centre of two masses m / 2 at L / (2 sqrt 3) either side of the centre (the two-point Gauss
+rule of the line), so the low modes hardly tell the two apart, and forward selection, which adds one
+point at a time, finds the pair (or one of them as a body with an inertia, :mod:`.bodies`, or a mass
+over a patch of the regions' grid). Each two masses found are tried as the line through them, sqrt 3
+times as long as they are apart, carrying their summed mass; its ends are then walked to where the data
+put them (the pair stood on nodes), and the line replaces the pair where it lowers the information
+criterion of :mod:`.select` (one effect instead of two or three; two unequal masses apart fit the line
+worse, and stay). A line the search found as one mass (its centre; a body whose inertia stands for the
+line's second moment) is tried as lines through that centre in four directions and several lengths, the
+best walked the same way; it must lower the criterion by one effect's penalty more, as its direction and
+length are two coordinates a point does not have, and end at least two elements long: a shorter line is
+not one the mesh resolves, and a mass between nodes fits it as well as a point (dev seed 0's 50 g point
+mass had become a 7.8 mm line on 6 mm elements). The same walk places a mass or a spring to ground found
+on nodes at its point between them (:mod:`.at_points`)."""
 
 from __future__ import annotations
 
@@ -152,13 +152,12 @@ def walked_in(res, candidates, sel, replaced, m, first, x, build, step, bounds, 
 
 def as_lines(res, candidates: list, sel, reach: float, layout, step: float, bounds=None, newton_steps: int = 8,
              alpha: float = ALPHA):
-    """``sel`` with each pair of chosen masses (:data:`LINE_LIKE`; groups of effects within ``reach`` [m],
-    reported as one: :func:`.merge.groups`) refitted as one line mass across ``layout``'s plate (module doc), its
-    ends walked from steps of ``step`` [m] (half the model's element size), where that lowers the
-    criterion; then each mass left alone tried as lines through its centre, the best walked where it
-    already fits better than the mass and kept where the criterion drops by one effect's penalty more
-    and it ends two elements long or more (module doc). Line candidates are appended to
-    ``candidates``; ``sel`` is updated in place."""
+    """``sel`` with each pair of chosen masses (:data:`LINE_LIKE`; groups of effects within ``reach`` [m], reported
+    as one: :func:`.merge.groups`) refitted as one line mass across ``layout``'s plate (module doc), its ends
+    walked from steps of ``step`` [m] (half the model's element size), where that lowers the criterion; then
+    each mass left alone tried as lines through its centre, the best walked where it already fits better than
+    the mass and kept where the criterion drops by one effect's penalty more and it ends two elements long or
+    more (module doc). Line candidates are appended to ``candidates``; ``sel`` is updated in place."""
     if not layout.planar:
         return sel
     pen = penalty(res.n_rows, len(candidates), alpha)
