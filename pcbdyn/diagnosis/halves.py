@@ -26,11 +26,16 @@ class Halves:
         self.group = np.array([f"{candidates[i].kind}+{candidates[j].kind}" for i, j in self.pairs])
 
     def shortlist(self, A_p, r_p, scale, lower, chosen, per_group: int) -> list:
-        """The ``per_group`` pairs of each pair of kinds whose two columns ``A_p`` (projected off the
-        held ones, as ``r_p``) remove the most chi^2 with both values physical (``lower``), none
-        ``chosen``: the linear score of :func:`.select.search` for an addition of two columns."""
+        """The ``per_group`` pairs of each pair of kinds best by :meth:`gains`."""
         if not self.pairs.size:
             return []
+        gain = self.gains(A_p, r_p, scale, lower, chosen)
+        return [tuple(int(k) for k in self.pairs[m]) for m in per_kind(gain, self.group, per_group)]
+
+    def gains(self, A_p, r_p, scale, lower, chosen) -> np.ndarray:
+        """The chi^2 each pair's two columns ``A_p`` (projected off the held ones, as ``r_p``) remove
+        together, -inf where a value is unphysical (``lower``) or a half ``chosen``: the linear score of
+        :func:`.select.search` for an addition of two columns."""
         a, b = A_p[:, self.pairs[:, 0]], A_p[:, self.pairs[:, 1]]
         g11, g22, g12 = (np.einsum("ij,ij->j", x, y) for x, y in ((a, a), (b, b), (a, b)))
         c1, c2 = a.T @ r_p, b.T @ r_p
@@ -41,7 +46,7 @@ class Halves:
         gain = np.where(ok, v1 * c1 + v2 * c2, -np.inf)
         i, j = self.pairs.T
         gain[(v1 * scale[i] < lower[i]) | (v2 * scale[j] < lower[j]) | np.isin(i, chosen) | np.isin(j, chosen)] = -np.inf
-        return [tuple(int(k) for k in self.pairs[m]) for m in per_kind(gain, self.group, per_group)]
+        return gain
 
 
 def bodies(candidates, idx) -> list:

@@ -28,8 +28,11 @@ lie on a grid coarser than the mesh (``coarse``: regions), is first walked to wh
 tested there (a patch of the coarse grid beside a real region predicts it badly). Where the
 trial that fits best is one that only the screen of saturating kinds or the bodies brought in and it
 is refused, the next best is weighed: they must not hide what the linear shortlist found (a bar on a
-card in guides, behind a guide's stiffness or a heat sink refused). After each addition an earlier
-effect that the others make redundant is dropped (backward check).
+card in guides, behind a guide's stiffness or a heat sink refused). Where a step keeps nothing and the
+chi^2 left exceeds the noise, the bodies with a spring are once tried at a grid of magnitudes on the
+reanalysis (:func:`.scan.resonant`: a bracket whose own mode falls among the structure's), and such a body
+that both first-order predictions refuse is weighed by refits of the folds (:func:`.held_out.refit_share`).
+After each addition an earlier effect that the others make redundant is dropped (backward check).
 """
 
 from __future__ import annotations
@@ -42,9 +45,9 @@ from scipy.stats import chi2 as chi2_dist
 from .catalogue import kind, moved_value
 from .fitting import RANK_STEPS, UPPER, Fit, estimate  # noqa: F401  (re-exported)
 from .halves import Halves, bodies, body_moves, per_kind
-from .held_out import predicts, secant
+from .held_out import HELD_OUT_SHARE, predicts, refit_share, secant
 from .reanalysis import Reanalysis
-from .scan import Runner, rank, saturated, worth_full
+from .scan import Runner, rank, resonant, saturated, worth_full
 
 #: probability that noise alone makes one of the candidates look like an effect (family-wise)
 ALPHA = 0.01
@@ -98,7 +101,7 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
     sel = adopt(Selection(), held, fit, pen)
     if without is not None and without < sel.chi2[0]:
         sel.chi2[0], sel.criterion[0] = without, without + len(held) * pen
-    halves = Halves(candidates)
+    halves, resonant_tried = Halves(candidates), False
     for _ in range(max_effects - len(held)):
         if sel.chi2[-1] <= pen:  # chi^2 >= 0: one more effect cannot lower the criterion
             break
@@ -127,30 +130,52 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
             break
         start = {j: v for j, v in stiff.items() if j not in short}
         adds = [(int(j),) for j in order] + halves.shortlist(A_p, r_p, scale, lower, sel.chosen, shortlist)
-        trials = [([candidates[i] for i in sel.chosen + list(add)],
-                   np.r_[sel.values, [start.get(j, max(value[j], 0.0)) for j in add]]) for add in adds]
-        fits = rank(res, st, trials, fit.p, bounds, P, runner, rx)
-        # ranked by the criterion: a pair pays for its second effect
-        crit = np.array([np.inf if f is None else f.chi2 + len(add) * pen for f, add in zip(fits, adds)])
-        new = None
-        for best in np.argsort(crit, kind="stable"):
-            if not np.isfinite(crit[best]):
-                break
-            add = list(adds[best])
-            idx = sel.chosen + add
-            new = _kept(res, candidates, sel, fit, idx, fits[best], held, A[:, add], scale[idx], newton_steps,
-                        bounds, pen, p0.size, len(add))
-            if new is None and moves is not None and len(add) == 1 and \
-                    worth(sel.chi2[-1], fits[best].chi2, n, p0.size + len(idx), pen):
-                new, idx = _walked(res, candidates, sel, fit, add[0], fits[best], held, moves, newton_steps, bounds,
-                                   pen, p0.size, runner, alpha)
-            if new is not None or (len(add) == 1 and add[0] not in start):  # a screened support or a body
-                break  # refused does not end the step
+        step = (res, candidates, sel, fit, held, A, scale, value, P, rx, newton_steps, bounds, pen, p0.size, runner,
+                moves, alpha)
+        new, idx = _weighed(step, adds, start)
+        if new is None and not resonant_tried and chi2_dist.sf(sel.chi2[-1], n - p0.size - len(sel.chosen)) < alpha:
+            resonant_tried = True
+            bodies_ = resonant(rx, [candidates[i] for i in sel.chosen], sel.values, candidates, halves.pairs,
+                               halves.gains(A_p, r_p, scale, lower, sel.chosen), shortlist)
+            new, idx = _weighed(step, [pair for pair, _ in bodies_],
+                                {j: v for pair, vs in bodies_ for j, v in zip(pair, vs)})
         if new is None:
             break
         idx, fit = _prune(res, candidates, idx, new, newton_steps, bounds, pen, p0.size, runner)
         adopt(sel, idx, fit, pen)
     return sel
+
+
+def _weighed(step, adds: list, start: dict) -> tuple:
+    """(estimate, effects) of the first of the additions ``adds`` (tuples of candidate indices), ranked by
+    the criterion of their trial fits (:func:`.scan.rank`, from the magnitudes ``start`` gives or else
+    their linear estimates; a pair pays for its second effect), that is kept (:func:`_kept`, an addition
+    of a ``coarse`` kind first walked: :func:`_walked`); (None, None) where none is. A screened support
+    or body refused gives way to the next best; a candidate of the linear shortlist refused ends the
+    step. ``step``: the search's state at this step (:func:`search`)."""
+    res, candidates, sel, fit, held, A, scale, value, P, rx, newton_steps, bounds, pen, n_params, runner, moves, \
+        alpha = step
+    trials = [([candidates[i] for i in sel.chosen + list(add)],
+               np.r_[sel.values, [start.get(j, max(value[j], 0.0)) for j in add]]) for add in adds]
+    fits = rank(res, fit.state, trials, fit.p, bounds, P, runner, rx)
+    crit = np.array([np.inf if f is None else f.chi2 + len(add) * pen for f, add in zip(fits, adds)])
+    for best in np.argsort(crit, kind="stable"):
+        if not np.isfinite(crit[best]):
+            break
+        add = list(adds[best])
+        idx = sel.chosen + add
+        resonant_body = len(add) == 2 and any(getattr(kind(candidates[j].kind), "saturates", False) for j in add)
+        new = _kept(res, candidates, sel, fit, idx, fits[best], held, A[:, add], scale[idx], newton_steps,
+                    bounds, pen, n_params, len(add), (rx, P) if resonant_body else None)
+        if new is None and moves is not None and len(add) == 1 and \
+                worth(sel.chi2[-1], fits[best].chi2, res.n_rows, n_params + len(idx), pen):
+            new, idx = _walked(res, candidates, sel, fit, add[0], fits[best], held, moves, newton_steps, bounds,
+                               pen, n_params, runner, alpha)
+        if new is not None:
+            return new, idx
+        if len(add) == 1 and add[0] not in start:
+            break
+    return None, None
 
 
 def _walked(res, candidates, sel, fit, j, trial, held, moves, newton_steps, bounds, pen, n_params, runner,
@@ -183,21 +208,28 @@ def _walked(res, candidates, sel, fit, j, trial, held, moves, newton_steps, boun
 
 
 def _kept(res, candidates, sel, fit, idx, trial, held, column, scale, newton_steps, bounds, pen, n_params,
-          n_added: int = 1):
+          n_added: int = 1, refit=None):
     """The estimate of effects ``idx`` (the chosen ones and an addition of its last ``n_added``, whose
     trial fit is ``trial`` and columns at the state without it ``column``) when the addition is kept: its
     chi^2 drop is worth ``n_added`` penalties ``pen`` (:func:`worth`) and it predicts the held-out folds
     to first order (:func:`.held_out.predicts`) from the state without it or along the secant to the
     state with it (:func:`.held_out.secant`); else None. Either first-order model can fail a real effect
     where the modes respond nonlinearly (a share of a mass beside another: the secant; a bar across the
-    card: the state without it); a model error taken for an effect fails both."""
+    card: the state without it); a model error taken for an effect fails both. ``refit``: (reanalysis, the
+    parameters' columns there) for a body with a mode of its own, which is then also weighed by its folds'
+    refits (:func:`.held_out.refit_share`) where both first-order models fail it."""
     new = estimate(res, fit.p, [candidates[i] for i in idx], trial.values, newton_steps, bounds)
     if not worth(sel.chi2[-1], new.chi2, res.n_rows, n_params + len(idx), n_added * pen):
         return None
     r = fit.state.r
     if predicts(res, r, held, column):
         return new
-    return new if predicts(res, r, *secant(res, held, column, new, [candidates[i] for i in idx], scale)) else None
+    if predicts(res, r, *secant(res, held, column, new, [candidates[i] for i in idx], scale)):
+        return new
+    if refit is not None and refit_share(res, *refit, fit, new, [candidates[i] for i in idx], n_added,
+                                         bounds) >= HELD_OUT_SHARE:
+        return new
+    return None
 
 
 def adopt(sel: Selection, idx: list, fit: Fit, pen: float) -> Selection:

@@ -275,9 +275,11 @@ def test_distances_to_segments_used_to_merge_effects():
 @pytest.mark.parametrize("kinds, xy, values", [
     (("region_stiffness", "region_mass"), (0.10, 0.12), (3.0, 0.04)),  # a heat sink: 4x as stiff, 40 g
     (("point_mass", "ground_spring"), (0.11, 0.15), (0.015, 3e4)),  # a bracket: 15 g held by a spring
-    pytest.param(("point_mass", "ground_spring"), (0.05, 0.07), (0.02, 1e5), marks=pytest.mark.xfail(strict=True, reason=(
-        "from eight frequencies alone the spring beside the mass predicts 5 of the 8 left-out modes, where each "
-        "half of a body must predict 6 (held_out.predicts): nothing is reported, chi^2 7071 is left"))),
+    # brackets whose own mode (356 and 280 Hz) falls among the card's (183-1310 Hz): no first-order prediction
+    # of the left-out modes follows them (before the folds' refits, :func:`.held_out.refit_share`: nothing
+    # reported, chi^2 7071 and 2258 left)
+    (("point_mass", "ground_spring"), (0.05, 0.07), (0.02, 1e5)),
+    (("point_mass", "ground_spring"), (0.05, 0.07), (0.011, 3.4e4)),
 ])
 def test_a_body_of_two_effects_at_one_place_is_found_as_both(card, kinds, xy, values):
     """A heat sink (a region stiffer and heavier) and a bracket (a mass on a spring at one point): each
