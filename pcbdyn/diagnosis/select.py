@@ -138,7 +138,7 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
             bodies_ = resonant(rx, [candidates[i] for i in sel.chosen], sel.values, candidates, halves.pairs,
                                halves.gains(A_p, r_p, scale, lower, sel.chosen), shortlist)
             new, idx = _weighed(step, [pair for pair, _ in bodies_],
-                                {j: v for pair, vs in bodies_ for j, v in zip(pair, vs)})
+                                {j: v for pair, vs in bodies_ for j, v in zip(pair, vs)}, refit=True)
         if new is None:
             break
         idx, fit = _prune(res, candidates, idx, new, newton_steps, bounds, pen, p0.size, runner)
@@ -146,13 +146,15 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
     return sel
 
 
-def _weighed(step, adds: list, start: dict) -> tuple:
+def _weighed(step, adds: list, start: dict, refit: bool = False) -> tuple:
     """(estimate, effects) of the first of the additions ``adds`` (tuples of candidate indices), ranked by
     the criterion of their trial fits (:func:`.scan.rank`, from the magnitudes ``start`` gives or else
     their linear estimates; a pair pays for its second effect), that is kept (:func:`_kept`, an addition
     of a ``coarse`` kind first walked: :func:`_walked`); (None, None) where none is. A screened support
     or body refused gives way to the next best; a candidate of the linear shortlist refused ends the
-    step. ``step``: the search's state at this step (:func:`search`)."""
+    step. ``step``: the search's state at this step (:func:`search`); ``refit``: the additions are the bodies
+    of :func:`.scan.resonant`, which the folds' refits may keep (:func:`_kept`; the linear shortlist's are not:
+    so weighed, a spring rode along a box's hidden mass and a line mass of the hold-out's card)."""
     res, candidates, sel, fit, held, A, scale, value, P, rx, newton_steps, bounds, pen, n_params, runner, moves, \
         alpha = step
     trials = [([candidates[i] for i in sel.chosen + list(add)],
@@ -164,9 +166,8 @@ def _weighed(step, adds: list, start: dict) -> tuple:
             break
         add = list(adds[best])
         idx = sel.chosen + add
-        resonant_body = len(add) == 2 and any(getattr(kind(candidates[j].kind), "saturates", False) for j in add)
         new = _kept(res, candidates, sel, fit, idx, fits[best], held, A[:, add], scale[idx], newton_steps,
-                    bounds, pen, n_params, len(add), (rx, P) if resonant_body else None)
+                    bounds, pen, n_params, len(add), (rx, P) if refit else None)
         if new is None and moves is not None and len(add) == 1 and \
                 worth(sel.chi2[-1], fits[best].chi2, res.n_rows, n_params + len(idx), pen):
             new, idx = _walked(res, candidates, sel, fit, add[0], fits[best], held, moves, newton_steps, bounds,
