@@ -34,15 +34,22 @@ def held_out_share(res, r, held, column) -> float:
     5: selection checked by cross-validation across modes and configurations). Counting folds, not
     adding their chi^2, keeps one fold that a large effect's linearisation overshoots (a mode it moves
     onto another) from outvoting the rest."""
+    def errors(test):
+        for A in (held, np.column_stack([held, column])):
+            e = r[test] - A[test] @ fit_without(A, r, test)
+            yield float(e @ e)
+
+    return _better_share(res, errors)
+
+
+def _better_share(res, errors) -> float:
+    """The share of the :func:`folds` of ``res`` on which ``errors(fold mask)`` (the fold's chi^2 predicted
+    without and with an addition) drops by more than a unit of chi^2, the noise's own scale."""
     groups = folds(res)
     better = []
     for f in np.unique(groups):
-        test = groups == f
-        err = []
-        for A in (held, np.column_stack([held, column])):
-            e = r[test] - A[test] @ fit_without(A, r, test)
-            err.append(float(e @ e))
-        better.append(err[1] < err[0] - 1.0)  # by more than a unit of chi^2: the noise's own scale
+        without, with_ = errors(groups == f)
+        better.append(with_ < without - 1.0)
     return float(np.mean(better))
 
 
@@ -123,15 +130,12 @@ def refit_share(res, rx, P, without: Fit, with_: Fit, effects: list, n_added: in
     spring has a mode of its own: its two magnitudes move the structure's modes together, far and in
     opposite senses, so that neither the state without it nor the secant predicts a fold (dev seed 23's
     11 g bracket on 35 kN/m); the refit follows it as the full fit does."""
-    groups = folds(res)
-    better = []
-    for f in np.unique(groups):
-        test, w = groups == f, (groups != f).astype(float)
-        err = []
+    def errors(test):
+        w = (~test).astype(float)
         for fit, cands in ((without, effects[:-n_added]), (with_, effects)):
             part = estimate(_Rows(res, w), fit.p, cands, fit.values, REFIT_STEPS, bounds, param_columns=P * w[:, None],
                             reduced=_Rows(rx, w))
             r = np.inf if part.state is None else part.state.inner.r[test]
-            err.append(float(np.sum(r * r)))
-        better.append(err[1] < err[0] - 1.0)
-    return float(np.mean(better))
+            yield float(np.sum(r * r))
+
+    return _better_share(res, errors)

@@ -141,12 +141,9 @@ def saturated(rx, effects, values, candidates, gain, per_kind: int) -> dict:
         spec = kind(k)
         idx = np.flatnonzero((kinds == k) & np.isfinite(gain))
         idx = idx[np.argsort(-gain[idx], kind="stable")[:getattr(spec, "saturated_screen", SATURATED_SCREEN)]]
-        best = []
-        for j in idx:
-            tried = [(_reduced_chi2(rx, rx.st.p, list(effects) + [candidates[j]], np.r_[values, v]), v)
-                     for v in spec.scale * np.asarray(getattr(spec, "saturated_values", SATURATED_VALUES))]
-            best.append((*min(tried), int(j)))
-        out.update({j: v for _, v, j in sorted(best)[:per_kind]})
+        grid = spec.scale * np.asarray(getattr(spec, "saturated_values", SATURATED_VALUES), float)[:, None]
+        out.update({add[0]: v[0] for add, v in _on_grid(rx, effects, values, candidates, [(int(j),) for j in idx],
+                                                        [grid] * idx.size, per_kind)})
     return out
 
 
@@ -161,15 +158,22 @@ def resonant(rx, effects, values, candidates, pairs, gain, per_group: int) -> li
     sat = np.array([any(getattr(candidates[j].spec, "saturates", False) for j in pair) for pair in pairs], bool)
     idx = np.flatnonzero(sat & np.isfinite(gain))
     idx = idx[np.argsort(-gain[idx], kind="stable")[:RESONANT_SCREEN]]
-    grid = np.asarray(RESONANT_VALUES)
+    combos = np.array([(a, b) for a in RESONANT_VALUES for b in RESONANT_VALUES], float)
+    adds = [tuple(int(k) for k in pairs[m]) for m in idx]
+    grids = [combos * [candidates[i].spec.scale, candidates[j].spec.scale] for i, j in adds]
+    return _on_grid(rx, effects, values, candidates, adds, grids, per_group)
+
+
+def _on_grid(rx, effects, values, candidates, adds: list, grids: list, keep: int) -> list:
+    """[(addition, its magnitudes)]: the ``keep`` additions ``adds`` (tuples of candidate indices) that
+    leave the least chi^2 on the reanalysis ``rx`` of a state (its parameters, ``effects`` at
+    ``values``), each at the best row of its grid of magnitudes (``grids``: one (n, len(addition))
+    array per addition): the screens of :func:`saturated` and :func:`resonant`."""
     best = []
-    for m in idx:
-        i, j = (int(k) for k in pairs[m])
-        scale = np.array([candidates[i].spec.scale, candidates[j].spec.scale])
-        tried = [(_reduced_chi2(rx, rx.st.p, list(effects) + [candidates[i], candidates[j]], np.r_[values, v]), tuple(v))
-                 for v in scale * np.array([(a, b) for a in grid for b in grid])]
-        best.append((*min(tried), (i, j)))
-    return [(pair, np.array(v)) for _, v, pair in sorted(best)[:per_group]]
+    for add, grid in zip(adds, grids):
+        cands = list(effects) + [candidates[j] for j in add]
+        best.append((*min((_reduced_chi2(rx, rx.st.p, cands, np.r_[values, v]), tuple(v)) for v in grid), add))
+    return [(add, np.array(v)) for _, v, add in sorted(best)[:keep]]
 
 
 def _reduced_chi2(rx, p, cands, values) -> float:

@@ -135,10 +135,10 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
         new, idx = _weighed(step, adds, start)
         if new is None and not resonant_tried and chi2_dist.sf(sel.chi2[-1], n - p0.size - len(sel.chosen)) < alpha:
             resonant_tried = True
-            bodies_ = resonant(rx, [candidates[i] for i in sel.chosen], sel.values, candidates, halves.pairs,
+            screened = resonant(rx, [candidates[i] for i in sel.chosen], sel.values, candidates, halves.pairs,
                                halves.gains(A_p, r_p, scale, lower, sel.chosen), shortlist)
-            new, idx = _weighed(step, [pair for pair, _ in bodies_],
-                                {j: v for pair, vs in bodies_ for j, v in zip(pair, vs)}, refit=True)
+            new, idx = _weighed(step, [pair for pair, _ in screened],
+                                {j: v for pair, vs in screened for j, v in zip(pair, vs)}, refit=True)
         if new is None:
             break
         idx, fit = _prune(res, candidates, idx, new, newton_steps, bounds, pen, p0.size, runner)
