@@ -125,6 +125,7 @@ def judge(truth: dict, result: dict, detectable_chi2: float) -> dict:
             used.add(j)
             r = reported[j]
             row["reported"] = r["magnitude"]
+            row["reported_kind"] = r.get("kind", r.get("type"))
             row["sigma"] = r.get("uncertainty")
             if mag is None:
                 row.update(sized=True, covered=None, covered_1sigma=None)

@@ -13,7 +13,7 @@ import shapely
 from ..fe.probe import segment_parameter
 from .catalogue import kind, weighted_centre
 from .moves import REGION_KINDS, overlap, rectangle
-from .uncertainty import at_state, interval, jackknife_cov, parts, place_cov, place_range, profile_interval
+from .uncertainty import at_state, interval, jackknife_cov, model_form, parts, place_cov, place_range, profile_interval
 
 #: kinds that act at one node: an effect between nodes is shared by its neighbours
 POINT_KINDS = ("point_mass", "point_inertia", "ground_spring")
@@ -110,7 +110,7 @@ def merged(chosen, values, cov, cov_jack, cov_place, group, profile=None, places
         d["mass_kg"] = float(sum(chosen[k].spec.mass(chosen[k], values[k]) for k in group))
         d["section_height_mm"] = round(1e3 * c.spec.section_of(c).h, 4)
     sub = np.ix_(group, group)
-    u = parts(float(w @ v), w, cov[sub] if cov.size else cov, cov_jack[sub], cov_place[sub], places)
+    u = parts(float(w @ v), w, cov[sub] if cov.size else cov, cov_jack[sub], cov_place[sub], places, model_form(c.kind))
     d["interval_2sigma"] = interval(float(w @ v), u, profile, c.spec.lower)
     d.update(magnitude=float(w @ v), uncertainty=u.pop("total"), uncertainty_parts=u, kind=c.kind)
     return d

@@ -245,6 +245,7 @@ def test_overlapping_regions_are_reported_as_one_with_their_mean_change(card):
     cover (their union, not its bounding box), with the mean change over it, so that the change's
     integral over the board is what the two add."""
     from pcbdyn.diagnosis.merge import groups, merged
+    from pcbdyn.diagnosis.uncertainty import model_form
 
     m, _ = card
     layout = dg.from_model(m)
@@ -259,6 +260,7 @@ def test_overlapping_regions_are_reported_as_one_with_their_mean_change(card):
     assert not union.contains(shapely.Point(70.0, 30.0))  # a corner of the bounding box neither covers
     assert d["magnitude"] * union.area == pytest.approx((2.0 + 1.0) * 40.0**2)
     assert d["at_mm"] == pytest.approx([50.0, 50.0])
+    assert d["uncertainty_parts"]["model_form"] == pytest.approx(model_form("region_stiffness") * d["magnitude"])
 
 
 def test_distances_to_segments_used_to_merge_effects():
