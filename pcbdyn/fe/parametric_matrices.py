@@ -6,7 +6,11 @@ each. :class:`ParametricMatrices` interpolates each set once, on the tensor grid
 points per parameter across the parameter's bounds, and checks the interpolant against a direct
 assembly at one more point; K and M at any parameter values, and their exact derivatives, are then
 sums of coefficient arrays times monomials: no element matrix is recomputed while a fit moves the
-parameters (a fit of the six-part card's four parameters re-solves it hundreds of times). A set
+parameters (a fit of the six-part card's four parameters re-solves it hundreds of times). A
+parameter that a set of its own shows to enter with a lower degree (a modulus or a density enters
+linearly) is interpolated on that many points in the sets it shares with others, and those are
+checked as any other (the card's parts, on E and their thickness: 9 assemblies each instead of 17,
+which halves the interpolation of a model meshed once for a trial, as a diagnosis's rib fit does). A set
 that fails the check (a quantity entering otherwise, such as a Timoshenko beam's shear term) or
 depends on more than :data:`MAX_PARAMS` parameters is made again from its property at each call,
 its derivatives by central differences with :meth:`.parametric.Parameter.step`, as
@@ -37,8 +41,15 @@ FULL_SHARE = 0.5
 #: relative step of the central differences of the sets made at each call
 REL_STEP = 1e-4
 
-_NODES = np.cos(np.pi * (np.arange(DEGREE + 1) + 0.5) / (DEGREE + 1))  # Chebyshev points in [-1, 1]
-_INV_V = np.linalg.inv(np.vander(_NODES, DEGREE + 1, increasing=True))
+
+def _chebyshev(degree: int) -> tuple[np.ndarray, np.ndarray]:
+    """(the degree + 1 Chebyshev points in [-1, 1], the inverse of their Vandermonde matrix: values at
+    the points -> power coefficients)."""
+    nodes = np.cos(np.pi * (np.arange(degree + 1) + 0.5) / (degree + 1))
+    return nodes, np.linalg.inv(np.vander(nodes, degree + 1, increasing=True))
+
+
+_GRIDS = {d: _chebyshev(d) for d in range(DEGREE + 1)}
 
 
 class _Set:
@@ -83,6 +94,7 @@ class ParametricMatrices:
             self.centre[j], self.half[j] = 0.5 * (lo + hi), 0.5 * (hi - lo)
         self.const = np.zeros((2, self.asm.nnz))
         self.sets: list[_Set] = []
+        self._degree: dict = {}  # {j: the highest power of parameter j in the sets of it alone}
         for name in self.asm.names:
             mk = pm.makers.get(name)
             js = [j for j in own if mk is not None and targets[j] & set(mk.deps)]
@@ -109,17 +121,33 @@ class ParametricMatrices:
         return np.array(self.asm.values(name, self.pm.makers[name].make(q)))
 
     def _interpolated(self, name, js, pos) -> _Set:
-        """The set interpolated on the Chebyshev grid of its parameters ``js``, checked at
-        :data:`CHECK_AT`; a set made at each call where the check fails."""
+        """The set interpolated on the Chebyshev grid of its parameters ``js`` (on as many points per
+        parameter as its degree in the sets of it alone, else :data:`DEGREE` + 1), checked at
+        :data:`CHECK_AT`; on the full grid where that check fails; a set made at each call where
+        this one fails too."""
+        full = [DEGREE] * len(js)
+        degrees = [self._degree.get(j, DEGREE) for j in js]
+        s = self._fitted(name, js, pos, degrees)
+        if s is None and degrees != full:
+            s = self._fitted(name, js, pos, full)
+        if s is None:
+            return _Set(name, js, pos)
+        if len(js) == 1:
+            self._degree[js[0]] = max(self._degree.get(js[0], 0), int(s.exps.max(initial=0)))
+        return s
+
+    def _fitted(self, name, js, pos, degrees) -> _Set | None:
+        """The set interpolated on the tensor grid of ``degrees[i]`` + 1 Chebyshev points along parameter
+        ``js[i]``, or None where it misses a direct assembly at :data:`CHECK_AT`."""
         k = len(js)
-        grid = np.empty((DEGREE + 1,) * k + (2, pos.size))
+        grid = np.empty(tuple(d + 1 for d in degrees) + (2, pos.size))
         p = self.centre.copy()
         for node in np.ndindex(*grid.shape[:k]):
-            p[js] = self.centre[js] + self.half[js] * _NODES[list(node)]
+            p[js] = self.centre[js] + self.half[js] * np.array([_GRIDS[d][0][i] for d, i in zip(degrees, node)])
             grid[node] = self._direct(name, p)
         coef = grid
-        for axis in range(k):  # values at the nodes -> power coefficients, one axis at a time
-            coef = np.moveaxis(np.tensordot(_INV_V, coef, axes=([1], [axis])), 0, axis)
+        for axis, d in enumerate(degrees):  # values at the nodes -> power coefficients, one axis at a time
+            coef = np.moveaxis(np.tensordot(_GRIDS[d][1], coef, axes=([1], [axis])), 0, axis)
         exps = np.array(list(np.ndindex(*coef.shape[:k])), dtype=np.int64).reshape(-1, k)
         coef = coef.reshape(-1, 2, pos.size)
         keep = np.abs(coef).max(axis=(1, 2)) > 1e-12 * (np.abs(coef).max() or 1.0)  # E and springs enter linearly
@@ -134,7 +162,7 @@ class ParametricMatrices:
         got = s.values(x)
         err = np.abs((got[:, pos] if whole else got) - direct)
         if np.any(err.max(axis=1) > CHECK_RTOL * np.maximum(np.abs(direct).max(axis=1), 1e-300)):
-            return _Set(name, js, pos)
+            return None
         return s
 
     # --- values --------------------------------------------------------------------------------

@@ -53,3 +53,24 @@ def test_derivatives_match_central_differences(models):
             fd = (a - b) / (2 * h)
             # round-off of the differences: 1e-13 of the matrix over the step
             assert abs(got - fd).max() <= 1e-5 * abs(fd).max() + 1e-13 * abs(a).max() / h, models.names[j]
+
+
+def test_a_degree_learned_too_low_falls_back_to_the_full_grid(models):
+    """E enters linearly (its own set, the laminate, shows it), so the parts' sets are interpolated on
+    two points along E; a part's thickness taken as linear too (it enters the bending as t^3) is
+    refused by the check and the full cubic grid gives the set, equal to an assembly off every node."""
+    from pcbdyn.fe.parametric_matrices import DEGREE, ParametricMatrices
+
+    pmx = models.parametric[0]
+    e = models.names.index("E_board")
+    assert pmx._degree[e] == 1
+    part = next(s for s in pmx.sets if len(s.js) == 2)
+    t = next(j for j in part.js if j != e)
+    fresh = ParametricMatrices(models.models[0], models.names)
+    fresh._degree = {e: 1, t: 1}
+    s = fresh._interpolated(part.name, part.js, part.pos)
+    assert s.coef is not None and s.exps[:, part.js.index(t)].max() == DEGREE
+    x = np.zeros(len(models.names))
+    x[part.js] = (-0.41, 0.63)
+    direct = fresh._direct(part.name, fresh.centre + fresh.half * x)
+    assert np.abs(s.values(x) - direct).max() <= 1e-9 * np.abs(direct).max()
