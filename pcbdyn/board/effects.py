@@ -53,16 +53,13 @@ def tributary_weights(xy: np.ndarray) -> np.ndarray:
     return w / w.sum()
 
 
-def area_weights(xy: np.ndarray, conns, nodes: np.ndarray, shares=None) -> np.ndarray:
+def area_weights(xy: np.ndarray, conns, nodes: np.ndarray) -> np.ndarray:
     """Tributary-area fractions (sum 1) of ``nodes`` over the cells ``conns`` (arrays of node rows,
-    polygons in the plane of ``xy`` (n, 2)): each cell's area, times its ``shares`` (arrays of the
-    fraction of each cell that counts; all of it by default), shared equally by its corners."""
+    polygons in the plane of ``xy`` (n, 2)): each cell's area shared equally by its corners."""
     w = np.zeros(len(xy))
-    for k, conn in enumerate(conns):
+    for conn in conns:
         p, q = xy[conn], xy[np.roll(conn, -1, axis=1)]
         area = 0.5 * np.abs(np.sum(p[..., 0] * q[..., 1] - q[..., 0] * p[..., 1], axis=1))
-        if shares is not None:
-            area = area * shares[k]
         np.add.at(w, conn, np.repeat(area / conn.shape[1], conn.shape[1]).reshape(conn.shape))
     return w[nodes] / w[nodes].sum()
 

@@ -83,27 +83,12 @@ class LocalMoves:
         self.shell = set(layout.shell_nodes().tolist())
         plate = layout.xy[layout.shell_nodes()]
         self.lo, self.hi = plate.min(axis=0), plate.max(axis=0)
-        self.lines = [np.unique(np.round(plate[:, k], 9)) for k in (0, 1)]  # [m] the nodes' x and y
         self.index = {c.name: k for k, c in enumerate(cands)}
         self.runs: dict = {}
         for k, c in enumerate(cands):
             if "run" in c.data:
                 side, i, j = c.data["run"]
                 self.runs.setdefault((c.kind, side), {})[(i, j)] = k
-
-    def _on_lines(self, box, moved) -> np.ndarray:
-        """``box`` (x0, y0, x1, y1) [m] with its ``moved`` sides taken to the nearest line of the mesh's
-        nodes within half a step: the walk goes from cell edge to cell edge, as a region of whole cells
-        would, and :mod:`.region_sides` fits the sides between them (walked a step off the lines from
-        where the patch grid cuts the cells, a heat sink on a 13 mm mesh stopped over 20 x 47 mm at 12
-        times the stiffness, chi^2 44, against the truth's 53 x 64 mm at 3)."""
-        out = np.array(box, float)
-        for k in np.flatnonzero(moved):
-            lines = self.lines[k % 2]
-            near = lines[np.argmin(np.abs(lines - out[k]))]
-            if abs(near - out[k]) <= 0.5 * RECT_STEP * self.h:
-                out[k] = near
-        return out
 
     def _add(self, made) -> list:
         out = []
@@ -167,8 +152,8 @@ class LocalMoves:
             return self._add(made)
         if (box := rectangle(c)) is not None:
             lo, hi, step, made = np.tile(self.lo, 2), np.tile(self.hi, 2), RECT_STEP * self.h, []
-            for d in [np.zeros(4), *_rect_moves(step)]:  # first: all four sides to the lines nearest them
-                b = self._on_lines(np.clip(np.array(box) + d, lo, hi), np.abs(d) > 0 if d.any() else np.ones(4, bool))
+            for d in _rect_moves(step):
+                b = np.clip(np.array(box) + d, lo, hi)
                 if b[2] - b[0] >= step and b[3] - b[1] >= step and not np.allclose(b, box):
                     made.append(c.spec.rectangle(self.layout, *b))
             return self._add([r for r in made if r is not None])

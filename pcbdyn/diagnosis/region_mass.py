@@ -1,9 +1,9 @@
 """``region_mass``: a mass m [kg] spread uniformly over a region of the board (a heat sink, a shield
 can, a potted block: a body glued over an area, whose mass moves with the plate under it and whose
 stiffness is the region's stiffness change, :mod:`.region_stiffness`). The mass is lumped at the
-region's nodes by their tributary area (the area the region covers of each cell, shared equally by
-its corners) on the three translations, as a board's ``[[regions]]`` entry with a ``mass`` builds it;
-M is linear in m (weights summing to one), K does not depend on it.
+region's nodes by their tributary area (each cell's area shared equally by its corners) on the three
+translations, as a board's ``[[regions]]`` entry with a ``mass`` builds it; M is linear in m (weights
+summing to one), K does not depend on it.
 
 Candidates: the regions of :mod:`.region_stiffness` (patches of two sizes and the parts' footprints),
 on a board only: on a housing those regions are whole plates, whose mass is a declared density.
@@ -39,11 +39,8 @@ class _RegionMass(SpreadMass, _RegionStiffness):
 
     @staticmethod
     def weights(model, candidate) -> np.ndarray:
-        """The share of the mass at each of ``candidate.nodes`` (sum 1): the area the region covers of
-        each cell shared by its corners."""
-        cells = candidate.data["cells"]
-        return area_weights(model.nodes[:, :2], list(cells.values()), candidate.nodes,
-                            [candidate.data["share"][e] for e in cells])
+        """The share of the mass at each of ``candidate.nodes`` (sum 1)."""
+        return area_weights(model.nodes[:, :2], list(candidate.data["cells"].values()), candidate.nodes)
 
 
 KIND = _RegionMass()

@@ -1,14 +1,12 @@
 """``region_stiffness``: a relative change s (dimensionless) of the membrane, bending and shear
 stiffness of the shells in a region (a local thickness or modulus error, a part stiffening the
-board, a delamination when s < 0). A cell the region covers a share w of has its element stiffness
-made (1 + w s) K_e and its mass unchanged, so K is linear in s with dK/ds = the sum of w K_e over the
-region's cells, dM/ds = 0, and K moves continuously with the region's outline
-(:mod:`.region_sides` fits a rectangle's sides). A thickness change dt corresponds to s of about
-3 dt / t in bending.
+board, a delamination when s < 0). The region's element stiffness becomes (1 + s) K_e and its mass is
+unchanged, so K is linear in s with dK/ds = the region's element stiffness, dM/ds = 0.
+A thickness change dt corresponds to s of about 3 dt / t in bending.
 
-A candidate holds its cells (node rows) and their shares, not their properties: dK/ds and the added
-effect use the properties the cells have in the model they are applied to, so a region effect follows
-the declared parameters (board E, part thickness) when both are estimated together, and overlapping
+A candidate holds its cells (node rows), not their properties: dK/ds and the added effect use the
+properties the cells have in the model they are applied to, so a region effect follows the
+declared parameters (board E, part thickness) when both are estimated together, and overlapping
 region effects add up.
 
 Candidates: a grid of square patches of side ``patch`` [m], grids of twice that side (aligned and
@@ -27,78 +25,44 @@ from ..board.effects import ScaledShell
 from ..fe.elements import kernel
 from .catalogue import register, Blocks, Candidate
 
-#: a cell a region covers less of than this share is left out of it (a sliver adds cost, not stiffness)
-MIN_SHARE = 1e-3
-#: [m] a rectangle's corners lie on this grid (its sides are fitted continuously: :mod:`.region_sides`)
-CORNER_GRID = 1e-5
 
-
-def _area_centroid(conns, xy, shares) -> tuple:
-    """(area, area centroid) of a set of polygonal cells, each counted by its covered share (shoelace
-    formula per cell; in 3-D, ``xy`` (n, 3), triangle fans of planar cells)."""
+def _area_centroid(conns, xy) -> tuple:
+    """(area, area centroid) of a set of polygonal cells (shoelace formula per cell; in 3-D, ``xy``
+    (n, 3), triangle fans of planar cells)."""
     if xy.shape[1] == 3:
         area, moment = 0.0, np.zeros(3)
-        for c, w in zip(conns, shares):
+        for c in conns:
             p = xy[c]
             for k in range(1, c.shape[1] - 1):
-                a = w * 0.5 * np.linalg.norm(np.cross(p[:, k] - p[:, 0], p[:, k + 1] - p[:, 0]), axis=1)
+                a = 0.5 * np.linalg.norm(np.cross(p[:, k] - p[:, 0], p[:, k + 1] - p[:, 0]), axis=1)
                 area += a.sum()
                 moment += a @ ((p[:, 0] + p[:, k] + p[:, k + 1]) / 3.0)
         return area, moment / area
     area, moment = 0.0, np.zeros(2)
-    for c, w in zip(conns, shares):
+    for c in conns:
         p, q = xy[c], xy[np.roll(c, -1, axis=1)]
-        cross = w[:, None] * (p[..., 0] * q[..., 1] - q[..., 0] * p[..., 1])
+        cross = p[..., 0] * q[..., 1] - q[..., 0] * p[..., 1]
         area += cross.sum() / 2.0
         moment += np.einsum("cv,cvk->k", cross, p + q) / 6.0
     return area, moment / area
 
 
-def _covered(layout, polygon) -> list:
-    """[(set name, cell indices, covered fraction)] of the shell cells ``polygon`` [m] covers: on a plate
-    in one plane, every cell it overlaps with the share of the cell's area inside it, so that a region
-    grows continuously with its sides (by centroids, a 19 x 28 mm region on an 8 mm mesh held 458 of its
-    549 mm^2, and a side's move of less than an element changed nothing); in 3-D (a box's plates), the
-    cells whose centroid lies in it, whole."""
-    polygon = np.asarray(polygon, dtype=float)
-    if polygon.shape[1] == 3:
-        return [(n, i, np.ones(i.size)) for n, i in layout.cells_in(polygon)]
-    region = shapely.Polygon(polygon)
-    lo, hi = polygon.min(axis=0), polygon.max(axis=0)
-    out = []
-    for name, conn in layout.cells():
-        p = layout.xy[conn]
-        near = np.flatnonzero(np.all(p.max(axis=1) > lo, axis=1) & np.all(p.min(axis=1) < hi, axis=1))
-        if not near.size:
-            continue
-        cells = shapely.polygons(p[near])
-        share = shapely.area(shapely.intersection(cells, region)) / shapely.area(cells)
-        keep = share > MIN_SHARE
-        if keep.any():
-            out.append((name, near[keep], np.minimum(share[keep], 1.0)))
-    return out
-
-
 def _candidate(layout, label: str, polygon, name: str = "region_stiffness") -> Candidate | None:
-    """A candidate of kind ``name`` on the shell cells ``polygon`` covers (``data["cells"]``: {etype:
-    conn}; ``data["share"]``: {etype: the covered fraction of each cell}; ``data["area"]``: the area
-    covered [m^2]); None where it covers no cell."""
+    """A candidate of kind ``name`` on the shell cells whose centroid is in ``polygon`` (``data["cells"]``:
+    {etype: conn}; ``data["area"]``: theirs [m^2])."""
     sets = layout.model.sets
     found: dict = {}
-    for n, i, w in _covered(layout, polygon):
-        cells, shares = found.setdefault(sets[n].etype, ([], []))
-        cells.append(sets[n].conn[i])
-        shares.append(w)
+    for n, i in layout.cells_in(polygon):
+        found.setdefault(sets[n].etype, []).append(sets[n].conn[i])
     if not found:
         return None
-    cells = {etype: np.concatenate(c) for etype, (c, _) in found.items()}
-    share = {etype: np.concatenate(w) for etype, (_, w) in found.items()}
+    cells = {etype: np.concatenate(c) for etype, c in found.items()}
     nodes = np.unique(np.concatenate([c.ravel() for c in cells.values()]))
     plate = label.removeprefix("plates.") if label.startswith("plates.") and layout.plates else None
-    area, centroid = _area_centroid(list(cells.values()), layout.points, list(share.values()))
+    area, centroid = _area_centroid(list(cells.values()), layout.points)
     return Candidate(name, f"{name}@{label}", tuple(centroid), nodes,
                      {"polygon": np.asarray(polygon, dtype=float)},
-                     {"cells": cells, "share": share, "area": float(area), **({"plate": plate} if plate else {})})
+                     {"cells": cells, "area": float(area), **({"plate": plate} if plate else {})})
 
 
 def _rows(a: np.ndarray) -> np.ndarray:
@@ -187,11 +151,11 @@ class _RegionStiffness:
         return value * old.data["area"] / new.data["area"]
 
     def candidate(self, layout, label: str, polygon):
-        """The region over ``polygon`` [[x, y], ...] [m] (None where it covers no cell)."""
+        """The region over ``polygon`` [[x, y], ...] [m] (None where it holds no cell centroid)."""
         return _candidate(layout, label, polygon, self.name)
 
     def place(self, layout, candidate):
-        """Over ``candidate``'s polygon (ValueError where it covers no cell)."""
+        """Over ``candidate``'s polygon (ValueError where it holds no cell centroid)."""
         plate = candidate.data.get("plate")
         c = _candidate(layout, targets.entry("plates", plate) if plate else "placed",
                        candidate.geometry["polygon"], self.name)
@@ -200,50 +164,40 @@ class _RegionStiffness:
         return c
 
     def rectangle(self, layout, x0: float, y0: float, x1: float, y1: float):
-        """The region over the rectangle [x0, x1] x [y0, y1] [m], its corners taken to the nearest
-        :data:`CORNER_GRID` and named by them in mm (a region's derivatives are kept by name)."""
-        x0, y0, x1, y1 = (CORNER_GRID * round(v / CORNER_GRID) for v in (x0, y0, x1, y1))
-        label = "rect[" + ",".join(f"{1e3 * v:.2f}" for v in (x0, y0, x1, y1)) + "]mm"
+        """The region over the rectangle [x0, x1] x [y0, y1] [m], named by its corners in mm."""
+        label = "rect[" + ",".join(f"{1e3 * v:.4g}" for v in (x0, y0, x1, y1)) + "]mm"
         return _candidate(layout, label, [[x0, y0], [x1, y0], [x1, y1], [x0, y1]], self.name)
 
     def blocks(self, model, candidates) -> list:
-        """Element stiffness of the regions' cells with their base properties in ``model``, each times
-        the share of it the region covers; one kernel call per (element type, property) over all
-        candidates."""
+        """Element stiffness of the regions' cells with their base properties in ``model``; one
+        kernel call per (element type, property) over all candidates."""
         out = []
         for etype in {e for c in candidates for e in c.data["cells"]}:
-            parts = [(k, c.data["cells"][etype], c.data["share"][etype]) for k, c in enumerate(candidates)
-                     if etype in c.data["cells"]]
-            conn = np.concatenate([c for _, c, _ in parts])
-            share = np.concatenate([w for _, _, w in parts])
-            owner = np.repeat([k for k, _, _ in parts], [len(c) for _, c, _ in parts])
+            parts = [(k, c.data["cells"][etype]) for k, c in enumerate(candidates) if etype in c.data["cells"]]
+            conn = np.concatenate([c for _, c in parts])
+            owner = np.repeat([k for k, _ in parts], [len(c) for _, c in parts])
             for name, _, mine in _locate(model, etype, conn):
                 Ke, _ = kernel(etype)(model.nodes[conn[mine]], _base(model.sets[name].prop)[0])
-                Ke = Ke * share[mine, None, None]
                 out.append(Blocks(conn[mine], Ke, np.zeros_like(Ke), owner[mine]))
         return out
 
     def apply(self, model, candidate, value: float):
         """The region's cells move out of their sets into ``effects.<name>...`` sets whose stiffness
-        is (f + w value) times that of their base property, f being their present factor (1, or that
-        of an overlapping region effect added before) and w the share of the cell the region covers
-        (one set per share); f + w value must stay > 0."""
+        is (f + value) times that of their base property, f being their present factor (1, or that
+        of an overlapping region effect added before); f + value must stay > 0."""
         m = model.copy()
         for etype, conn in candidate.data["cells"].items():
-            share = candidate.data["share"][etype]
-            for w in np.unique(share):
-                for name, in_set, _ in _locate(m, etype, conn[share == w]):
-                    es = m.sets[name]
-                    base, f = _base(es.prop)
-                    if not f + w * value > 0.0:
-                        raise ValueError(f"{candidate.name}: a stiffness change must leave the stiffness > 0 "
-                                         f"(change > {-f / w:g}), got {value}")
-                    if in_set.all():
-                        del m.sets[name]
-                    else:
-                        m.sets[name] = type(es)(es.name, es.etype, es.conn[~in_set], es.prop)
-                    m.add(_fresh(m, f"effects.{candidate.name}.{name}"), etype, es.conn[in_set],
-                          ScaledShell(base, f + w * value))
+            for name, in_set, _ in _locate(m, etype, conn):
+                es = m.sets[name]
+                base, f = _base(es.prop)
+                if not f + value > 0.0:
+                    raise ValueError(f"{candidate.name}: a stiffness change must leave the stiffness > 0 "
+                                     f"(change > {-f:g}), got {value}")
+                if in_set.all():
+                    del m.sets[name]
+                else:
+                    m.sets[name] = type(es)(es.name, es.etype, es.conn[~in_set], es.prop)
+                m.add(_fresh(m, f"effects.{candidate.name}.{name}"), etype, es.conn[in_set], ScaledShell(base, f + value))
         return m
 
 

@@ -47,7 +47,6 @@ from .fitting import RANK_STEPS, UPPER, Fit, estimate  # noqa: F401  (re-exporte
 from .halves import Halves, bodies, body_moves, per_kind
 from .held_out import HELD_OUT_SHARE, predicts, refit_share, secant
 from .reanalysis import Reanalysis
-from .region_sides import fit_sides
 from .scan import Runner, rank, resonant, saturated, worth_full
 
 #: probability that noise alone makes one of the candidates look like an effect (family-wise)
@@ -56,10 +55,11 @@ ALPHA = 0.01
 
 @dataclass
 class Selection:
-    """``chosen``: candidate indices in the order found; ``values``: their magnitudes (SI) and ``sigma``
-    their standard deviations (``cov`` their covariance); ``p``: the declared parameters estimated with
-    them; ``chi2[s]``, ``criterion[s]``: after step s (s = 0: the declared parameters alone); ``state``:
-    the final :class:`.residual.State`; ``frequencies``: the first configuration's paired model ones."""
+    """``chosen``: candidate indices in the order found; ``values``: their magnitudes (SI) and
+    ``sigma`` their standard deviations (``cov`` their covariance); ``p``: the declared parameters estimated with them;
+    ``chi2[s]``, ``criterion[s]``: after step s (s = 0: the declared parameters alone);
+    ``state``: the final :class:`.residual.State`; ``frequencies``: the paired model frequencies of
+    the first configuration."""
 
     chosen: list = field(default_factory=list)
     values: np.ndarray = field(default_factory=lambda: np.zeros(0))
@@ -91,7 +91,8 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
     search from the declared values), which every addition must then beat; ``runner``: where the
     shortlist's trial fits run (:mod:`.scan`); ``moves``: a :class:`.moves.LocalMoves` that walks an
     addition of a ``coarse`` kind worth its penalty but refused by the held-out folds before it is
-    refused (:func:`_walked`). ``max_effects`` counts the held effects."""
+    refused (:func:`_walked`).
+    ``max_effects`` counts the held effects."""
     p0 = np.asarray(p0, float)
     n = res.n_rows
     pen = penalty(n, len(candidates), alpha)
@@ -286,14 +287,15 @@ def noticed(res, candidates, sel: Selection, bounds=None, newton_steps: int = NO
 def refine(res, candidates, sel: Selection, neighbours, bounds=None, newton_steps: int = 8,
            alpha: float = ALPHA, runner: Runner | None = None) -> Selection:
     """Local search on the geometry of the effects found: each chosen candidate is swapped in turn
-    for each of ``neighbours(i)`` (candidates of its kind next to it: a segment a piece longer, a
-    rectangle with a side an element further), all magnitudes and the declared parameters re-estimated;
-    the best swap is kept while it lowers chi^2 (a body's two halves move together,
-    :func:`.halves.body_moves`; swaps ranked by :func:`.scan.rank`, full fits run on ``runner``). Then
-    rectangles' sides are fitted between the mesh's lines (:mod:`.region_sides`, where ``neighbours`` is a
-    :class:`.moves.LocalMoves`) and effects the others now explain are pruned. Forward selection places
-    effects on a coarse set of places: this moves each to where the effects found later leave it best."""
-    pen, n_par = penalty(res.n_rows, len(candidates), alpha), np.size(sel.p)
+    for each of ``neighbours(i)`` (candidate indices of the same kind next to it, e.g. a segment
+    one piece longer or shorter), all magnitudes and the declared parameters re-estimated; the
+    best swap is kept while it lowers chi^2, then effects the others now explain are pruned.
+    Forward selection adds effects greedily on a coarse set of places; this lets a place found
+    early move to where the effects found later leave it best; the two halves of a body move
+    together (:func:`.halves.body_moves`). The swaps are ranked by
+    :func:`.scan.rank` (``runner``: where their full fits run)."""
+    pen = penalty(res.n_rows, len(candidates), alpha)
+    n_par = np.size(sel.p)
     idx = list(sel.chosen)
     fit = Fit(sel.p, sel.values, sel.state, np.zeros((0, 0)))
     improved = bool(idx)
@@ -315,8 +317,6 @@ def refine(res, candidates, sel: Selection, neighbours, bounds=None, newton_step
             new = estimate(res, best[1].p, [candidates[t] for t in best[0]], best[1].values, newton_steps, bounds)
             if new.chi2 < fit.chi2 * (1 - 1e-6):
                 idx, fit, improved = best[0], new, True
-    if hasattr(neighbours, "region"):
-        idx, fit = fit_sides(res, candidates, idx, fit, neighbours, bounds)
     if idx == list(sel.chosen):
         return sel
     return adopt(sel, *_prune(res, candidates, idx, fit, newton_steps, bounds, pen, n_par, runner), pen)

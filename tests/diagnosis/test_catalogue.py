@@ -152,23 +152,27 @@ def test_overlapping_region_effects_add_up(plate):
 
 
 def test_overlapping_softenings_below_zero_stiffness_are_refused_on_any_mesh(plate):
-    """Two regions overlapping over an 8 mm strip that no cell of this 10 mm mesh lies within (each
-    covers a share of the cells the strip cuts) but cells of a 2 mm mesh do: their changes add where
-    they overlap, so -0.5 and -0.5 would leave no stiffness there and are refused together, though each
-    is allowed alone and this mesh would take them; regions that only touch along an edge are
-    independent."""
+    """Two regions over a 8 mm strip that holds no cell centroid of this 10 mm mesh (they share no
+    cell here, but do on a 5 mm mesh): their changes add where they overlap, so -0.5 and -0.5 would
+    leave no stiffness there and are refused together, though each is allowed alone; regions that
+    only touch along an edge are independent."""
     m, layout, _, _, _ = plate
     a = region_stiffness._candidate(layout, "a", [[0, 0], [0.034, 0], [0.034, B], [0, B]])
     b = region_stiffness._candidate(layout, "b", [[0.026, 0], [0.06, 0], [0.06, B], [0.026, B]])
     c = region_stiffness._candidate(layout, "c", [[0.06, 0], [A, 0], [A, B], [0.06, B]])
-    dg.add_effect(dg.add_effect(m, a, -0.5), b, -0.5)  # no cell of this mesh loses all of its stiffness
-    fine = cantilever(50, 40)
+    assert not _cells(a) & _cells(b)
+    fine = cantilever(20, 16)
     fine_layout = dg.from_model(fine)
     a2, b2 = (region_stiffness._candidate(fine_layout, k.name, k.geometry["polygon"]) for k in (a, b))
+    assert _cells(a2) & _cells(b2)
     ok = jointly([a, b, c])
     assert ok([-0.4, -0.4, -0.9]) and not ok([-0.5, -0.5, 0.0]) and ok([-0.5, 0.6, 0.0])
     with pytest.raises(ValueError, match="must leave the stiffness > 0"):
         dg.add_effect(dg.add_effect(fine, a2, -0.5), b2, -0.5)
+
+
+def _cells(region) -> set:
+    return {tuple(row) for conn in region.data["cells"].values() for row in conn}
 
 
 def test_region_effect_follows_the_properties_of_the_model_it_is_applied_to(plate):
