@@ -52,25 +52,31 @@ def _rows(ref, other, n: int, sf: float, ss: float) -> np.ndarray:
     return np.concatenate([rows_f, rows_s])
 
 
-def effect_chi2(case: Case) -> list:
-    """[chi^2 of each hidden effect's signature beyond the declared parameters]."""
-    points = np.column_stack([1e-3 * np.asarray(case.points, float), np.zeros(len(case.points))])
+def effect_chi2(case, state=None) -> list:
+    """[chi^2 of each hidden effect's signature beyond the declared parameters]; ``state(case)``: the
+    (frequencies, unit shapes at the points) of a case's truth at the model mesh (default: a board's,
+    measured in z)."""
+    if state is None:
+        points = np.column_stack([1e-3 * np.asarray(case.points, float), np.zeros(len(case.points))])
+
+        def state(c):
+            return _state(c, c.mesh_mm, points)
     n = case.test_modes
     sf, ss = case.noise[0] / 100.0 / np.sqrt(3.0), case.noise[1] / 100.0 / np.sqrt(3.0)
-    ref = _state(case, case.mesh_mm, points)
+    ref = state(case)
     cols = []
     for k, p in enumerate(case.parameters):
         pm = []
         for step in (1.02, 1.0 / 1.02):
             params = [dict(q) for q in case.parameters]
             params[k]["true"] = p["true"] * step
-            pm.append(_rows(ref, _state(replace(case, parameters=params), case.mesh_mm, points), n, sf, ss))
+            pm.append(_rows(ref, state(replace(case, parameters=params)), n, sf, ss))
         cols.append((pm[0] - pm[1]) / 2.0)
     Q = np.linalg.qr(np.column_stack(cols))[0] if cols else np.zeros((0, 0))
     out = []
     for i in range(len(case.effects)):
         others = [e for j, e in enumerate(case.effects) if j != i]
-        r = _rows(ref, _state(replace(case, effects=others), case.mesh_mm, points), n, sf, ss)
+        r = _rows(ref, state(replace(case, effects=others)), n, sf, ss)
         if Q.size:
             r = r - Q @ (Q.T @ r)
         out.append(float(r @ r))

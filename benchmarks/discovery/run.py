@@ -4,6 +4,8 @@ against its truth (:mod:`score`), and the split's figures printed.
     python benchmarks/discovery/run.py dev [--n 50] [--jobs 2] [--workers 1] [--scheduler tcp://...]
     python benchmarks/discovery/run.py report            # seeds 1000-1199: run to report, never to tune
     python benchmarks/discovery/run.py 0-9,17            # given seeds
+    python benchmarks/discovery/run.py dev-housings      # the ribbed housings of the same seeds (:mod:`housings`)
+    python benchmarks/discovery/run.py h0-3,h1000        # given housings
 
 Cases are made on demand (:mod:`make`, cached); each diagnosis runs as the command line does (a
 child process, ``--json``), ``--jobs`` of them at once on local processes or on a Dask cluster, and
@@ -28,6 +30,7 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
 sys.path.insert(0, str(HERE))
 
+import housings  # noqa: E402
 from cases import DEV, REPORT  # noqa: E402
 from detectability import DETECTABLE_CHI2  # noqa: E402
 from make import cache_dir, make, seeds  # noqa: E402
@@ -45,11 +48,22 @@ def _tag() -> str:
         return "untagged"
 
 
-def run_case(seed: int, options: dict, shared=None) -> dict:
-    """Make case ``seed`` and diagnose it (or reuse the result kept under the tag and the truth's key);
-    a case that cannot be made is a result with ``exit`` None and the reason."""
+def case_names(text: str) -> list:
+    """'0-9,h2-3' -> ['s0000', ..., 's0009', 'h0002', 'h0003']: boards (s) and housings (h) by seed."""
+    out = []
+    for part in text.split(","):
+        kind = "h" if part.startswith("h") else "s"
+        out += [f"{kind}{s:04d}" for s in seeds(part.lstrip("hs"))]
+    return out
+
+
+def run_case(name: str, options: dict, shared=None) -> dict:
+    """Make case ``name`` (a board ``s0012`` or a housing ``h0012``) and diagnose it (or reuse the result
+    kept under the tag and the truth's key); a case that cannot be made is a result with ``exit`` None
+    and the reason."""
+    seed, housing = int(name[1:]), name.startswith("h")
     try:
-        folder = make(seed, options["cache"])
+        folder = (housings.make if housing else make)(seed, options["cache"])
     except Exception as exc:  # the generator's own failure: reported per case, the split goes on
         return {"seed": seed, "wall_s": 0.0, "exit": None, "stderr_tail": f"{type(exc).__name__}: {exc}",
                 "diagnosis": None}
@@ -58,7 +72,8 @@ def run_case(seed: int, options: dict, shared=None) -> dict:
     if out.exists() and not options["again"]:
         return json.loads(out.read_text())
     js = folder / f"diagnose-{options['tag']}.json"
-    cmd = [sys.executable, "-m", "pcbdyn.cli", "diagnose", str(folder / "board.toml"), str(folder / "test.uff"),
+    cmd = [sys.executable, "-m", "pcbdyn.cli", "diagnose", str(folder / ("box.toml" if housing else "board.toml")),
+           str(folder / "test.uff"),
            "--noise", "f={:g},shape={:g}".format(*json.loads((folder / "truth.json").read_text())["case"]["noise"]),
            "--json", str(js), "--out", str(folder / f"out-{options['tag']}"), "--force",
            "--workers", str(options["workers"])]
@@ -124,30 +139,33 @@ def main(argv=None):
     ap.add_argument("--cache", default=None)
     ap.add_argument("--json", default=None, help="write the rows and figures as JSON")
     a = ap.parse_args(argv)
-    todo = {"dev": list(DEV), "report": list(REPORT)}.get(a.split) or seeds(a.split)
+    splits = {"dev": DEV, "report": REPORT}
+    todo = ([f"s{s:04d}" for s in splits[a.split]] if a.split in splits else
+            [f"h{s:04d}" for s in splits[a.split.split("-")[0]]] if a.split.endswith("-housings") else
+            case_names(a.split))
     todo = todo[:a.n] if a.n else todo
     options = {"cache": Path(a.cache) if a.cache else cache_dir(), "tag": a.tag or _tag(), "again": a.again,
                "workers": a.workers}
     print(f"{len(todo)} cases, tag {options['tag']}, load {os.getloadavg()[0]:.1f}", flush=True)
     rows = []
     t0 = time.perf_counter()
-    for (seed, _), result in run_jobs(run_case, [(s, options) for s in todo], None, workers=a.jobs,
+    for (name, _), result in run_jobs(run_case, [(s, options) for s in todo], None, workers=a.jobs,
                                       scheduler=a.scheduler):
         if result["exit"] is None:
-            print(f"s{seed:04d} not made: {result['stderr_tail']}", flush=True)
+            print(f"{name} not made: {result['stderr_tail']}", flush=True)
             continue
-        truth = json.loads((options["cache"] / f"s{seed:04d}" / "truth.json").read_text())
+        truth = json.loads((options["cache"] / name / "truth.json").read_text())
         v = judge(truth, result["diagnosis"], DETECTABLE_CHI2)
         rows.append((truth, result, v))
         kinds = ",".join(e["kind"] for e in truth["case"]["effects"]) or "-"
         marks = " ".join(f"{x['type'][:6]}{'+' if x['found'] else ('~' if x['placed'] else '-')}"
                          f"{'' if x['detectable'] else '(u)'}" for x in v["atoms"])
-        print(f"s{seed:04d} {truth['case']['hold']:<9} {kinds:<26} {marks:<34} inv {len(v['invented'])} "
+        print(f"{name} {truth['case']['hold']:<9} {kinds:<26} {marks:<34} inv {len(v['invented'])} "
               f"after {v.get('after', float('nan')):6.2f} % (po {v.get('parameters_only', float('nan')):6.2f}) "
               f"{result['wall_s']:5.0f} s{'' if result['exit'] == 0 else ' EXIT ' + str(result['exit'])} "
               f"[load {os.getloadavg()[0]:.1f}]", flush=True)
     print(f"\n{len(rows)} cases in {time.perf_counter() - t0:.0f} s")
-    unseen = [r for r in rows if r[0]["case"]["seed"] not in SEEN]
+    unseen = [r for r in rows if r[0]["case"]["hold"] == "housing" or r[0]["case"]["seed"] not in SEEN]
     s = summary(rows)
     _print(s)
     if 0 < len(unseen) < len(rows):
@@ -155,7 +173,8 @@ def main(argv=None):
         _print(summary(unseen))
     if a.json:
         Path(a.json).write_text(json.dumps({"summary": s, "summary_unseen": summary(unseen),
-                                            "rows": [v | {"seed": t["case"]["seed"]} for t, _, v in rows]},
+                                            "rows": [v | {"seed": t["case"]["seed"], "housing": t["case"]["hold"] == "housing"}
+                                                     for t, _, v in rows]},
                                            indent=1, default=float))
 
 

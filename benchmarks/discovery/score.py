@@ -59,8 +59,9 @@ def judged_as(r: dict) -> str:
 
 
 def to_polyline(p, pts) -> float:
-    """Distance of point ``p`` to the polyline through ``pts`` (one point: to that point)."""
-    pts = np.asarray(pts, float).reshape(-1, 2)
+    """Distance of point ``p`` to the polyline through ``pts`` (one point: to that point), in 2-D (a board)
+    or 3-D (a housing)."""
+    pts = np.asarray(pts, float).reshape(-1, np.size(p))
     if len(pts) == 1:
         return float(np.linalg.norm(p - pts[0]))
     a, b = pts[:-1], pts[1:]
@@ -110,7 +111,7 @@ def judge(truth: dict, result: dict, detectable_chi2: float) -> dict:
     """Per case: atoms (found or not, detectable or not, magnitude error, 1- and 2-sigma covered), the
     reported effects that match no atom (invented), noise-only cleanliness and the errors."""
     case = truth["case"]
-    E_board = next((p["true"] for p in case["parameters"] if p["name"] == "E_board"), case["E"])
+    E_board = next((p["true"] for p in case["parameters"] if p["name"] == "E_board"), case.get("E"))
     reported = result.get("effects", []) if result else []
     used = set()
     rows = []

@@ -80,3 +80,51 @@ def test_a_rotary_inertia_is_not_judged_as_a_mass():
     assert both["invented"] == [("point_mass", [50.0, 40.0])]
     alone = judge(truth, {"effects": [inertia]}, 100.0)
     assert not alone["atoms"][0]["placed"]
+
+
+def test_housings_are_drawn_as_the_issue_asks(tmp_path):
+    """Ribbed housings (benchmarks/discovery/housings.py): 3-5 plates, 0-6 ribs, walls held on the base, 0-2
+    hidden effects on the plates (masses, ribs that may stop short), 20-120 points on the plates, declared
+    values a few % to 40 % off; the handed and the true box.toml load, the truth with its effects as a box
+    entry each, and the same housing comes from the same seed."""
+    from housings import box_text
+    from housings import draw as draw_housing
+
+    from pcbdyn.box import load_box
+
+    housings = [draw_housing(s) for s in range(30)]
+    for h in housings:
+        assert 3 <= len(h.plates) <= 5 and len(h.ribs) <= 6 and len(h.effects) <= 2
+        assert 20 * 0.8 <= len(h.points) <= 120 * 1.3
+        for p in h.parameters:
+            assert np.log(1.03) * 0.99 <= abs(np.log(p["true"] / p["nominal"])) <= np.log(1 / 0.6) * 1.01
+    assert {len(h.plates) for h in housings} == {3, 4, 5} and {e["kind"] for h in housings for e in h.effects} == {
+        "point_mass", "stiffener"}
+    for h in housings[:6]:
+        handed, true = (tmp_path / f"{h.name}_{t}.toml" for t in ("handed", "true"))
+        handed.write_text(box_text(h))
+        true.write_text(box_text(h, truth=True))
+        box, truth = load_box(handed), load_box(true)
+        assert [p.name for p in box.parameters] == [p["name"] for p in h.parameters]
+        assert len(truth.masses) == sum(e["kind"] == "point_mass" for e in h.effects)
+        assert len(truth.ribs) - len(box.ribs) == sum(e["kind"] == "stiffener" for e in h.effects)
+        held = {s.plate for s in box.supports}
+        assert held == {p["name"] for p in h.plates} - {"upper"}
+        for xyz in np.asarray(h.points, float):  # on a plate: on one of the box's faces, within its sides
+            assert np.any(np.isclose(xyz, 0.0) | np.isclose(xyz, h.size_mm))
+            assert np.all((xyz >= -1e-9) & (xyz <= np.asarray(h.size_mm) + 1e-9))
+    assert draw_housing(3).to_json() == draw_housing(3).to_json()
+
+
+def test_a_housing_effect_is_judged_in_three_dimensions():
+    """A rib found along a 3-D path on a housing's plate: judged by the farther end's distance to the reported
+    line, in the box's frame."""
+    from score import judge
+
+    path = [[0.0, 50.0, 20.0], [0.0, 150.0, 20.0]]
+    case = {"effects": [{"kind": "stiffener", "path": path, "EI": 1.0}], "parameters": []}
+    truth = {"case": case, "signal_chi2": [1e4]}
+    near = {"type": "stiffener", "path_mm": [[0.0, 55.0, 24.0], [0.0, 145.0, 24.0]], "magnitude": 1.1}
+    far = {"type": "stiffener", "path_mm": [[0.0, 50.0, 60.0], [0.0, 150.0, 60.0]], "magnitude": 1.0}
+    assert judge(truth, {"effects": [near]}, 100.0)["atoms"][0]["found"]
+    assert not judge(truth, {"effects": [far]}, 100.0)["atoms"][0]["placed"]
