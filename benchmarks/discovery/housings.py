@@ -11,9 +11,10 @@ points on the plates, each measured in x, y and z. The truth is solved in OpenSe
 ribs as offset beams) on a mesh half the model's; the test has pcbdyn's noise model.
 
 Housing seeds use the boards' split ranges (dev 0-199, report 1000-1199) and are kept in the cache as
-``h0000``...; ``run.py`` takes them as ``h0-9`` or ``dev-housings``/``report-housings``.
+``h0000``...; ``make.py`` and ``run.py`` take them as ``h0-9`` (``run.py`` also ``dev-housings``,
+``report-housings``).
 
-    python benchmarks/discovery/housings.py 0-3 [--cache DIR]
+    python benchmarks/discovery/make.py h0-3 [--cache DIR]
 """
 
 from __future__ import annotations
@@ -32,7 +33,7 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
 from cases import _loguniform, _parameter, _segment_in  # noqa: E402
-from make import ZETA, cache_dir, seeds  # noqa: E402
+from make import ZETA, cache_dir, cached  # noqa: E402
 from seen import EXTRA_MODES  # noqa: E402
 
 E_AL, NU_AL, RHO_AL = 70e9, 0.33, 2700.0
@@ -263,6 +264,20 @@ def code_key() -> str:
 def make(seed: int, cache: Path | None = None) -> Path:
     """The folder of housing ``seed`` (made if missing): box.toml, points.csv, test.uff, truth.json."""
     from detectability import effect_chi2
+
+    folder, key = (cache or cache_dir()) / f"h{seed:04d}", code_key()
+    if not cached(folder, key):
+        folder.mkdir(parents=True, exist_ok=True)
+        h = draw(seed)
+        f = _solve_and_write(h, folder)
+        (folder / "truth.json").write_text(json.dumps({"key": key, "case": h.to_json(), "frequencies_hz": f.tolist(),
+                                                       "signal_chi2": effect_chi2(h, _state)}, indent=1))
+    return folder
+
+
+def _solve_and_write(h: Housing, folder: Path) -> np.ndarray:
+    """The housing's box.toml texts, its truth solved in OpenSees and its test written; the truth's
+    frequencies [Hz]."""
     from opensees_truth import solve_opensees
 
     from pcbdyn.fe.modal import Modes as ModelModes
@@ -271,12 +286,6 @@ def make(seed: int, cache: Path | None = None) -> Path:
     from pcbdyn.testdata.simulate import simulate_test
     from pcbdyn.testdata.uff import write_uff
 
-    folder = (cache or cache_dir()) / f"h{seed:04d}"
-    tj, key = folder / "truth.json", code_key()
-    if tj.exists() and json.loads(tj.read_text()).get("key") == key and (folder / "test.uff").exists():
-        return folder
-    folder.mkdir(parents=True, exist_ok=True)
-    h = draw(seed)
     (folder / "box.toml").write_text(box_text(h))
     (folder / "truth.toml").write_text(box_text(h, truth=True, mesh_mm=h.mesh_mm / TRUTH_REFINEMENT))
     model = _model(h, True, h.mesh_mm / TRUTH_REFINEMENT)
@@ -287,29 +296,5 @@ def make(seed: int, cache: Path | None = None) -> Path:
     write_uff(folder / "test.uff", simulate_test(ModelModes(f, u, np.zeros((u.shape[0], 0)), None), points, dofs,
                                                  np.eye(u.shape[0]), zeta=ZETA,
                                                  noise=Noise(frequency_pct=h.noise[0], shape_pct=h.noise[1]),
-                                                 seed=seed))
-    tj.write_text(json.dumps({"key": key, "case": h.to_json(), "frequencies_hz": f.tolist(),
-                              "signal_chi2": effect_chi2(h, _state)}, indent=1))
-    return folder
-
-
-def main(argv=None):
-    import argparse
-    import time
-
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("seeds", help="e.g. 0-3 or 1000-1004")
-    ap.add_argument("--cache", default=None)
-    a = ap.parse_args(argv)
-    for s in seeds(a.seeds):
-        t0 = time.perf_counter()
-        t = json.loads((make(s, Path(a.cache) if a.cache else None) / "truth.json").read_text())
-        c = t["case"]
-        print(f"h{s:04d} {len(c['plates'])} plates, {len(c['ribs'])} ribs, {len(c['points'])} points, effects "
-              f"{','.join(e['kind'] for e in c['effects']) or '-':<22} chi2 "
-              f"{','.join(f'{v:.3g}' for v in t['signal_chi2']) or '-':<14} f1 {t['frequencies_hz'][0]:8.1f} Hz "
-              f"({time.perf_counter() - t0:.0f} s)", flush=True)
-
-
-if __name__ == "__main__":
-    main()
+                                                 seed=h.seed))
+    return f

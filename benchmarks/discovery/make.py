@@ -4,7 +4,7 @@ and truth.json (the case, its exact frequencies). Made on demand from the seed a
 outside git (``PCBDYN_DISCOVERY_CACHE``, default ``~/.cache/pcbdyn/discovery``); a folder made by the
 same code for the same seed is reused.
 
-    python benchmarks/discovery/make.py 0-9 [--cache DIR]
+    python benchmarks/discovery/make.py 0-9 [--cache DIR]     # boards; h0-9: housings (:mod:`housings`)
 
 needs openseespy (``pip install -e .[discovery]``: an extra, not a core dependency).
 """
@@ -44,12 +44,17 @@ def code_key() -> str:
     return h.hexdigest()[:12]
 
 
+def cached(folder: Path, key: str) -> bool:
+    """Whether ``folder`` holds a case made by the code whose digest is ``key``."""
+    tj = folder / "truth.json"
+    return tj.exists() and json.loads(tj.read_text()).get("key") == key and (folder / "test.uff").exists()
+
+
 def make(seed: int, cache: Path | None = None) -> Path:
     """The folder of case ``seed`` (made if missing): board.toml, points.csv, test.uff, truth.json."""
     folder = (cache or cache_dir()) / f"s{seed:04d}"
-    tj = folder / "truth.json"
-    key = code_key()
-    if tj.exists() and json.loads(tj.read_text()).get("key") == key and (folder / "test.uff").exists():
+    tj, key = folder / "truth.json", code_key()
+    if cached(folder, key):
         return folder
     folder.mkdir(parents=True, exist_ok=True)
     case = draw(seed)
@@ -121,20 +126,39 @@ def seeds(text: str) -> list:
     return out
 
 
+def case_names(text: str) -> list:
+    """'0-9,h2-3' -> ['s0000', ..., 's0009', 'h0002', 'h0003']: boards (s) and housings (h) by seed."""
+    out = []
+    for part in text.split(","):
+        kind = "h" if part.startswith("h") else "s"
+        out += [f"{kind}{s:04d}" for s in seeds(part.lstrip("hs"))]
+    return out
+
+
+def made(name: str, cache: Path | None = None) -> Path:
+    """The folder of case ``name``, a board ``s0012`` or a housing ``h0012`` (:mod:`housings`), made if missing."""
+    if name.startswith("h"):
+        from housings import make as make_housing
+
+        return make_housing(int(name[1:]), cache)
+    return make(int(name[1:]), cache)
+
+
 def main(argv=None):
     import argparse
     import time
 
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("seeds", help="e.g. 0-9 or 1000-1004,1010")
+    ap.add_argument("seeds", help="e.g. 0-9 or 1000-1004,1010; housings h0-3")
     ap.add_argument("--cache", default=None)
     a = ap.parse_args(argv)
-    for s in seeds(a.seeds):
+    for name in case_names(a.seeds):
         t0 = time.perf_counter()
-        folder = make(s, Path(a.cache) if a.cache else None)
-        t = json.loads((folder / "truth.json").read_text())
+        t = json.loads((made(name, Path(a.cache) if a.cache else None) / "truth.json").read_text())
         c = t["case"]
-        print(f"s{s:04d} {c['hold']:<10} parts {len(c['parts']):>2}  effects "
+        structure = (f"{len(c['plates'])} plates, {len(c['ribs'])} ribs" if name.startswith("h") else
+                     f"{c['hold']:<10} parts {len(c['parts']):>2}")
+        print(f"{name} {structure}  {len(c['points']):>3} points  effects "
               f"{','.join(e['kind'] for e in c['effects']) or '-':<28} chi2 "
               f"{','.join(f'{v:.3g}' for v in t['signal_chi2']) or '-':<16} f1 {t['frequencies_hz'][0]:8.1f} Hz "
               f"({time.perf_counter() - t0:.0f} s)", flush=True)

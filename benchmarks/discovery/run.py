@@ -30,10 +30,9 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
 sys.path.insert(0, str(HERE))
 
-import housings  # noqa: E402
 from cases import DEV, REPORT  # noqa: E402
 from detectability import DETECTABLE_CHI2  # noqa: E402
-from make import cache_dir, make, seeds  # noqa: E402
+from make import cache_dir, case_names, made  # noqa: E402
 from score import judge  # noqa: E402
 
 
@@ -48,22 +47,13 @@ def _tag() -> str:
         return "untagged"
 
 
-def case_names(text: str) -> list:
-    """'0-9,h2-3' -> ['s0000', ..., 's0009', 'h0002', 'h0003']: boards (s) and housings (h) by seed."""
-    out = []
-    for part in text.split(","):
-        kind = "h" if part.startswith("h") else "s"
-        out += [f"{kind}{s:04d}" for s in seeds(part.lstrip("hs"))]
-    return out
-
-
 def run_case(name: str, options: dict, shared=None) -> dict:
     """Make case ``name`` (a board ``s0012`` or a housing ``h0012``) and diagnose it (or reuse the result
     kept under the tag and the truth's key); a case that cannot be made is a result with ``exit`` None
     and the reason."""
     seed, housing = int(name[1:]), name.startswith("h")
     try:
-        folder = (housings.make if housing else make)(seed, options["cache"])
+        folder = made(name, options["cache"])
     except Exception as exc:  # the generator's own failure: reported per case, the split goes on
         return {"seed": seed, "wall_s": 0.0, "exit": None, "stderr_tail": f"{type(exc).__name__}: {exc}",
                 "diagnosis": None}

@@ -30,14 +30,17 @@ from ..fe.model import SHELL_TYPES
 from .entries import BoardError, RibSection
 
 
-def rib_property(EI: float, plate_thickness: float, section: RibSection = RibSection()) -> BeamProperty:
+def rib_property(EI: float, plate_thickness: float, section: RibSection = RibSection(),
+                 normal=(0.0, 0.0, 1.0)) -> BeamProperty:
     """The stiffener's beam section for bending stiffness ``EI`` [N m^2] on a plate of thickness
-    ``plate_thickness`` (the diagnosis kind's RibSection.prop); its bending is linear, as the
+    ``plate_thickness`` (the diagnosis kind's RibSection.prop), standing on the side of the plate that its
+    unit ``normal`` points to (a board's +z; a housing wall's inside); its bending is linear, as the
     shell's it is tied to (on a node row or embedded across cells alike)."""
     b = 12.0 * EI / (section.E * section.h**3)
     inertia = b * section.h**3 / 12.0
+    n = np.asarray(normal, float)
     return BeamProperty(section.E, section.nu, section.rho, b * section.h, inertia, inertia, 4.0 * inertia,
-                        orientation=(0.0, 0.0, 1.0), offset=(0.0, 0.0, 0.5 * (plate_thickness + section.h)),
+                        orientation=tuple(n), offset=tuple(0.5 * (plate_thickness + section.h) * n),
                         linear_bending=True)
 
 

@@ -8,9 +8,9 @@ plates as footprints and each plate's nodes). Candidate generators (the catalogu
 geometric questions: grid nodes, boundary segments, cells inside a polygon, the cells a line crosses.
 
 A plate in one plane z = const (a board) is described in x, y (``planar``); a structure in 3-D (a box)
-in x, y, z (``points``): its grid is a 3-D one, its footprints are planar polygons in space, and the
-kinds that act along sides, lines or in-plane axes (edge stiffness, stiffeners, line masses, point
-inertias) have no candidates there.
+in x, y, z (``points``): its grid is a 3-D one, its footprints are planar polygons in space; stiffeners
+are placed on each of its plates seen in its own plane (:meth:`Layout.plate_view`), and the kinds that act
+along sides or in-plane axes (edge stiffness, line masses, point inertias) have no candidates there.
 """
 
 from __future__ import annotations
@@ -63,6 +63,15 @@ class Layout:
     def points(self) -> np.ndarray:
         """The node coordinates candidates are placed by: x, y on a plane, x, y, z in 3-D."""
         return self.xy if self.planar else self.model.nodes
+
+    def plate_view(self, name: str) -> tuple:
+        """(plate ``name`` as a layout in its own plane, its :class:`.plate_view.Frame`), made once."""
+        from .plate_view import plate_view
+
+        views = self.__dict__.setdefault("_plate_views", {})
+        if name not in views:
+            views[name] = plate_view(self, name)
+        return views[name]
 
     def plate_of(self, node: int) -> str | None:
         """The (first) plate that holds ``node`` (None on a single plate)."""

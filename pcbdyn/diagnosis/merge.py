@@ -13,6 +13,7 @@ import shapely
 from ..fe.probe import segment_parameter
 from .catalogue import kind, weighted_centre
 from .moves import REGION_KINDS, overlap, rectangle
+from .stiffener import in_plane
 from .uncertainty import at_state, interval, jackknife_cov, model_form, parts, place_cov, place_range, profile_interval
 
 #: kinds that act at one node: an effect between nodes is shared by its neighbours
@@ -33,10 +34,11 @@ def linked(a, b, reach: float) -> bool:
         return math.dist(a.at, b.at) <= reach
     if a.kind == b.kind and a.kind in REGION_KINDS and None not in (ra := rectangle(a), rb := rectangle(b)):
         return min(overlap(ra, rb)) > 0.0
-    if a.kind == b.kind == "stiffener":
-        da, db = (np.diff(np.asarray(c.geometry["path"], float)[[0, -1]], axis=0)[0] for c in (a, b))
+    if a.kind == b.kind == "stiffener":  # on one plate, in its plane
+        pa, pb = in_plane(a), in_plane(b)
+        da, db = np.diff(pa, axis=0)[0], np.diff(pb, axis=0)[0]
         parallel = abs(da[0] * db[1] - da[1] * db[0]) <= 1e-6 * np.linalg.norm(da) * np.linalg.norm(db)
-        return parallel and _segment_gap(a.geometry["path"], b.geometry["path"]) <= reach
+        return a.data.get("plate") == b.data.get("plate") and parallel and _segment_gap(pa, pb) <= reach
     if a.kind == b.kind == "line_mass":  # masses along one stretch of a side add up
         return _segment_gap(a.geometry["segment"], b.geometry["segment"]) <= reach
     if {a.kind, b.kind} == {"point_mass", "line_mass"}:
@@ -108,7 +110,9 @@ def merged(chosen, values, cov, cov_jack, cov_place, group, profile=None, places
             d["path_mm"] = np.round(1e3 * mean_path([chosen[k] for k in group], v), 3).tolist()
     if hasattr(c.spec, "mass"):  # a rib carries its mass: its section's, at the stiffness found
         d["mass_kg"] = float(sum(chosen[k].spec.mass(chosen[k], values[k]) for k in group))
-        d["section_height_mm"] = round(1e3 * c.spec.section_of(c).h, 4)
+        sec = c.spec.section_of(c)
+        d["section_height_mm"] = round(1e3 * sec.h, 4)
+        d["section_material"] = {"E_Pa": sec.E, "nu": sec.nu, "rho_kg_m3": sec.rho}
     sub = np.ix_(group, group)
     u = parts(float(w @ v), w, cov[sub] if cov.size else cov, cov_jack[sub], cov_place[sub], places, model_form(c.kind))
     d["interval_2sigma"] = interval(float(w @ v), u, profile, c.spec.lower)

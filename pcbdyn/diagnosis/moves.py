@@ -15,6 +15,8 @@ from .catalogue import kind
 #: (:mod:`.geometry_fit` then moves it on meshes along it; the bar of ``ho_al_bar``, found as two
 #: lines, took 22 s of local search in quarter steps, 13 s in halves)
 LINE_STEP = 0.5
+#: [element sizes] how far an end of a stiffener on a housing's plate moves along its line in one step
+END_STEP = 1.0
 #: [element sizes] how far a point between nodes moves in one step of the local search
 POINT_STEP = 0.25
 #: [element sizes] how far a side of a rectangular region moves in one step of the local search
@@ -69,7 +71,8 @@ def overlap(ra, rb) -> list:
 class LocalMoves:
     """neighbours(i) for :func:`.select.refine`: for a run of pieces of a side, the runs of the
     same kind and side that start and end at most one piece from its own; for a stiffener, its line
-    moved half an element (:data:`LINE_STEP`) across itself either way; for a rectangular region,
+    moved half an element (:data:`LINE_STEP`) across itself either way, and on a housing's plate each of its
+    ends an element (:data:`END_STEP`) along it either way; for a rectangular region,
     the rectangles with one side or both sides of an axis moved by one element (:data:`RECT_STEP`) in or
     out, or shifted by one element (:func:`_rect_moves`); for a point
     between nodes (a support, :mod:`.support`, or a mass at its point), the points a quarter element
@@ -134,7 +137,11 @@ class LocalMoves:
             return [runs[(a, b)] for a in (i - 1, i, i + 1) for b in (j - 1, j, j + 1)
                     if (a, b) != (i, j) and (a, b) in runs]
         if c.kind == "stiffener":
-            return self._add(kind("stiffener").parallel(self.layout, c, LINE_STEP * self.h * np.array([-1.0, 1.0])))
+            rib, steps = kind("stiffener"), self.h * np.array([-1.0, 1.0])
+            made = rib.parallel(self.layout, c, LINE_STEP * steps)
+            if "plate" in c.data:  # a housing's rib is not fitted on meshes along it (:mod:`.geometry_fit`): its ends walk
+                made += rib.stretched(self.layout, c, END_STEP * steps)
+            return self._add(made)
         if at_point(c):
             step = POINT_STEP * self.h
             made = [c.spec.at_point(self.layout, c, (c.at[0] + dx, c.at[1] + dy))

@@ -313,7 +313,7 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
     sel = without_vanished(res, cands, sel, models.bounds, alpha=alpha)
     carried = [(cands[i], v) for i, v in zip(sel.chosen, sel.values) if cands[i].kind in MASS_KINDS or cands[i].between_nodes]
     searched = cands  # the candidates on the model's own mesh (the evidence map is drawn on it)
-    lined = None if quick or not conforming.stiffeners(cands, sel) else \
+    lined = None if quick or not conforming.stiffeners(cands, sel) or not hasattr(models.structure, "following") else \
         _on_lines(models, res, cands, sel, forms, h, levels, runner, alpha, say)
     if lined is not None:
         models, res, cands, sel = lined

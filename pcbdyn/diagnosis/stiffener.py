@@ -46,37 +46,44 @@ class _Stiffener:
     def generate(self, layout, path_spacing: float = 0.02) -> list:
         """Lines across the whole plate in :data:`DIRECTIONS`, ``path_spacing`` [m] apart, and their
         :data:`PIECES`: a bar at any angle and of any length starts from the line it lies nearest (its ends,
-        direction and section are fitted after, :mod:`.geometry_fit`)."""
+        direction and section are fitted after, :mod:`.geometry_fit`). On a structure in 3-D, on each of
+        its plates in the plate's own plane (:meth:`.layout.Layout.plate_view`), standing on its inside."""
         if not path_spacing > 0:
             raise ValueError(f"path_spacing must be > 0 m, got {path_spacing}")
-        if not layout.planar:  # lines of a plate in one plane only
-            return []
-        lo, hi = _extent(layout)
-        centre = 0.5 * (lo + hi)
+        plates = [None] if layout.planar else list(layout.plates)
         out = []
-        for angle in DIRECTIONS:
-            d = np.array([np.cos(angle), np.sin(angle)])
-            d[np.abs(d) < 1e-12] = 0.0
-            across = np.array([-d[1], d[0]])
-            half = 0.5 * float(np.abs(hi - lo) @ np.abs(across))  # the plate's half-width across the lines
-            n = max(1, int(round(2.0 * half / path_spacing)))
-            for s in -half + (np.arange(n) + 0.5) * (2.0 * half / n):
-                ends = _clipped(centre + s * across, d, lo, hi)
-                for a, b in [] if ends is None else PIECES:
-                    c = self.candidate(layout, None, ends[0] + a * (ends[1] - ends[0]), ends[0] + b * (ends[1] - ends[0]))
-                    if c is not None:
-                        out.append(c)
+        for plate in plates:
+            for p0, p1 in _lines(layout if plate is None else layout.plate_view(plate)[0], path_spacing):
+                c = self.candidate(layout, None, p0, p1, plate=plate)
+                if c is not None:
+                    out.append(c)
         return out
 
     def parallel(self, layout, candidate, offsets) -> list:
         """``candidate``'s line moved across itself by ``offsets`` [m] (same length and direction;
         the pieces off the plate left out)."""
-        path = np.asarray(candidate.geometry["path"], float)[[0, -1]]
+        path, plate = in_plane(candidate), candidate.data.get("plate")
         out = []
         for o in np.asarray(offsets, float):
-            c = self.candidate(layout, None, *(path + o * normal(path)), height=candidate.data.get("height"))
+            c = self.candidate(layout, None, *(path + o * normal(path)), height=candidate.data.get("height"),
+                               plate=plate)
             if c is not None:
                 out.append(c)
+        return out
+
+    def stretched(self, layout, candidate, steps) -> list:
+        """``candidate``'s line with one end moved along it by each of ``steps`` [m] (> 0: longer; clipped
+        where it would leave the plate)."""
+        path, plate = in_plane(candidate), candidate.data.get("plate")
+        d = (path[1] - path[0]) / np.linalg.norm(path[1] - path[0])
+        out = []
+        for end, s in ((e, s) for e in (0, 1) for s in np.asarray(steps, float)):
+            moved = path.copy()
+            moved[end] += (s if end else -s) * d
+            if (moved[1] - moved[0]) @ d > 0:
+                c = self.candidate(layout, None, *moved, height=candidate.data.get("height"), plate=plate)
+                if c is not None:
+                    out.append(c)
         return out
 
     def along(self, candidate, path):
@@ -91,23 +98,30 @@ class _Stiffener:
         same = height is None or np.isclose(height, self.section.h, rtol=1e-9, atol=0.0)
         return label(path) + ("" if same else f"/h={1e3 * height:.4g}mm")
 
-    def candidate(self, layout, name, p0, p1, height: float | None = None):
+    def candidate(self, layout, name, p0, p1, height: float | None = None, plate: str | None = None):
         """The rib along the straight line ``p0``-``p1`` [m] called ``stiffener@<name>`` (None: named
         for its ends on the plate), of section ``height`` [m] (None: the kind's; the mass per length
-        of a rib of stiffness EI is 12 rho EI / (E h^2)); None where the line misses the plate."""
-        conn, weights, ends = layout.line_cells(p0, p1)
+        of a rib of stiffness EI is 12 rho EI / (E h^2)); None where the line misses the plate. On a
+        structure in 3-D, ``p0`` and ``p1`` are in the plane of its ``plate`` (:mod:`.plate_view`): the
+        candidate's path is in space, its ``plane_path`` in the plate's plane."""
+        view, frame = (layout, None) if plate is None else layout.plate_view(plate)
+        conn, weights, ends = view.line_cells(p0, p1)
         if not len(conn):
             return None
-        path = np.vstack([ends[:1, 0], ends[-1:, 1]])
+        flat = np.vstack([ends[:1, 0], ends[-1:, 1]])
         length = float(np.linalg.norm(ends[:, 1] - ends[:, 0], axis=1).sum())
         h = self.section.h if height is None else float(height)
-        return Candidate(self.name, f"{self.name}@{name or self._tag(path, height)}", tuple(path.mean(axis=0)), np.unique(conn),
-                         {"path": path}, {"conn": conn, "weights": weights, "length": length,
-                                          "thickness": layout.thickness, "height": h})
+        data = {"conn": conn, "weights": weights, "length": length, "thickness": view.thickness, "height": h}
+        path, tag = flat, name or self._tag(flat, height)
+        if frame is not None:
+            path, tag = frame.lift(flat), f"{plate}:{tag}"
+            data.update(plate=plate, plane_path=flat, normal=frame.normal)
+        return Candidate(self.name, f"{self.name}@{tag}", tuple(path.mean(axis=0)), np.unique(conn), {"path": path}, data)
 
     def place(self, layout, candidate):
         """Along ``candidate``'s line, of its section (ValueError where it misses the plate)."""
-        c = self.candidate(layout, "placed", *candidate.geometry["path"], height=candidate.data.get("height"))
+        c = self.candidate(layout, "placed", *in_plane(candidate), height=candidate.data.get("height"),
+                           plate=candidate.data.get("plate"))
         if c is None:
             raise ValueError(f"{candidate.name}: its line misses the plate")
         return c
@@ -115,8 +129,9 @@ class _Stiffener:
     def whole(self, candidates, i: int) -> int:
         """The index of the longest stiffener of ``candidates`` on candidate ``i``'s line (a bar across the
         card was found as a middle piece whose ends, fitted after, stopped 33 mm short of either edge)."""
-        ribs = [j for j, c in enumerate(candidates) if c.kind == self.name]
-        paths = [np.asarray(candidates[j].geometry["path"], float)[[0, -1]] for j in ribs]
+        plate = candidates[i].data.get("plate")
+        ribs = [j for j, c in enumerate(candidates) if c.kind == self.name and c.data.get("plate") == plate]
+        paths = [in_plane(candidates[j]) for j in ribs]
         n = np.array([normal(q) for q in paths])
         offset = np.einsum("ij,ij->i", n, np.array([q[0] for q in paths]))
         length = np.array([np.linalg.norm(q[1] - q[0]) for q in paths])
@@ -134,7 +149,8 @@ class _Stiffener:
         return 12.0 * sec.rho * value / (sec.E * sec.h**2) * candidate.data["length"]
 
     def _property(self, value: float, candidate):
-        return EmbeddedBeamProperty(rib_property(value, candidate.data["thickness"], self.section_of(candidate)),
+        return EmbeddedBeamProperty(rib_property(value, candidate.data["thickness"], self.section_of(candidate),
+                                                 candidate.data.get("normal", (0.0, 0.0, 1.0))),
                                     candidate.data["weights"])
 
     def blocks(self, model, candidates) -> list:
@@ -158,6 +174,27 @@ DIRECTIONS = np.radians([0.0, 90.0, 45.0, 135.0])
 #: the stretches of each line searched first (fractions of its length across the plate): the whole, and
 #: halves at either end and in the middle (a bar glued over part of the board is nearer one of them)
 PIECES = ((0.0, 1.0), (0.0, 0.5), (0.5, 1.0), (0.25, 0.75))
+
+
+def in_plane(candidate) -> np.ndarray:
+    """The ends (2, 2) [m] of a stiffener candidate's line in its plate's plane (a board's x, y)."""
+    return np.asarray(candidate.data.get("plane_path", candidate.geometry["path"]), float)[[0, -1]]
+
+
+def _lines(layout, path_spacing: float):
+    """The ends (p0, p1) of the lines :meth:`_Stiffener.generate` tries on a plate in its plane."""
+    lo, hi = _extent(layout)
+    centre = 0.5 * (lo + hi)
+    for angle in DIRECTIONS:
+        d = np.array([np.cos(angle), np.sin(angle)])
+        d[np.abs(d) < 1e-12] = 0.0
+        across = np.array([-d[1], d[0]])
+        half = 0.5 * float(np.abs(hi - lo) @ np.abs(across))  # the plate's half-width across the lines
+        n = max(1, int(round(2.0 * half / path_spacing)))
+        for s in -half + (np.arange(n) + 0.5) * (2.0 * half / n):
+            ends = _clipped(centre + s * across, d, lo, hi)
+            for a, b in [] if ends is None else PIECES:
+                yield ends[0] + a * (ends[1] - ends[0]), ends[0] + b * (ends[1] - ends[0])
 
 
 def normal(path) -> np.ndarray:

@@ -109,6 +109,8 @@ def enriched_effects(diagnosis) -> list:
             d["plate"] = e["plate"]
         if "section_height_mm" in e:
             d["height"] = 1e-3 * e["section_height_mm"]
+        if "section_material" in e:
+            d["material"] = e["section_material"]
         for key in ("segment", "path", "polygon"):
             if f"{key}_mm" in e:
                 d[key] = (np.asarray(e[f"{key}_mm"]) / 1e3).tolist()
