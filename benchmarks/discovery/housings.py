@@ -35,6 +35,7 @@ sys.path.insert(0, str(HERE))
 from cases import _loguniform, _parameter, _segment_in  # noqa: E402
 from make import ZETA, cache_dir, cached  # noqa: E402
 from seen import EXTRA_MODES  # noqa: E402
+from toml_text import declared_values, parameters_text, quantity_text  # noqa: E402
 
 E_AL, NU_AL, RHO_AL = 70e9, 0.33, 2700.0
 #: hidden effect kinds on housings and their weights
@@ -182,7 +183,7 @@ def _mm3(v) -> str:
 def box_text(h: Housing, truth: bool = False, mesh_mm: float | None = None, effects=None) -> str:
     """The box.toml handed to diagnose (nominal values, ``[[parameters]]``) or the true one (true values,
     the hidden effects declared: ``effects``, default all of them)."""
-    values = {t: (p["true"] if truth else p["nominal"]) for p in h.parameters for t in p["targets"]}
+    values = declared_values(h, truth)
     out = [f'[box]\nname = "{h.name}"\nmesh_size = "{mesh_mm or h.mesh_mm:g} mm"\n',
            f'[materials.al]\nE = "{E_AL / 1e9:g} GPa"\nnu = {NU_AL}\nrho = "{RHO_AL:g} kg/m^3"\n']
     for p in h.plates:
@@ -190,7 +191,7 @@ def box_text(h: Housing, truth: bool = False, mesh_mm: float | None = None, effe
              f'thickness = "{h.thickness_mm:g} mm"\nmaterial = "al"\n')
         E, rho = values.get(f"plates.{p['name']}.E"), values.get(f"plates.{p['name']}.rho")
         if E is not None:
-            s += f'E = "{E / 1e9:.6g} GPa"\nrho = "{rho:.6g} kg/m^3"\n'
+            s += f'E = {quantity_text(E, "Pa")}\nrho = {quantity_text(rho, "kg/m^3")}\n'
         out.append(s)
     inner = {p["name"]: p["inner"] for p in h.plates}
     for r in h.ribs:
@@ -208,12 +209,7 @@ def box_text(h: Housing, truth: bool = False, mesh_mm: float | None = None, effe
                        f'to = {_mm3(e["st"][1])}\nheight = "{e["height_mm"]:g} mm"\nwidth = "{e["width_mm"]:g} mm"\n'
                        f'side = "{inner[e["plate"]]}"\nmaterial = {{ E = "{e["E"] / 1e9:g} GPa", nu = 0.3, '
                        f'rho = "{e["rho"]:g} kg/m^3" }}\n')
-    for p in h.parameters:
-        lo, hi = p["bounds"]
-        unit = {"Pa": (1e-9, "GPa"), "mm": (1e3, "mm")}.get(p["unit"], (1.0, p["unit"]))
-        targets = "[" + ", ".join(f'"{t}"' for t in p["targets"]) + "]"
-        out.append(f'[[parameters]]\nname = "{p["name"]}"\ntarget = {targets}\n'
-                   f'bounds = ["{lo * unit[0]:.6g} {unit[1]}", "{hi * unit[0]:.6g} {unit[1]}"]\n')
+    out.append(parameters_text(h.parameters))
     return "\n".join(out)
 
 
@@ -256,7 +252,7 @@ def _state(h: Housing):
 def code_key() -> str:
     """A digest of the code that makes a housing: a cached one made by other code is made again."""
     digest = hashlib.sha1()
-    for name in ("housings.py", "cases.py", "opensees_truth.py", "detectability.py", "seen.py"):
+    for name in ("housings.py", "cases.py", "toml_text.py", "opensees_truth.py", "detectability.py", "seen.py"):
         digest.update((HERE / name).read_bytes())
     return digest.hexdigest()[:12]
 

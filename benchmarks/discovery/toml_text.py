@@ -10,7 +10,8 @@ from cases import Case
 SHOWN = {"Pa": (1e-9, "GPa"), "mm": (1e3, "mm"), "N/m": (1.0, "N/m"), "N*m/rad/m": (1.0, "N*m/rad/m")}
 
 
-def _q(value: float, unit: str) -> str:
+def quantity_text(value: float, unit: str) -> str:
+    """``value`` [SI] as a quoted quantity in the unit a case file shows for ``unit``."""
     scale, shown = SHOWN.get(unit, (1.0, unit))
     return f'"{value * scale:.6g} {shown}"'
 
@@ -23,7 +24,7 @@ def _pt(p) -> str:
     return f"[{_mm(p[0])}, {_mm(p[1])}]"
 
 
-def _values(case: Case, truth: bool) -> dict:
+def declared_values(case: Case, truth: bool) -> dict:
     """{target: SI value} of the declared parameters (nominal or true)."""
     return {t: (p["true"] if truth else p["nominal"]) for p in case.parameters for t in p["targets"]}
 
@@ -35,9 +36,9 @@ def _part(p: dict, values: dict) -> str:
         out += f'height = {_mm(p["height_mm"])}\n'
     if p["model"] == "equivalent_thickness":
         t = values.get(f"components.{p['ref']}.thickness", 1e-3 * p["thickness_mm"])
-        out += f'thickness = {_q(t, "mm")}\n'
+        out += f'thickness = {quantity_text(t, "mm")}\n'
     if p["model"] == "smeared_local":
-        out += f'E = {_q(p["E"], "Pa")}\n'
+        out += f'E = {quantity_text(p["E"], "Pa")}\n'
     return out
 
 
@@ -47,11 +48,11 @@ def _fixture(f: dict, values: dict) -> str:
         out += f'edge = "{f["edge"]}"\n'
     if f["type"] == "wedge_lock":
         k = values.get(f"fixtures.{f['name']}.k_rot", f["k_rot"])
-        out += f'k_rot = {_q(k, "N*m/rad/m")}\n'
+        out += f'k_rot = {quantity_text(k, "N*m/rad/m")}\n'
     if f["type"] == "standoff":
         out += f'at = {_pt(f["at"])}\n'
         k = values.get(f"fixtures.{f['name']}.k", f["k"])
-        out += 'k = "rigid"\n' if k is None else f'k = {_q(k, "N/m")}\n'
+        out += 'k = "rigid"\n' if k is None else f'k = {quantity_text(k, "N/m")}\n'
     return out
 
 
@@ -62,52 +63,59 @@ def _effect(e: dict) -> str:
         out = f'\n[[masses]]\nname = "{n}"\nat = {_pt(e["at"])}\nmass = "{1e3 * e["mass"]:.6g} g"\n'
         if k == "bracket":
             out += (f'\n[[fixtures]]\nname = "{n}_spring"\ntype = "point_spring"\nat = {_pt(e["at"])}\n'
-                    f'k = {_q(e["k"], "N/m")}\n')
+                    f'k = {quantity_text(e["k"], "N/m")}\n')
         return out
     if k == "ground_spring":
-        return f'\n[[fixtures]]\nname = "{n}"\ntype = "point_spring"\nat = {_pt(e["at"])}\nk = {_q(e["k"], "N/m")}\n'
+        return f'\n[[fixtures]]\nname = "{n}"\ntype = "point_spring"\nat = {_pt(e["at"])}\nk = {quantity_text(e["k"], "N/m")}\n'
     if k == "standoff":
         return f'\n[[fixtures]]\nname = "{n}"\ntype = "standoff"\nat = {_pt(e["at"])}\n'
     if k == "stiffener":
-        section = (f'{{ E = {_q(e["E"], "Pa")}, nu = 0.3, rho = "{e["rho"]:.6g} kg/m^3", '
+        section = (f'{{ E = {quantity_text(e["E"], "Pa")}, nu = 0.3, rho = "{e["rho"]:.6g} kg/m^3", '
                    f'height = {_mm(e["height_mm"])} }}')
         return (f'\n[[stiffeners]]\nname = "{n}"\npath = [{_pt(e["path"][0])}, {_pt(e["path"][1])}]\n'
                 f'EI = "{e["EI"]:.6g} N*m^2"\nsection = {section}\n')
     if k == "heat_sink":
         return (f'\n[[components]]\nref = "{n}"\nat = {_pt(e["at"])}\nsize = [{_mm(e["size"][0])}, {_mm(e["size"][1])}]\n'
-                f'mass = "{1e3 * e["mass"]:.6g} g"\nmodel = "smeared_local"\nE = {_q(e["E"], "Pa")}\n')
+                f'mass = "{1e3 * e["mass"]:.6g} g"\nmodel = "smeared_local"\nE = {quantity_text(e["E"], "Pa")}\n')
     if k == "line_mass":
         a, b = e["segment"]
         return f'\n[[line_masses]]\nname = "{n}"\nfrom = {_pt(a)}\nto = {_pt(b)}\nmass = "{1e3 * e["mass"]:.6g} g"\n'
     if k == "edge_stiffness":
         a, b = e["segment"]
         return (f'\n[[fixtures]]\nname = "{n}"\ntype = "edge_spring"\nfrom = {_pt(a)}\nto = {_pt(b)}\n'
-                f'k_rot = {_q(e["k_rot"], "N*m/rad/m")}\n')
+                f'k_rot = {quantity_text(e["k_rot"], "N*m/rad/m")}\n')
     if k == "region":
         x0, y0, x1, y1 = e["rect"]
         return f'\n[[regions]]\nname = "{n}"\nrect = [{_mm(x0)}, {_mm(y0)}, {_mm(x1)}, {_mm(y1)}]\nstiffness_factor = {e["factor"]:.6g}\n'
     raise ValueError(k)
 
 
+def parameters_text(parameters) -> str:
+    """``[[parameters]]`` entries of a case's declared parameters, within their bounds."""
+    out = ""
+    for p in parameters:
+        lo, hi = p["bounds"]
+        targets = ", ".join(f'"{t}"' for t in p["targets"])
+        out += (f'\n[[parameters]]\nname = "{p["name"]}"\ntarget = [{targets}]\n'
+                f'bounds = [{quantity_text(lo, p["unit"])}, {quantity_text(hi, p["unit"])}]\n')
+    return out
+
+
 def board_text(case: Case, truth: bool = False, mesh_mm: float | None = None) -> str:
     """The handed board.toml (``truth`` False) or the true one (true values, hidden effects declared)."""
-    values = _values(case, truth)
+    values = declared_values(case, truth)
     E = values.get("board.E", case.E)
     out = (f'# discovery case {case.name} ({"truth" if truth else "handed to diagnose"}), drawn by '
            f'benchmarks/discovery/cases.py\n[board]\nname = "{case.name}"\n'
            f'outline = {{ polygon = [{", ".join(_pt(p) for p in case.outline)}] }}\n'
            f'thickness = {_mm(case.thickness_mm)}\n'
-           f'material = {{ E = {_q(E, "Pa")}, nu = {case.nu:g}, rho = "{case.rho:g} kg/m^3" }}\n'
+           f'material = {{ E = {quantity_text(E, "Pa")}, nu = {case.nu:g}, rho = "{case.rho:g} kg/m^3" }}\n'
            f'mesh_size = {_mm(mesh_mm or case.mesh_mm)}\n')
     out += "".join(_part(p, values) for p in case.parts)
     out += "".join(_fixture(f, values) for f in case.fixtures)
     if truth:
         out += "".join(_effect(e) for e in case.effects)
     else:
-        for p in case.parameters:
-            lo, hi = p["bounds"]
-            targets = ", ".join(f'"{t}"' for t in p["targets"])
-            out += (f'\n[[parameters]]\nname = "{p["name"]}"\ntarget = [{targets}]\n'
-                    f'bounds = [{_q(lo, p["unit"])}, {_q(hi, p["unit"])}]\n')
+        out += parameters_text(case.parameters)
     out += f"\n[analysis]\nmodes = {case.test_modes + 4}\n"
     return out

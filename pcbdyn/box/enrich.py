@@ -6,7 +6,8 @@ stiffer or softer as a whole that plate's own ``E`` (the declared one times 1 + 
 comments that say where and how stiff.
 
 An effect is a dict as :func:`pcbdyn.report.diagnosis_report.enriched_effects` makes them: type, name,
-value (SI), at (x, y, z) [m] and plate; a stiffener's path [m], section height [m] and material.
+value (SI), at (x, y, z) [m] and plate; a stiffener's path [m], section height [m], material and the
+normal of the side it stands on.
 """
 
 from __future__ import annotations
@@ -25,16 +26,14 @@ def _name(doc, base: str, collection: str = "masses") -> str:
     return new_entry_name(base, used, collection[:-1])
 
 
-def _rib(doc, box, plate, e) -> tomlkit.items.Table:
+def _rib(doc, plate, e) -> tomlkit.items.Table:
     """A stiffener found as a ``[[ribs]]`` entry: its line in lengths along the plate's u and v, and the
     diagnosis's section (its material, its height h and the width b = 12 EI / (E h^3) its stiffness EI
-    gives), on the side of the plate that faces the box's centre, where the diagnosis placed it
-    (:mod:`pcbdyn.diagnosis.plate_view`)."""
+    gives), on the side of the plate its ``normal`` points to, where the diagnosis placed it."""
     m, h = e["material"], float(e["height"])
     ends = plate.coordinates(np.asarray(e["path"], float))[:, :2] * plate.lengths
-    centre = np.mean([q.corners().mean(axis=0) for q in box.plates], axis=0)
     width = 12.0 * float(e["value"]) / (m["E_Pa"] * h**3)
-    side = "+n" if plate.normal @ (centre - plate.corners().mean(axis=0)) > 0 else "-n"
+    side = "+n" if plate.normal @ np.asarray(e["normal"], float) > 0 else "-n"
     entry = tomlkit.table()
     entry.update({"name": _name(doc, str(e["name"]), "ribs"), "plate": plate.name,
                   "from": [targets.quantity(v, "mm") for v in ends[0]], "to": [targets.quantity(v, "mm") for v in ends[-1]],
@@ -63,8 +62,8 @@ def enriched_text(box, text: str, effects) -> str:
                           "mass": targets.formatted(targets.KINDS["masses", "mass"], float(e["value"]))})
             entry.comment(f"found by pcbdyn diagnose ({e['name']})")
             doc.setdefault("masses", tomlkit.aot()).append(entry)
-        elif e["type"] == "stiffener" and "path" in e and "material" in e:
-            doc.setdefault("ribs", tomlkit.aot()).append(_rib(doc, box, plate, e))
+        elif e["type"] == "stiffener" and {"path", "material", "normal"} <= e.keys():
+            doc.setdefault("ribs", tomlkit.aot()).append(_rib(doc, plate, e))
         elif e["type"] == "region_stiffness":
             i = next(k for k, p in enumerate(doc["plates"]) if entry_name("plates", p, k) == plate.name)
             factor = 1.0 + float(e["value"])

@@ -113,6 +113,8 @@ def merged(chosen, values, cov, cov_jack, cov_place, group, profile=None, places
         sec = c.spec.section_of(c)
         d["section_height_mm"] = round(1e3 * sec.h, 4)
         d["section_material"] = {"E_Pa": sec.E, "nu": sec.nu, "rho_kg_m3": sec.rho}
+        if "normal" in c.data:  # the side of a housing's plate it stands on (:mod:`.plate_view`)
+            d["normal"] = np.round(c.data["normal"], 12).tolist()
     sub = np.ix_(group, group)
     u = parts(float(w @ v), w, cov[sub] if cov.size else cov, cov_jack[sub], cov_place[sub], places, model_form(c.kind))
     d["interval_2sigma"] = interval(float(w @ v), u, profile, c.spec.lower)

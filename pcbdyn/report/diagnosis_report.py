@@ -111,6 +111,8 @@ def enriched_effects(diagnosis) -> list:
             d["height"] = 1e-3 * e["section_height_mm"]
         if "section_material" in e:
             d["material"] = e["section_material"]
+        if "normal" in e:
+            d["normal"] = e["normal"]
         for key in ("segment", "path", "polygon"):
             if f"{key}_mm" in e:
                 d[key] = (np.asarray(e[f"{key}_mm"]) / 1e3).tolist()

@@ -33,11 +33,14 @@ def edited(tmp_path, changes: dict | None = None, remove=(), name: str = "box.to
 
 
 def plate_box(tmp_path, a_mm: float, b_mm: float, t_mm: float, body: str = "", mesh_mm: float = 10.0,
-              material: str = 'E = "70 GPa"\nnu = 0.33\nrho = "2700 kg/m^3"', name: str = "box.toml") -> Path:
-    """A box of one plate a x b in the x-y plane (material ``al``), with ``body`` appended (ribs, supports)."""
+              material: str = 'E = "70 GPa"\nnu = 0.33\nrho = "2700 kg/m^3"', name: str = "box.toml",
+              axes=((1, 0, 0), (0, 1, 0))) -> Path:
+    """A box of one plate a x b along the unit ``axes`` (u, v; default the x-y plane), material ``al``, with
+    ``body`` appended (ribs, supports)."""
+    u, v = (", ".join(f'"{side * c:g} mm"' for c in axis) for side, axis in ((a_mm, axes[0]), (b_mm, axes[1])))
     text = (f'[box]\nname = "plate"\nmesh_size = "{mesh_mm} mm"\n\n[materials.al]\n{material}\n\n'
-            f'[[plates]]\nname = "p"\norigin = ["0 mm", "0 mm", "0 mm"]\nu = ["{a_mm} mm", "0 mm", "0 mm"]\n'
-            f'v = ["0 mm", "{b_mm} mm", "0 mm"]\nthickness = "{t_mm} mm"\nmaterial = "al"\n\n{body}')
+            f'[[plates]]\nname = "p"\norigin = ["0 mm", "0 mm", "0 mm"]\nu = [{u}]\n'
+            f'v = [{v}]\nthickness = "{t_mm} mm"\nmaterial = "al"\n\n{body}')
     out = Path(tmp_path) / name
     out.write_text(text)
     return out

@@ -30,19 +30,9 @@ from pcbdyn.diagnosis.layout import from_structure
 from pcbdyn.fe.modal import solve_modes
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "box"))
-from box_helpers import EXAMPLE, POINTS, edited  # noqa: E402
+from box_helpers import EXAMPLE, POINTS, edited, plate_box, supports  # noqa: E402
 
-HEAD = '[box]\nname = "plate"\nmesh_size = "10 mm"\n\n[materials.al]\nE = "70 GPa"\nnu = 0.33\nrho = "2700 kg/m^3"\n\n'
 A, B = 180.0, 120.0  # [mm] the plate's sides along u and v
-
-
-def _one_plate(tmp_path, name, origin, u, v) -> Path:
-    def mm(p):
-        return "[" + ", ".join(f'"{x} mm"' for x in p) + "]"
-    path = tmp_path / f"{name}.toml"
-    path.write_text(HEAD + f'[[plates]]\nname = "p"\norigin = {mm(origin)}\nu = {mm(u)}\nv = {mm(v)}\nthickness = "2 mm"\n'
-                           'material = "al"\n\n[[supports]]\nplate = "p"\nedge = "v0"\ntype = "clamped"\n')
-    return path
 
 
 def test_a_rib_on_a_plate_stood_up_as_a_wall_is_the_rib_on_the_flat_plate(tmp_path):
@@ -50,9 +40,10 @@ def test_a_rib_on_a_plate_stood_up_as_a_wall_is_the_rib_on_the_flat_plate(tmp_pa
     shifts agree within three times that difference."""
     rib = kind("stiffener")
     shifts, counts, plain = [], [], []
-    for name, origin, u, v, to3 in (("flat", [0, 0, 0], [A, 0, 0], [0, B, 0], lambda s, t: [s, t, 0.0]),
-                                    ("wall", [0, 0, 0], [0, A, 0], [0, 0, B], lambda s, t: [0.0, s, t])):
-        pm = load_box(_one_plate(tmp_path, name, origin, u, v)).build()
+    for name, axes, to3 in (("flat", ((1, 0, 0), (0, 1, 0)), lambda s, t: [s, t, 0.0]),
+                            ("wall", ((0, 1, 0), (0, 0, 1)), lambda s, t: [0.0, s, t])):
+        pm = load_box(plate_box(tmp_path, A, B, 2, supports("p", "clamped", ("v0",)), name=f"{name}.toml",
+                                axes=axes)).build()
         layout = from_structure(pm)
         assert layout.planar == (name == "flat")
         ends = 1e-3 * np.array([to3(0.2 * A, 0.0), to3(0.7 * A, B)])  # an oblique line across the cells
