@@ -16,7 +16,7 @@ from collections import OrderedDict
 import numpy as np
 import scipy.sparse as sp
 
-from ..fe.sparsity import UnionPattern, canonical_csr
+from ..fe.sparsity import UnionPattern, canonical_csr, same_array
 from .catalogue import BlockCache, derivatives, kind
 
 #: patterns of effect sets kept (least recently used dropped first)
@@ -25,19 +25,26 @@ PLANS_KEPT = 64
 
 class EffectPlan:
     """The union pattern of a base CSR pattern and the effects' derivative matrices, and where each
-    of them sits in it (``base``: positions of the base entries, ``at[k]``: of effect k's)."""
+    of them sits in it (``base``: positions of the base entries, None where the union is the base's
+    own pattern; ``at[k]``: of effect k's). ``own``: the base's pattern alone
+    (:meth:`pcbdyn.fe.sparsity.UnionPattern.of`): where the effects lie within it (a mass or a spring
+    on a node, a rib along the cells' edges) the union is that pattern, index arrays and all, so
+    every later cache keyed by the arrays' identity hits."""
 
-    def __init__(self, base: sp.csr_matrix, parts: list):
-        self.union = UnionPattern([A for pair in parts for A in pair], keep=base)
+    def __init__(self, base: sp.csr_matrix, parts: list, own: UnionPattern):
+        matrices = [A for pair in parts for A in pair]
+        inside = all(own.covers(A) for A in matrices)
+        self.union = own if inside else UnionPattern(matrices, keep=base)
         self.of = base.indices  # held: the plan is found again by the identity of the base's index
-        self.base = self.union.positions(base)
+        self.base = None if inside else self.union.positions(base)
         self.at = [(self.union.positions(dK), self.union.positions(dM)) for dK, dM in parts]
 
     def combine(self, K, M, parts, values) -> tuple[sp.csr_matrix, sp.csr_matrix]:
         """K + sum v_k dK_k and M + sum v_k dM_k on the union pattern (shared index arrays)."""
         data = np.zeros((2, self.union.nnz))
-        data[0, self.base] = K.data
-        data[1, self.base] = M.data
+        at = slice(None) if self.base is None else self.base
+        data[0, at] = K.data
+        data[1, at] = M.data
         for (pk, pm), (dK, dM), v in zip(self.at, parts, values):  # positions are unique within each
             data[0, pk] += v * dK.data
             data[1, pm] += v * dM.data
@@ -54,6 +61,7 @@ class Effects:
         self._fixed: dict = {}
         self._moving: dict = {}
         self._plans: OrderedDict = OrderedDict()
+        self._own: dict = {}  # configuration -> the pattern of its K alone
 
     def derivative(self, k: int, model, cand, p) -> tuple:
         """(dK, dM) of ``cand`` on configuration ``k``'s ``model`` at parameters ``p``, canonical CSR."""
@@ -77,7 +85,10 @@ class Effects:
         key = (k, K.shape, id(K.indices), tuple(c.name for c, _ in on))
         plan = self._plans.get(key)
         if plan is None or plan.of is not K.indices:
-            plan = self._plans[key] = EffectPlan(K, parts)
+            own = self._own.get(k)
+            if own is None or not same_array(own.indices, K.indices):
+                own = self._own[k] = UnionPattern.of(K)
+            plan = self._plans[key] = EffectPlan(K, parts, own)
             while len(self._plans) > PLANS_KEPT:
                 self._plans.popitem(last=False)
         else:

@@ -86,6 +86,55 @@ def selection(A: sp.csr_matrix, idx: np.ndarray) -> Gather:
     return Gather.kept(A, keep, idx, cols, (m, m))
 
 
+def _expanded(starts: np.ndarray, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(owner, position): each i repeated ``counts[i]`` times, with the consecutive positions
+    ``starts[i]``, ``starts[i] + 1``, ... of its run."""
+    owner = np.repeat(np.arange(counts.size), counts)
+    first = np.cumsum(counts) - counts
+    return owner, np.arange(owner.size) - first[owner] + starts[owner]
+
+
+@dataclass
+class Projection:
+    """The plan of T^T A T for every A on one CSR pattern (``indptr``, ``indices``): the reduced
+    matrix's values are one sparse product ``P @ A.data`` on a pattern found once (index arrays shared
+    by every matrix it makes, so K and M and every later solve of the model come out on one
+    pattern). Multi-point constraints make T more than a selection; the triple product of sparse
+    matrices, with the union of K's and M's reduced patterns after it, cost a third of a small
+    model's eigen-solution (8.7k DOF, 769 MPCs: 37 of 111 ms)."""
+
+    indptr: np.ndarray
+    indices: np.ndarray
+    P: sp.csr_matrix
+    sub_indptr: np.ndarray
+    sub_indices: np.ndarray
+    shape: tuple
+
+    @classmethod
+    def of(cls, A: sp.csr_matrix, T: sp.csr_matrix) -> Projection:
+        """The plan of T^T A T for canonical CSR ``A`` (n, n) and CSR ``T`` (n, m)."""
+        m = T.shape[1]
+        per_row = np.diff(T.indptr)
+        rows = np.repeat(np.arange(A.shape[0]), np.diff(A.indptr))
+        e1, ti = _expanded(T.indptr[rows], per_row[rows])  # entry e = (r, c) meets T's row r ...
+        e2, tj = _expanded(T.indptr[A.indices[e1]], per_row[A.indices[e1]])  # ... and T's row c
+        ti, entry = ti[e2], e1[e2]
+        keys = T.indices[ti].astype(np.int64) * m + T.indices[tj]
+        pattern, at = np.unique(keys, return_inverse=True)
+        P = sp.csr_matrix((T.data[ti] * T.data[tj], (at.ravel(), entry)), shape=(pattern.size, A.indices.size))
+        sub_indptr = np.zeros(m + 1, dtype=A.indices.dtype)
+        np.cumsum(np.bincount(pattern // m, minlength=m), out=sub_indptr[1:])
+        return cls(A.indptr, A.indices, P, sub_indptr, (pattern % m).astype(A.indices.dtype), (m, m))
+
+    def fits(self, A) -> bool:
+        """True when ``A`` has the source pattern of this plan."""
+        return _same(A.indptr, self.indptr) and _same(A.indices, self.indices)
+
+    def apply(self, data: np.ndarray) -> sp.csr_matrix:
+        """T^T A T from the values ``data`` of A on the source pattern."""
+        return sp.csr_matrix((self.P @ data, self.sub_indices, self.sub_indptr), shape=self.shape, copy=False)
+
+
 def lower_triangle(A: sp.csr_matrix) -> Gather:
     """The plan of the lower triangle of a symmetric CSR ``A`` as CSC: its upper entries row by row
     are the lower ones column by column, so CHOLMOD gets it without a transpose."""
@@ -120,6 +169,20 @@ class UnionPattern:
         union = canonical_csr(union)
         self.indptr, self.indices, self.shape = union.indptr, union.indices, union.shape
         self._keys = entry_keys(union)
+
+    @classmethod
+    def of(cls, A) -> UnionPattern:
+        """The pattern of canonical CSR ``A`` alone, on A's own index arrays (every matrix it makes
+        shares them)."""
+        out = cls.__new__(cls)
+        out.indptr, out.indices, out.shape, out._keys = A.indptr, A.indices, A.shape, entry_keys(A)
+        return out
+
+    def covers(self, A) -> bool:
+        """True when every stored entry of canonical CSR ``A`` has its place in this pattern."""
+        keys = entry_keys(A)
+        at = np.searchsorted(self._keys, keys)
+        return bool(np.all(at < self._keys.size) and np.array_equal(self._keys[np.minimum(at, self._keys.size - 1)], keys))
 
     @property
     def nnz(self) -> int:

@@ -12,7 +12,8 @@ from pcbdyn.fe.assembly import assemble
 from pcbdyn.fe.generate import rectangle, rectangle_edges
 from pcbdyn.fe.model import Model
 from pcbdyn.fe.properties import ShellProperty, SpringProperty
-from pcbdyn.fe.sparsity import common_pattern, lower_triangle, same_array, selection
+from pcbdyn.fe.constraints import build_reduction
+from pcbdyn.fe.sparsity import Projection, UnionPattern, common_pattern, lower_triangle, same_array, selection
 
 
 def plate(n, tilt=0.0, support="clamped", aspect=0.93):
@@ -169,6 +170,39 @@ def test_index_plans_equal_fancy_indexing():
     assert same_array(Kc.indices, Mc.indices)
     np.testing.assert_array_equal(Kc.toarray(), A.toarray())
     np.testing.assert_array_equal(Mc.toarray(), B.toarray())
+
+
+def test_projection_plan_equals_the_triple_product():
+    """T^T A T by the kept projection plan equals the sparse triple product to round-off, for a T with
+    several masters per slave; K and M on one pattern come out on one pattern, and a Reduction built
+    again for the same model reduces on the very index arrays (what the layout cache finds them by)."""
+    model = plate(6, support="simple")
+    for slave, masters in ((8, (1, 2)), (9, (8,)), (10, (9, 1)), (30, (31, 32, 40))):  # a chain: 10 -> 9 -> 8 -> 1, 2
+        model.constrain(6 * slave + 2, [(6 * m + 2, 1.0 / len(masters)) for m in masters])
+    K, M = assemble(model)
+    red = build_reduction(model, K, M)
+    assert not red.is_selection
+    for A in (K, M):
+        ref = (red.T.T @ A @ red.T).toarray()
+        got = Projection.of(A.tocsr(), red.T).apply(A.tocsr().data).toarray()
+        np.testing.assert_allclose(got, ref, rtol=0, atol=1e-14 * np.abs(ref).max())
+    Kr, Mr = red.reduce(K), red.reduce(M)
+    again = build_reduction(model, K, M).reduce(M)
+    assert same_array(Kr.indices, Mr.indices) and same_array(again.indices, Mr.indices)
+    np.testing.assert_array_equal(again.toarray(), Mr.toarray())
+
+
+def test_a_pattern_covering_a_local_matrix_keeps_its_own_index_arrays():
+    """A local matrix (one node's spring) inside a pattern is placed on that pattern itself; one that
+    reaches outside it (two far nodes tied) is not covered."""
+    K, _ = assemble(plate(4))
+    own = UnionPattern.of(K)
+    inside = sp.csr_matrix(([1.0], ([3 * 6 + 2], [3 * 6 + 2])), shape=K.shape)
+    outside = sp.csr_matrix(([1.0, 1.0], ([2, 20 * 6 + 2], [20 * 6 + 2, 2])), shape=K.shape)
+    assert own.covers(inside) and not own.covers(outside)
+    assert same_array(own.matrix(K.data).indices, K.indices)
+    row = K.indices[K.indptr[20]:K.indptr[21]]
+    assert own.positions(inside)[0] == K.indptr[20] + np.flatnonzero(row == 20)[0]
 
 
 def test_thread_limit_from_the_environment(monkeypatch):
