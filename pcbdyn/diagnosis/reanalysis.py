@@ -83,11 +83,15 @@ class _Config:
         if key in self.X:
             return
         X = beyond_basis(self.cs, self.phi, _column_space(dK @ self.paired - (dM @ self.paired) * self.lam_p[None, :]))
-        X -= self.phi @ (self.phi.T @ (self.cs.M @ X))  # M-orthogonal to the modes (to round-off already)
-        d, U = np.linalg.eigh(X.T @ (self.cs.M @ X))
+        MX = self.cs.M @ X
+        along = self.phi.T @ MX
+        X -= self.phi @ along  # M-orthogonal to the modes (to round-off already)
+        MX -= self.M_phi @ along
+        d, U = np.linalg.eigh(X.T @ MX)
         keep = d > RANK_TOL * max(d.max(initial=0.0), 1e-300)
-        X = X @ (U[:, keep] / np.sqrt(d[keep]))
-        self.X[key], self.KX[key], self.MX[key] = X, self.cs.K @ X, self.cs.M @ X
+        W = U[:, keep] / np.sqrt(d[keep])
+        X = X @ W
+        self.X[key], self.KX[key], self.MX[key] = X, self.cs.K @ X, MX @ W
         self.read_X[key] = None if self.read_phi is None else np.asarray(self.ob.read @ X)
 
     def moved(self, key, dK, dM, keys) -> tuple:
