@@ -20,7 +20,7 @@ from .sparsity import Gather, Projection, canonical_csr, row_counts, same_array,
 #: other caches keyed by pattern (:data:`.blocks.LAYOUT_CACHE_SIZE`)
 PLANS_KEPT = 8
 _plans: OrderedDict = OrderedDict()
-_resolved: OrderedDict = OrderedDict()
+_resolved: OrderedDict = OrderedDict()  # the MPC chains followed (:func:`_chains`), as many
 
 
 @dataclass
@@ -65,12 +65,11 @@ class Reduction:
         return plan
 
 
-def _chains(mpcs) -> tuple[np.ndarray, np.ndarray, tuple]:
-    """(the slaves, the direct masters of each constraint term (aligned with ``np.repeat(slaves,
-    terms)``), the (slave, master, coefficient) arrays with every chain of MPCs (a master that is
-    itself a slave) followed to DOFs that are no slave), kept by the constraints' digest:
-    every solve of a model reduces it anew, and following 800 chains in Python took 5 ms of a
-    small model's 80 ms solve."""
+def _chains(mpcs) -> tuple[np.ndarray, tuple, tuple]:
+    """(the slave DOFs, (master, slave) of every constraint term, (slave, master, coefficient) with
+    every chain of MPCs (a master that is itself a slave) followed to DOFs that are no slave), kept
+    by the constraints' digest: every solve of a model reduces it anew, and following 800 chains in
+    Python took 5 ms of a small model's 80 ms solve."""
     flat = [(int(s), int(m), float(c)) for s, terms in mpcs for m, c in terms]
     sizes = np.array([len(terms) for _, terms in mpcs], dtype=np.int64)
     key = pattern_key(sizes, np.array(flat, dtype=float).reshape(-1, 3))
@@ -121,8 +120,10 @@ def build_reduction(model, K=None, M=None) -> Reduction:
             held = [(A.indptr, A.data != 0) for A in (K, M)]
         for indptr, nonzero in held:  # symmetric: a DOF with a nonzero in its column has one in its row
             touched |= row_counts(indptr, nonzero) > 0
-        while not touched[reached := masters[touched[of_slave]]].all():  # a slave's stiffness reaches its masters
+        reached = masters[touched[of_slave]]  # a slave's stiffness reaches its masters (along chains)
+        while not touched[reached].all():
             touched[reached] = True
+            reached = masters[touched[of_slave]]
         untouched = ~touched
     is_slave = np.zeros(n, dtype=bool)
     is_slave[slaves] = True
