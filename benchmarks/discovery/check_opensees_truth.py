@@ -6,6 +6,7 @@ a. simply supported square plate against Kirchhoff's f_mn;
 b. a beam alone (Iy != Iz, skew axis, offset) against pcbdyn's beam (axes and offset);
 c. the example boards, a card with one entry of each kind and a card with only a stiffener,
    pcbdyn against OpenSees: frequencies, ratio and MAC (z DOFs) of the shapes paired by max MAC;
+d. the ribbed housing of seed 0 (tall ribs: their rotary inertia) at the model's mesh;
 --timing: solve_opensees on the six-part card at three mesh sizes; --shell: the shell element of c.
 """
 
@@ -138,6 +139,20 @@ def compare(label: str, toml_text: str, h: float, n: int = 8, shell: str = "Shel
     table(ours.frequencies, f, mac(ours.shapes[2::6], s[:, 2, :]), n)
 
 
+def check_housing(seed: int = 0) -> None:
+    """The ribbed housing of ``seed`` (:mod:`housings`, its true values and effects) at the model's mesh:
+    the ribs' rotary inertia, lumped on OpenSees' axis nodes, against pcbdyn's consistent one."""
+    from housings import _model, draw
+
+    h = draw(seed)
+    m = _model(h, True, h.mesh_mm)
+    ours = solve_modes(m, n_modes=h.test_modes)
+    f, s = solve_opensees(m, h.test_modes + 2, h.shell)
+    print(f"\nd. housing h{seed:04d}, mesh {h.mesh_mm:g} mm, {m.n_nodes} nodes, {h.shell} (translations for the MAC)")
+    table(ours.frequencies, f, mac(ours.shapes.reshape(m.n_nodes, 6, -1)[:, :3].reshape(-1, ours.frequencies.size),
+                                   s[:, :3].reshape(-1, f.size)))
+
+
 def timing() -> None:
     print("\ntiming of solve_opensees(model, 10) on the six-part card")
     for h in (6.75e-3, 3.375e-3, 1.6875e-3):
@@ -158,5 +173,6 @@ if __name__ == "__main__":
             shell=shell)
     for h in (3.375e-3, 1.6875e-3):
         compare("c. card + rib only", card + RIB, h, shell=shell)
+    check_housing()
     if "--timing" in sys.argv:
         timing()
