@@ -15,7 +15,8 @@ from .catalogue import kind
 #: (:mod:`.geometry_fit` then moves it on meshes along it; the bar of ``ho_al_bar``, found as two
 #: lines, took 22 s of local search in quarter steps, 13 s in halves)
 LINE_STEP = 0.5
-#: [element sizes] how far an end of a stiffener on a housing's plate moves along its line in one step
+#: [element sizes] how far an end of a stiffener moves along its line in one step, on a structure that
+#: cannot be meshed along it (a housing's plates: :func:`.conforming.follows_lines`)
 END_STEP = 1.0
 #: [element sizes] how far a point between nodes moves in one step of the local search
 POINT_STEP = 0.25
@@ -71,8 +72,9 @@ def overlap(ra, rb) -> list:
 class LocalMoves:
     """neighbours(i) for :func:`.select.refine`: for a run of pieces of a side, the runs of the
     same kind and side that start and end at most one piece from its own; for a stiffener, its line
-    moved half an element (:data:`LINE_STEP`) across itself either way, and on a housing's plate each of its
-    ends an element (:data:`END_STEP`) along it either way; for a rectangular region,
+    moved half an element (:data:`LINE_STEP`) across itself either way, and with ``walk_ends`` (a
+    structure not meshed along lines, whose ribs :mod:`.geometry_fit` cannot fit) each of its ends an
+    element (:data:`END_STEP`) along it either way; for a rectangular region,
     the rectangles with one side or both sides of an axis moved by one element (:data:`RECT_STEP`) in or
     out, or shifted by one element (:func:`_rect_moves`); for a point
     between nodes (a support, :mod:`.support`, or a mass at its point), the points a quarter element
@@ -81,8 +83,8 @@ class LocalMoves:
     partner, sits where that model's modes put it, and walks to where the fitted model's do). Lines,
     rectangles and points are made on demand and appended to ``cands``."""
 
-    def __init__(self, layout, cands: list, h: float):
-        self.layout, self.cands, self.h = layout, cands, h
+    def __init__(self, layout, cands: list, h: float, walk_ends: bool = False):
+        self.layout, self.cands, self.h, self.walk_ends = layout, cands, h, walk_ends
         self.shell = set(layout.shell_nodes().tolist())
         plate = layout.xy[layout.shell_nodes()]
         self.lo, self.hi = plate.min(axis=0), plate.max(axis=0)
@@ -139,7 +141,7 @@ class LocalMoves:
         if c.kind == "stiffener":
             rib, steps = kind("stiffener"), self.h * np.array([-1.0, 1.0])
             made = rib.parallel(self.layout, c, LINE_STEP * steps)
-            if "plate" in c.data:  # a housing's rib is not fitted on meshes along it (:mod:`.geometry_fit`): its ends walk
+            if self.walk_ends:
                 made += rib.stretched(self.layout, c, END_STEP * steps)
             return self._add(made)
         if at_point(c):
