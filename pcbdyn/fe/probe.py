@@ -25,6 +25,8 @@ from .model import SHELL_TYPES, ModelError
 _XI = np.array([-1.0, 1.0, 1.0, -1.0])
 _ETA = np.array([-1.0, -1.0, 1.0, 1.0])
 _ITER = 30
+#: a point's projection has converged once its (xi, eta) moves no more than this in a step
+_CONVERGED = 1e-13
 
 
 class ProbeError(ModelError):
@@ -61,21 +63,29 @@ def _quad_weights(xi, eta):
 
 
 def _project_quads(X, p):
-    """Closest point on bilinear patches X (m, 4, 3) to points p (m, 3): (weights (m, 4), distance)."""
+    """Closest point on bilinear patches X (m, 4, 3) to points p (m, 3): (weights (m, 4), distance).
+    A point stops iterating once its (xi, eta) moves less than :data:`_CONVERGED` in a step (two to
+    four steps inside a cell); points beside a distorted cell, clamped to its edge, may swing between
+    its sides to the last of :data:`_ITER` steps."""
     xi = np.zeros(len(p))
     eta = np.zeros(len(p))
+    on = np.arange(len(p))
     for _ in range(_ITER):
-        dxi = 0.25 * _XI * (1 + eta[:, None] * _ETA)
-        deta = 0.25 * _ETA * (1 + xi[:, None] * _XI)
-        r = p - np.einsum("ma,mak->mk", _quad_weights(xi, eta), X)
-        a = np.einsum("ma,mak->mk", dxi, X)
-        b = np.einsum("ma,mak->mk", deta, X)
+        Xo, x0, e0 = X[on], xi[on], eta[on]
+        dxi = 0.25 * _XI * (1 + e0[:, None] * _ETA)
+        deta = 0.25 * _ETA * (1 + x0[:, None] * _XI)
+        r = p[on] - np.einsum("ma,mak->mk", _quad_weights(x0, e0), Xo)
+        a = np.einsum("ma,mak->mk", dxi, Xo)
+        b = np.einsum("ma,mak->mk", deta, Xo)
         aa, ab, bb = (a * a).sum(1), (a * b).sum(1), (b * b).sum(1)
         ra, rb = (r * a).sum(1), (r * b).sum(1)
         det = aa * bb - ab * ab
         det = np.where(np.abs(det) > 0, det, 1.0)
-        xi = np.clip(xi + (bb * ra - ab * rb) / det, -1.0, 1.0)
-        eta = np.clip(eta + (aa * rb - ab * ra) / det, -1.0, 1.0)
+        xi[on] = np.clip(x0 + (bb * ra - ab * rb) / det, -1.0, 1.0)
+        eta[on] = np.clip(e0 + (aa * rb - ab * ra) / det, -1.0, 1.0)
+        on = on[np.maximum(np.abs(xi[on] - x0), np.abs(eta[on] - e0)) > _CONVERGED]
+        if not on.size:
+            break
     w = _quad_weights(xi, eta)
     return w, np.linalg.norm(p - np.einsum("ma,mak->mk", w, X), axis=1)
 
