@@ -27,6 +27,8 @@ from pathlib import Path
 
 import numpy as np
 
+from pcbdyn.board.entries import RibSection
+
 ROOT = Path(__file__).resolve().parents[2]
 CARD = ROOT / "examples" / "six_part_card" / "board.toml"
 WEDGE = ROOT / "examples" / "wedge_locked" / "board.toml"
@@ -34,6 +36,9 @@ F_MAX = 1000.0
 MODEL_MESH = 6.75e-3  # the mesh of both example boards
 FINE_MESH = MODEL_MESH / 4.0  # the truths are meshed four times finer
 SHAKER = (0.135, 0.06357)  # the card's shaker point (its 13 g force transducer)
+#: bending stiffness [N m^2] of an aluminium flat bar 10 mm wide, of the stiffener's default section
+#: (:class:`pcbdyn.board.entries.RibSection`, 4 mm high), whose mass then follows from it
+AL_BAR_EI = RibSection().E * 10e-3 * RibSection().h ** 3 / 12.0
 
 
 # ----------------------------------------------------------------------------------------- cases
@@ -137,6 +142,11 @@ CASES = [
          configs=(None, "c2"), true_values=CARD_TRUE, seed=11, note="a 20 g connector along the top edge; two configurations"),
     Case("line_mass_free_edge", "wedge", (Effect("line_mass", 25e-3, segment=((0.0, 0.050), (0.0, 0.100))),),
          true_values=WEDGE_TRUE, seed=12, note="a 25 g connector along the free left edge"),
+    Case("compound_al_bar", "card", (Effect("stiffener", AL_BAR_EI, path=((0.0, 0.112), (0.162, 0.112))),),
+         true_values=CARD_TRUE, seed=21, note="an aluminium flat bar 10 x 4 mm glued across the card (17.5 g with it)"),
+    Case("compound_bracket", "card", (Effect("point_mass", 15e-3, at=(0.081, 0.113)),
+                                      Effect("ground_spring", 1e5, at=(0.081, 0.113))),
+         true_values=CARD_TRUE, seed=22, note="a 15 g bracket on a 1e5 N/m spring to the frame"),
     Case("noise_card", "card", true_values=CARD_TRUE, seed=13, note="no hidden effect"),
     Case("noise_card_cfg", "card", configs=C23, true_values=CARD_TRUE, seed=14, note="no hidden effect; three configurations"),
     Case("noise_wedge", "wedge", true_values=WEDGE_TRUE, seed=15,
