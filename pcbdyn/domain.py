@@ -19,8 +19,9 @@ A structure has a ``name``, the ``path`` of its file, its ``parameters``
 - ``write_enriched(effects, dst)``: its file with the effects a diagnosis found declared in it (the
   user's comments and layout kept); returns the path written;
 - ``outlines(config=None)``: what a mode-shape picture outlines (plain data: kind, label, points);
-- a plate in one plane (on which a diagnosis looks for stiffeners) also has ``following(lines)``: a
-  copy whose meshes' element edges follow ``lines`` (polylines (m, 2) [m]) as well.
+- ``following(lines)``: a copy whose meshes' element edges also follow ``lines`` (polylines on its
+  plates, (m, 2) [m] on a board in its plane, (m, 3) in space on a housing), where a diagnosis found
+  ribs; a :class:`StructureError` where it cannot be meshed along them.
 
 A built model (:class:`pcbdyn.fe.parametric.ParametricModel`) adds what a diagnosis asks of it:
 ``layout_hints()`` (prime suspects, footprints, plate thickness) and ``with_shear_factor(f)``.
@@ -66,6 +67,8 @@ class Structure(Protocol):
     def write_enriched(self, effects, dst): ...
 
     def outlines(self, config=None) -> list: ...
+
+    def following(self, lines): ...
 
 
 #: fewest elements across a structure's smallest plate a mesh must have

@@ -6,7 +6,7 @@ configuration, measurement points on the plates, the updated box.toml."""
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -49,6 +49,7 @@ class Box(Configured):
     analysis: Analysis = field(default_factory=Analysis)
     cards: list = field(default_factory=list)  # .cards.Card
     holds: dict = field(default_factory=dict)  # {card name: [.cards.Hold]}
+    guides: list = field(default_factory=list)  # lines (m, 3) [m] element edges also follow (:meth:`following`)
 
     def card(self, name):
         return next((c for c in self.cards if c.name == name), None)
@@ -90,6 +91,11 @@ class Box(Configured):
 
             return build_system(self, config, mesh_size, shared_mesh)
         return build_model(self, config, mesh_size, shared_mesh)
+
+    def following(self, lines) -> "Box":
+        """This box meshed so that element edges also follow ``lines`` (polylines (m, 3) [m] on its plates)
+        with nothing declared on them: where a diagnosis found ribs (:mod:`pcbdyn.diagnosis.conforming`)."""
+        return replace(self, guides=[np.asarray(line, float) for line in lines])
 
     def nearest_plates(self, xyz) -> tuple:
         """(index of the nearest plate, distance [m]) of each point (k, 3)."""

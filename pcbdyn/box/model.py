@@ -197,11 +197,13 @@ def build_model(box, config: str | None = None, mesh_size: float | None = None, 
     """The FE model of ``box`` in configuration ``config`` (None: the base one); ``shared_mesh``: every
     configuration's masses are nodes, so that all configurations share one mesh node for node.
     ``points`` [(name, plate, xyz)]: more points that must be nodes (in ``point_nodes`` by name),
-    ``lines`` [(p0, p1)] more lines element edges follow: where cards meet the housing; ``bind``: the
+    ``lines`` [(p0, p1)] more lines element edges follow: where cards meet the housing (and the box's
+    ``guides``, :meth:`.box.Box.following`); ``bind``: the
     box's parameters bound (a system binds them once its cards are in)."""
     cfg = configuration_of(box, config, BoxError)
     named = _named_points(box, cfg, shared_mesh) + list(points)
     ribs = [(box.plate(r.plate).point(*r.start), box.plate(r.plate).point(*r.end)) for r in box.ribs]
+    ribs += [(a, b) for g in box.guides for a, b in zip(g[:-1], g[1:])]
     size = mesh_size or box.mesh_size
     check_mesh_size(f"{box.path.name}: box.mesh_size", min(min(p.lengths) for p in box.plates),
                     sum(float(np.linalg.norm(np.cross(p.u, p.v))) for p in box.plates), size, BoxError,

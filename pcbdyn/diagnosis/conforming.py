@@ -31,13 +31,6 @@ REMEASURE = 0.25
 STEPS = 8
 
 
-def follows_lines(structure) -> bool:
-    """Whether ``structure`` can be meshed along lines (``following``, :mod:`pcbdyn.domain`): where it
-    cannot (a housing's plates), this stage does not run and the local search walks a rib's ends
-    (:class:`.moves.LocalMoves`) instead of :mod:`.geometry_fit` fitting them."""
-    return hasattr(structure, "following")
-
-
 def stiffeners(cands, sel) -> list:
     """Positions in ``sel.chosen`` of the stiffeners found."""
     return [j for j, i in enumerate(sel.chosen) if cands[i].kind == "stiffener"]

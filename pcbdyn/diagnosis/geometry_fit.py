@@ -38,7 +38,8 @@ from ..updating.gauss_newton import DAMPING, gauss_newton, taken
 from . import conforming
 from .catalogue import kind
 from .fitting import UPPER, Fit, estimate
-from .stiffener import normal
+from .layout import from_structure
+from .stiffener import extent, in_plane, normal
 
 #: the moves of a rib and their first steps ([element sizes]; the height's in ln h)
 MOVES = {"across": 0.25, "turn": 0.25, "end0": 0.5, "end1": 0.5, "height": 0.25}
@@ -75,7 +76,7 @@ class Ribs:
 def moved(rib, move: str, amount: float, h: float):
     """``rib`` moved by ``amount`` ([m]; ln h for the height) in one of :data:`MOVES` (None where it
     would end shorter than :data:`MIN_LENGTH` elements or its height leave :data:`HEIGHT`)."""
-    path = np.asarray(rib.geometry["path"], float)[[0, -1]]
+    path = in_plane(rib)
     d = (path[1] - path[0]) / np.linalg.norm(path[1] - path[0])
     n = normal(path)
     height = rib.data.get("height", kind("stiffener").section.h)
@@ -165,7 +166,8 @@ def _solve(base, observations, effects, p, values):
 
 
 def _with_geometry(chosen, ribs, g, h):
-    """``chosen`` with rib ``ribs[n]`` along g[5n:5n+4] (x0, y0, x1, y1) [m] of section exp(g[5n+4]);
+    """``chosen`` with rib ``ribs[n]`` along g[5n:5n+4] (x0, y0, x1, y1) [m] in its plate's plane, of
+    section exp(g[5n+4]);
     None where a rib would be shorter than :data:`MIN_LENGTH` elements."""
     out = list(chosen)
     for n, k in enumerate(ribs):
@@ -185,23 +187,21 @@ def _difference(_, g, shared):
     return None if out is None else out[3].r
 
 
-def _gauss_newton(base, observations, chosen, ribs, h, fit, bounds, runner, steps: int = GN_STEPS):
+def _gauss_newton(base, observations, chosen, ribs, h, fit, bounds, runner, plates, steps: int = GN_STEPS):
     """(chosen, (models, res, placed, Fit)) after the bounded Gauss-Newton on (ln p, magnitudes, the
-    ribs' ends and ln h) from ``fit`` (module doc); None where it cannot start."""
+    ribs' ends in their plates' planes and ln h) from ``fit`` (module doc), the ends within ``plates``
+    [(lowest, highest) corner (2,) [m] per rib]; None where it cannot start."""
     p = np.asarray(fit.p, float)
     npar, ne = p.size, len(chosen)
-    g0 = np.concatenate([np.r_[np.asarray(chosen[k].geometry["path"], float)[[0, -1]].ravel(),
+    g0 = np.concatenate([np.r_[in_plane(chosen[k]).ravel(),
                                np.log(chosen[k].data.get("height", kind("stiffener").section.h))] for k in ribs])
-    outline = getattr(base[0], "outline", None)
-    ends = np.asarray(outline.vertices if outline is not None else g0[:4].reshape(2, 2), float)
-    lo_xy, hi_xy = ends.min(axis=0), ends.max(axis=0)
     v_lo = np.array([c.spec.lower for c in chosen], float)
     v_hi = UPPER * np.array([c.spec.scale for c in chosen], float)
     lo_p, hi_p = bounds if bounds is not None else (np.zeros(npar), np.full(npar, np.inf))
     with np.errstate(divide="ignore"):
         lower = np.r_[np.log(np.maximum(lo_p, 1e-6 * np.abs(p))), v_lo,
-                      np.tile(np.r_[lo_xy, lo_xy, np.log(HEIGHT[0])], len(ribs))]
-        upper = np.r_[np.log(hi_p), v_hi, np.tile(np.r_[hi_xy, hi_xy, np.log(HEIGHT[1])], len(ribs))]
+                      np.concatenate([np.r_[lo, lo, np.log(HEIGHT[0])] for lo, _ in plates])]
+        upper = np.r_[np.log(hi_p), v_hi, np.concatenate([np.r_[hi, hi, np.log(HEIGHT[1])] for _, hi in plates])]
     scale = np.r_[np.ones(npar), [c.spec.scale for c in chosen], np.tile([h, h, h, h, 1.0], len(ribs))]
     step = np.tile(np.r_[np.full(4, STEP * h), STEP], len(ribs))
     standing: list = []  # [(y, effects, solved)] of the state the fit stands on: trials it does not take are let go
@@ -242,7 +242,10 @@ def fit_ribs(structure, configs, names, h: float, observations, chosen: list, p,
     here = _fit_at(base, observations, chosen, p, values, conforming.STEPS) if ribs else None
     if here is None:
         return None
-    gn = _gauss_newton(base, observations, chosen, ribs, h, here[3], here[0].bounds, runner)
+    layout = from_structure(here[0].models[0])
+    plates = [extent(layout if c.data.get("plate") is None else layout.plate_view(c.data["plate"])[0])
+              for c in (chosen[k] for k in ribs)]
+    gn = _gauss_newton(base, observations, chosen, ribs, h, here[3], here[0].bounds, runner, plates)
     if gn is not None and gn[1][3].chi2 < here[3].chi2:
         chosen, here = gn
         if say:

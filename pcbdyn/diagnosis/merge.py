@@ -13,7 +13,7 @@ import shapely
 from ..fe.probe import segment_parameter
 from .catalogue import kind, weighted_centre
 from .moves import REGION_KINDS, overlap, rectangle
-from .stiffener import in_plane
+from .stiffener import in_plane, lifted
 from .uncertainty import at_state, interval, jackknife_cov, model_form, parts, place_cov, place_range, profile_interval
 
 #: kinds that act at one node: an effect between nodes is shared by its neighbours
@@ -107,7 +107,7 @@ def merged(chosen, values, cov, cov_jack, cov_place, group, profile=None, places
         elif not lines:
             d["at_mm"] = np.round(1e3 * weighted_centre([chosen[k] for k in group], v), 3).tolist()
         if c.kind == "stiffener":
-            d["path_mm"] = np.round(1e3 * mean_path([chosen[k] for k in group], v), 3).tolist()
+            d["path_mm"] = np.round(1e3 * lifted(c, mean_path([chosen[k] for k in group], v)), 3).tolist()
     if hasattr(c.spec, "mass"):  # a rib carries its mass: its section's, at the stiffness found
         d["mass_kg"] = float(sum(chosen[k].spec.mass(chosen[k], values[k]) for k in group))
         sec = c.spec.section_of(c)
@@ -145,9 +145,9 @@ def reported(res, sel, chosen, neighbours, reach: float, bounds=None) -> list:
 
 
 def mean_path(stiffeners, values) -> np.ndarray:
-    """The line (2, 2) [m] of parallel ``stiffeners`` fitted as shares of one rib: their end
-    points' mean weighted by their ``values`` (EI)."""
+    """The line (2, 2) [m] in their plate's plane of parallel ``stiffeners`` fitted as shares of one rib:
+    their end points' mean weighted by their ``values`` (EI)."""
     v = np.asarray(values, float)
     share = v / v.sum() if v.sum() > 0 else np.full(v.size, 1.0 / v.size)
-    paths = np.array([np.asarray(c.geometry["path"], float)[[0, -1]] for c in stiffeners])
+    paths = np.array([in_plane(c) for c in stiffeners])
     return np.einsum("g,gij->ij", share, paths)

@@ -15,9 +15,6 @@ from .catalogue import kind
 #: (:mod:`.geometry_fit` then moves it on meshes along it; the bar of ``ho_al_bar``, found as two
 #: lines, took 22 s of local search in quarter steps, 13 s in halves)
 LINE_STEP = 0.5
-#: [element sizes] how far an end of a stiffener moves along its line in one step, on a structure that
-#: cannot be meshed along it (a housing's plates: :func:`.conforming.follows_lines`)
-END_STEP = 1.0
 #: [element sizes] how far a point between nodes moves in one step of the local search
 POINT_STEP = 0.25
 #: [element sizes] how far a side of a rectangular region moves in one step of the local search
@@ -72,9 +69,8 @@ def overlap(ra, rb) -> list:
 class LocalMoves:
     """neighbours(i) for :func:`.select.refine`: for a run of pieces of a side, the runs of the
     same kind and side that start and end at most one piece from its own; for a stiffener, its line
-    moved half an element (:data:`LINE_STEP`) across itself either way, and with ``walk_ends`` (a
-    structure not meshed along lines, whose ribs :mod:`.geometry_fit` cannot fit) each of its ends an
-    element (:data:`END_STEP`) along it either way; for a rectangular region,
+    moved half an element (:data:`LINE_STEP`) across itself either way (its ends, direction and section
+    are fitted on meshes along it, :mod:`.geometry_fit`); for a rectangular region,
     the rectangles with one side or both sides of an axis moved by one element (:data:`RECT_STEP`) in or
     out, or shifted by one element (:func:`_rect_moves`); for a point
     between nodes (a support, :mod:`.support`, or a mass at its point), the points a quarter element
@@ -83,8 +79,8 @@ class LocalMoves:
     partner, sits where that model's modes put it, and walks to where the fitted model's do). Lines,
     rectangles and points are made on demand and appended to ``cands``."""
 
-    def __init__(self, layout, cands: list, h: float, walk_ends: bool = False):
-        self.layout, self.cands, self.h, self.walk_ends = layout, cands, h, walk_ends
+    def __init__(self, layout, cands: list, h: float):
+        self.layout, self.cands, self.h = layout, cands, h
         self.shell = set(layout.shell_nodes().tolist())
         plate = layout.xy[layout.shell_nodes()]
         self.lo, self.hi = plate.min(axis=0), plate.max(axis=0)
@@ -139,11 +135,7 @@ class LocalMoves:
             return [runs[(a, b)] for a in (i - 1, i, i + 1) for b in (j - 1, j, j + 1)
                     if (a, b) != (i, j) and (a, b) in runs]
         if c.kind == "stiffener":
-            rib, steps = kind("stiffener"), self.h * np.array([-1.0, 1.0])
-            made = rib.parallel(self.layout, c, LINE_STEP * steps)
-            if self.walk_ends:
-                made += rib.stretched(self.layout, c, END_STEP * steps)
-            return self._add(made)
+            return self._add(kind("stiffener").parallel(self.layout, c, LINE_STEP * self.h * np.array([-1.0, 1.0])))
         if at_point(c):
             step = POINT_STEP * self.h
             made = [c.spec.at_point(self.layout, c, (c.at[0] + dx, c.at[1] + dy))

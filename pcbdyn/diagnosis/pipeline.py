@@ -268,8 +268,7 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
     say(f"searching {len(cands)} candidate effects")
     cands += [c for c, _ in support]
     held = list(range(len(cands) - len(support), len(cands)))
-    lines = conforming.follows_lines(models.structure)
-    moves = LocalMoves(layout, cands, h, walk_ends=not lines)
+    moves = LocalMoves(layout, cands, h)
 
     def searched(begin, **kw):
         return search(res, cands, p0, models.bounds, max_effects=max_effects, shortlist=1 if quick else 2, alpha=alpha,
@@ -314,7 +313,7 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
     sel = without_vanished(res, cands, sel, models.bounds, alpha=alpha)
     carried = [(cands[i], v) for i, v in zip(sel.chosen, sel.values) if cands[i].kind in MASS_KINDS or cands[i].between_nodes]
     searched = cands  # the candidates on the model's own mesh (the evidence map is drawn on it)
-    lined = None if quick or not conforming.stiffeners(cands, sel) or not lines else \
+    lined = None if quick or not conforming.stiffeners(cands, sel) else \
         _on_lines(models, res, cands, sel, forms, h, levels, runner, alpha, say)
     if lined is not None:
         models, res, cands, sel = lined

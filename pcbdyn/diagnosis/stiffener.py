@@ -71,27 +71,17 @@ class _Stiffener:
                 out.append(c)
         return out
 
-    def stretched(self, layout, candidate, steps) -> list:
-        """``candidate``'s line with one end moved along it by each of ``steps`` [m] (> 0: longer; clipped
-        where it would leave the plate)."""
-        path, plate = in_plane(candidate), candidate.data.get("plate")
-        d = (path[1] - path[0]) / np.linalg.norm(path[1] - path[0])
-        out = []
-        for end, s in ((e, s) for e in (0, 1) for s in np.asarray(steps, float)):
-            moved = path.copy()
-            moved[end] += (s if end else -s) * d
-            if (moved[1] - moved[0]) @ d > 0:
-                c = self.candidate(layout, None, *moved, height=candidate.data.get("height"), plate=plate)
-                if c is not None:
-                    out.append(c)
-        return out
-
     def along(self, candidate, path):
-        """``candidate`` on the straight line ``path`` (2, 2) [m] instead, named for it (a rib moved to
-        where another mesh, on which it is placed (:meth:`place`), follows it)."""
-        path = np.asarray(path, float)[[0, -1]]
-        return replace(candidate, name=f"{self.name}@{self._tag(path, candidate.data.get('height'))}",
-                       at=tuple(path.mean(axis=0)), geometry={**candidate.geometry, "path": path})
+        """``candidate`` on the straight line ``path`` (2, 2) [m] of its plate's plane instead (a board's
+        x, y: :func:`in_plane`), named for it (a rib moved to where another mesh, on which it is placed
+        (:meth:`place`), follows it)."""
+        flat = np.asarray(path, float)[[0, -1]]
+        tag, data = self._tag(flat, candidate.data.get("height")), candidate.data
+        if "frame" in data:
+            tag, data = f"{data['plate']}:{tag}", {**data, "plane_path": flat}
+        path = lifted(candidate, flat)
+        return replace(candidate, name=f"{self.name}@{tag}", at=tuple(path.mean(axis=0)),
+                       geometry={**candidate.geometry, "path": path}, data=data)
 
     def _tag(self, path, height) -> str:
         """The name of a rib from its ends and, where it is not the kind's, its section height."""
@@ -115,7 +105,7 @@ class _Stiffener:
         path, tag = flat, name or self._tag(flat, height)
         if frame is not None:
             path, tag = frame.lift(flat), f"{plate}:{tag}"
-            data.update(plate=plate, plane_path=flat, normal=frame.normal)
+            data.update(plate=plate, plane_path=flat, normal=frame.normal, frame=frame)
         return Candidate(self.name, f"{self.name}@{tag}", tuple(path.mean(axis=0)), np.unique(conn), {"path": path}, data)
 
     def place(self, layout, candidate):
@@ -181,9 +171,15 @@ def in_plane(candidate) -> np.ndarray:
     return np.asarray(candidate.data.get("plane_path", candidate.geometry["path"]), float)[[0, -1]]
 
 
+def lifted(candidate, flat) -> np.ndarray:
+    """Points ``flat`` (..., 2) [m] of the plane of ``candidate``'s plate in space (on a board, as they are)."""
+    frame = candidate.data.get("frame")
+    return np.asarray(flat, float) if frame is None else frame.lift(flat)
+
+
 def _lines(layout, path_spacing: float):
     """The ends (p0, p1) of the lines :meth:`_Stiffener.generate` tries on a plate in its plane."""
-    lo, hi = _extent(layout)
+    lo, hi = extent(layout)
     centre = 0.5 * (lo + hi)
     for angle in DIRECTIONS:
         d = np.array([np.cos(angle), np.sin(angle)])
@@ -225,7 +221,8 @@ def _clipped(point, d, lo, hi):
     return None if t1 <= t0 else np.array([point + t0 * d, point + t1 * d])
 
 
-def _extent(layout):
+def extent(layout):
+    """(lowest, highest) (2,) [m] corners of the box around ``layout``'s shell nodes in its plane."""
     xy = layout.xy[layout.shell_nodes()]
     return xy.min(axis=0), xy.max(axis=0)
 

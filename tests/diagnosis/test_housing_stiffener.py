@@ -9,8 +9,10 @@ that a housing's description lacks, found on its wall.
   declared rib's line reproduces that rib's frequencies within the two beam models' difference.
 - A 4 x 12 mm aluminium bar glued inside the housing's left wall, y = 20 to 140 mm at z = 30 mm, and left
   out of the box.toml handed to diagnose (test: the example meshed at 8 mm, pcbdyn's noise; model 16 mm):
-  found as a stiffener on that wall within the benchmark's 30 mm of the bar's ends, and the enriched
-  box.toml declares it as a rib.
+  found as a stiffener on that wall within the benchmark's 30 mm of the bar's ends and 30 % of its EI
+  (its ends and section fitted on the housing meshed along it, :mod:`pcbdyn.diagnosis.geometry_fit`: they
+  were walked on the model's own cells before, which left EI 36 % low), and the enriched box.toml
+  declares it as a rib of the section found.
 """
 
 from __future__ import annotations
@@ -60,6 +62,30 @@ def test_a_rib_on_a_plate_stood_up_as_a_wall_is_the_rib_on_the_flat_plate(tmp_pa
     meshes = float(np.abs(plain[1] / plain[0] - 1.0).max())
     assert meshes < 1e-3
     assert np.abs(shifts[1] / shifts[0] - 1.0).max() <= 3.0 * meshes + 1e-9
+
+
+def test_a_housing_meshed_along_a_rib_found_on_its_wall_puts_the_rib_on_nodes(tmp_path):
+    """``following`` (the domain interface): the wall's mesh gains element edges along an oblique line,
+    so the rib placed on it ends every piece on a node (one shape-function weight of 1), as it does on a
+    board meshed along a line; moved in the wall's plane (:meth:`along`), it stays on the wall."""
+    from pcbdyn.diagnosis.catalogue import place
+    from pcbdyn.diagnosis.stiffener import in_plane
+
+    rib = kind("stiffener")
+    box = load_box(plate_box(tmp_path, A, B, 2, supports("p", "clamped", ("v0",)), axes=((0, 1, 0), (0, 0, 1))))
+    layout = from_structure(box.build())
+    st = layout.plate_view("p")[1].flat(1e-3 * np.array([[0.0, 0.23 * A, 0.11 * B], [0.0, 0.71 * A, 0.87 * B]]))
+    embedded = rib.candidate(layout, "t", *st, plate="p")
+    assert not np.allclose(np.sort(embedded.data["weights"], axis=2)[:, :, -1], 1.0)  # inside the cells
+
+    followed = from_structure(box.following([embedded.geometry["path"]]).build())
+    on = place(followed, embedded)
+    assert np.allclose(np.sort(on.data["weights"], axis=2)[:, :, -1], 1.0, atol=1e-9)
+    assert in_plane(on) == pytest.approx(st, abs=1e-12) and on.name == embedded.name
+    shifted = rib.along(on, st + [0.01, -0.02])
+    assert np.abs(shifted.geometry["path"][:, 0]).max() < 1e-12  # on the wall x = 0
+    assert in_plane(shifted) == pytest.approx(st + [0.01, -0.02], abs=1e-12)
+    assert np.asarray(shifted.geometry["path"]) == pytest.approx(followed.plate_view("p")[1].lift(st + [0.01, -0.02]))
 
 
 def test_candidates_stand_inside_the_housing_and_follow_a_declared_rib(tmp_path):
@@ -112,9 +138,10 @@ def test_a_bar_glued_inside_a_housing_wall_is_found(tmp_path):
     for end in ([0.0, 20.0, 30.0], [0.0, 140.0, 30.0]):  # the bar's ends lie within 30 mm of the line found
         t = np.clip((np.asarray(end) - path[0]) @ (path[1] - path[0]) / np.sum((path[1] - path[0]) ** 2), 0.0, 1.0)
         assert np.linalg.norm(path[0] + t * (path[1] - path[0]) - end) < 30.0
+    assert ribs[0]["magnitude"] == pytest.approx(70e9 * 0.012 * 0.004**3 / 12, rel=0.30)  # its EI, 4.48 N m^2
     assert data["after"]["max_freq_error_pct"] < data["parameters_only"]["max_freq_error_pct"]
     enriched = load_box(data["enriched_board"])
     found = next(r for r in enriched.ribs if r.name not in {q.name for q in load_box(model).ribs})
-    assert found.plate == "left" and found.height == pytest.approx(4e-3)
-    width = 12.0 * ribs[0]["magnitude"] / (70e9 * 0.004**3)
-    assert found.width == pytest.approx(width, rel=1e-9)
+    h = 1e-3 * ribs[0]["section_height_mm"]  # the section the fit ended on, declared as it is
+    assert found.plate == "left" and found.height == pytest.approx(h, rel=1e-4)
+    assert found.width == pytest.approx(12.0 * ribs[0]["magnitude"] / (70e9 * h**3), rel=1e-3)

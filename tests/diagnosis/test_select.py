@@ -343,23 +343,3 @@ def test_a_spring_that_pins_the_plate_is_not_dropped_for_its_standard_deviation(
     sel = Selection(chosen=[spring], values=np.array([1e7]), sigma=np.array([3e7]), p=np.zeros(0))
     assert without_vanished(None, cands, sel) is sel and sel.chosen == [spring]
 
-
-@pytest.mark.parametrize("walk_ends", [False, True])
-def test_a_stiffeners_ends_walk_only_where_the_structure_is_not_meshed_along_lines(card, walk_ends):
-    """A bar that stops inside the card moves half an element across itself either way; with
-    ``walk_ends`` (a housing, whose ribs :mod:`pcbdyn.diagnosis.geometry_fit` cannot fit on meshes along
-    them) each end also moves an element along its line, the other end staying put."""
-    from pcbdyn.diagnosis.moves import END_STEP, LINE_STEP, LocalMoves
-
-    m, _ = card
-    layout, step = dg.from_model(m), 0.16 / NX
-    bar = dg.kind("stiffener").candidate(layout, None, (0.04, 0.09), (0.12, 0.09))
-    moves = LocalMoves(layout, [bar], step, walk_ends=walk_ends)
-    paths = [np.asarray(c.geometry["path"])[[0, -1], :2] for c in moves.around(bar)]
-    ends = np.asarray(bar.geometry["path"])[[0, -1], :2]
-    across = [p for p in paths if np.allclose(p[:, 0], ends[:, 0], atol=1e-9)]
-    assert sorted(np.round(p[0, 1] - ends[0, 1], 9) for p in across) == pytest.approx([-LINE_STEP * step, LINE_STEP * step])
-    along = [p for p in paths if np.allclose(p[:, 1], ends[:, 1], atol=1e-9)]
-    moved = sorted(np.round(np.sum(p[:, 0] - ends[:, 0]), 9) for p in along)
-    assert len(paths) == len(across) + len(along)
-    assert moved == (pytest.approx(END_STEP * step * np.array([-1.0, -1.0, 1.0, 1.0])) if walk_ends else [])
