@@ -10,6 +10,7 @@ from dataclasses import replace
 import numpy as np
 
 from .catalogue import kind
+from .stiffener import extent
 
 #: [element sizes] how far a stiffener's line moves across itself in one step of the local search
 #: (:mod:`.geometry_fit` then moves it on meshes along it; the bar of ``ho_al_bar``, found as two
@@ -82,8 +83,7 @@ class LocalMoves:
     def __init__(self, layout, cands: list, h: float):
         self.layout, self.cands, self.h = layout, cands, h
         self.shell = set(layout.shell_nodes().tolist())
-        plate = layout.xy[layout.shell_nodes()]
-        self.lo, self.hi = plate.min(axis=0), plate.max(axis=0)
+        self.lo, self.hi = extent(layout)
         self.index = {c.name: k for k, c in enumerate(cands)}
         self.runs: dict = {}
         for k, c in enumerate(cands):
