@@ -39,7 +39,7 @@ from . import conforming
 from .catalogue import kind
 from .fitting import UPPER, Fit, estimate
 from .layout import from_structure
-from .stiffener import extent, in_plane, normal
+from .stiffener import extent, in_its_plane, in_plane, normal
 
 #: the moves of a rib and their first steps ([element sizes]; the height's in ln h)
 MOVES = {"across": 0.25, "turn": 0.25, "end0": 0.5, "end1": 0.5, "height": 0.25}
@@ -243,8 +243,7 @@ def fit_ribs(structure, configs, names, h: float, observations, chosen: list, p,
     if here is None:
         return None
     layout = from_structure(here[0].models[0])
-    plates = [extent(layout if c.data.get("plate") is None else layout.plate_view(c.data["plate"])[0])
-              for c in (chosen[k] for k in ribs)]
+    plates = [extent(in_its_plane(layout, chosen[k].data.get("plate"))[0]) for k in ribs]
     gn = _gauss_newton(base, observations, chosen, ribs, h, here[3], here[0].bounds, runner, plates)
     if gn is not None and gn[1][3].chi2 < here[3].chi2:
         chosen, here = gn

@@ -53,7 +53,7 @@ class _Stiffener:
         plates = [None] if layout.planar else list(layout.plates)
         out = []
         for plate in plates:
-            for p0, p1 in _lines(layout if plate is None else layout.plate_view(plate)[0], path_spacing):
+            for p0, p1 in _lines(in_its_plane(layout, plate)[0], path_spacing):
                 c = self.candidate(layout, None, p0, p1, plate=plate)
                 if c is not None:
                     out.append(c)
@@ -94,7 +94,7 @@ class _Stiffener:
         of a rib of stiffness EI is 12 rho EI / (E h^2)); None where the line misses the plate. On a
         structure in 3-D, ``p0`` and ``p1`` are in the plane of its ``plate`` (:mod:`.plate_view`): the
         candidate's path is in space, its ``plane_path`` in the plate's plane."""
-        view, frame = (layout, None) if plate is None else layout.plate_view(plate)
+        view, frame = in_its_plane(layout, plate)
         conn, weights, ends = view.line_cells(p0, p1)
         if not len(conn):
             return None
@@ -169,6 +169,12 @@ PIECES = ((0.0, 1.0), (0.0, 0.5), (0.5, 1.0), (0.25, 0.75))
 def in_plane(candidate) -> np.ndarray:
     """The ends (2, 2) [m] of a stiffener candidate's line in its plate's plane (a board's x, y)."""
     return np.asarray(candidate.data.get("plane_path", candidate.geometry["path"]), float)[[0, -1]]
+
+
+def in_its_plane(layout, plate: str | None) -> tuple:
+    """(the layout of ``plate`` seen in its plane, its :class:`.plate_view.Frame`); a board's own layout
+    and None where ``plate`` is None."""
+    return (layout, None) if plate is None else layout.plate_view(plate)
 
 
 def lifted(candidate, flat) -> np.ndarray:
