@@ -218,12 +218,14 @@ def build_model(box, config: str | None = None, mesh_size: float | None = None, 
     plate_map = {p.name: np.arange(len(mesh.nodes)) for p in box.plates}
     _joint_nodes(box, mesh, model, plate_map, q, makers)
     for p in box.plates:
-        own = (targets.target("plates", p.name, a) for a in ("thickness", "rho", "E"))
-        keys = (SHEAR_KEY,) + tuple(k for k in own if k in q)
+        own = {a: targets.target("plates", p.name, a) for a in ("thickness", "rho", "E")}
+        keys = (SHEAR_KEY,) + tuple(k for k in own.values() if k in q)
+        linear = {own[a]: 1 for a in ("rho", "E") if own[a] in q}  # M in rho, K in E
         for etype, conn in mesh.cells[p.name].items():
             name = targets.entry("plates", p.name)
             name = name if etype == "quad4" else targets.member(name, etype)
-            makers[name] = SetMaker(etype, plate_map[p.name][conn], keys, lambda q, p=p: _shell(p, q))
+            makers[name] = SetMaker(etype, plate_map[p.name][conn], keys, lambda q, p=p: _shell(p, q),
+                                    powers=linear)
     chains = [plate_map[r.plate][mesh.chain(*line, mesh.plate_nodes(r.plate))] for r, line in zip(box.ribs, ribs)]
     if box.rib_model == "beam":
         for r, chain in zip(box.ribs, chains):
@@ -234,7 +236,7 @@ def build_model(box, config: str | None = None, mesh_size: float | None = None, 
             makers[targets.entry("ribs", r.name)] = SetMaker(
                 "beam2", np.column_stack([chain[:-1], chain[1:]]), keys,
                 lambda q, r=r, m=m, k=keys: rib_section(r.material.E, r.material.nu, r.material.rho, q[k[0]], q[k[1]],
-                                                        m, q[k[2]]))
+                                                        m, q[k[2]]), powers=dict.fromkeys(keys[:2]))
     else:
         strips = [(targets.entry("ribs", r.name), chain, box.plate(r.plate).normal * (1.0 if r.side == "+n" else -1.0),
                    box.plate(r.plate).thickness, r.height, r.width, r.material) for r, chain in zip(box.ribs, chains)]

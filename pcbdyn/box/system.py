@@ -170,7 +170,8 @@ def _place(model, q, makers, point_nodes, card, local) -> PlacedCard:
     q.update({prefix + k: v for k, v in local.quantities.items()})
     for name, mk in local.makers.items():
         makers[prefix + name] = SetMaker(mk.etype, np.asarray(mk.conn) + first, tuple(prefix + d for d in mk.deps),
-                                         lambda q, mk=mk: mk.make(Prefixed(q, prefix)), card.R)
+                                         lambda q, mk=mk: mk.make(Prefixed(q, prefix)), card.R,
+                                         {prefix + k: v for k, v in mk.powers.items()})
     point_nodes.update({prefix + k: int(v) + first for k, v in local.point_nodes.items()})
     return PlacedCard(card, local, first)
 

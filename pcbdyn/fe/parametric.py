@@ -27,13 +27,17 @@ from .model import Model, ModelError
 @dataclass
 class SetMaker:
     """How to make one element set: its type, connectivity, the quantities it depends on,
-    ``make(q) -> property`` and its ``frame`` (:class:`.model.ElementSet`)."""
+    ``make(q) -> property`` and its ``frame`` (:class:`.model.ElementSet`); ``powers``: {quantity of
+    ``deps``: the highest power it enters the matrices with (a modulus or a density 1), or None where
+    it enters otherwise (a beam's shear term and torsion constant in its section's sides)}, for
+    :class:`.parametric_matrices.ParametricMatrices`, which interpolates on that many points."""
 
     etype: str
     conn: np.ndarray
     deps: tuple
     make: object
     frame: object = None
+    powers: dict = field(default_factory=dict)
 
 
 @dataclass

@@ -8,11 +8,14 @@ assembly at one more point; K and M at any parameter values, and their exact der
 sums of coefficient arrays times monomials: no element matrix is recomputed while a fit moves the
 parameters (a fit of the six-part card's four parameters re-solves it hundreds of times). A
 parameter that a set of its own shows to enter with a lower degree (a modulus or a density enters
-linearly) is interpolated on that many points in the sets it shares with others, and those are
-checked as any other (the card's parts, on E and their thickness: 9 assemblies each instead of 17,
-which halves the interpolation of a model meshed once for a trial, as a diagnosis's rib fit does). A set
-that fails the check (a quantity entering otherwise, such as a Timoshenko beam's shear term) or
-depends on more than :data:`MAX_PARAMS` parameters is made again from its property at each call,
+linearly), or whose maker declares its power (a housing plate's E and rho), is interpolated on that
+many points in the sets it shares with others, and those are checked as any other (the card's parts,
+on E and their thickness: 9 assemblies each instead of 17, which halves the interpolation of a model
+meshed once for a trial, as a diagnosis's rib fit does). A set that fails the check (a quantity
+entering otherwise, such as a Timoshenko beam's shear term), whose maker says it is not a polynomial
+in a parameter (:attr:`.parametric.SetMaker.powers`: a housing's rib in its height, whose grid would
+be assembled in every re-meshed trial of a diagnosis only to fail the check) or that depends on more
+than :data:`MAX_PARAMS` parameters is made again from its property at each call,
 its derivatives by central differences with :meth:`.parametric.Parameter.step`, as
 :meth:`.parametric.Parameter.derivatives` takes them.
 
@@ -102,7 +105,12 @@ class ParametricMatrices:
             if not js:
                 self.const[:, pos] += np.array(self.asm.values(name))
                 continue
-            self.sets.append(self._interpolated(name, js, pos) if len(js) <= MAX_PARAMS else _Set(name, js, pos))
+            known = [[mk.powers[t] for t in targets[j] & set(mk.deps) if t in mk.powers] for j in js]
+            if len(js) > MAX_PARAMS or any(None in k for k in known):
+                self.sets.append(_Set(name, js, pos))
+                continue
+            declared = [max(k) if len(k) == len(targets[j] & set(mk.deps)) else None for j, k in zip(js, known)]
+            self.sets.append(self._interpolated(name, js, pos, declared))
         touched = {j: np.zeros(self.asm.nnz, bool) for j in range(len(self.names))}
         for s in self.sets:
             for j in s.js:
@@ -120,13 +128,13 @@ class ParametricMatrices:
                 q.update(self.pm.parameters[nm].quantities(p[j]))
         return np.array(self.asm.values(name, self.pm.makers[name].make(q)))
 
-    def _interpolated(self, name, js, pos) -> _Set:
+    def _interpolated(self, name, js, pos, declared) -> _Set:
         """The set interpolated on the Chebyshev grid of its parameters ``js`` (on as many points per
-        parameter as its degree in the sets of it alone, else :data:`DEGREE` + 1), checked at
-        :data:`CHECK_AT`; on the full grid where that check fails; a set made at each call where
-        this one fails too."""
+        parameter as the degree its maker ``declared`` for it, else its degree in the sets of it alone,
+        else :data:`DEGREE` + 1), checked at :data:`CHECK_AT`; on the full grid where that check fails;
+        a set made at each call where this one fails too."""
         full = [DEGREE] * len(js)
-        degrees = [self._degree.get(j, DEGREE) for j in js]
+        degrees = [self._degree.get(j, DEGREE) if d is None else d for j, d in zip(js, declared)]
         s = self._fitted(name, js, pos, degrees)
         if s is None and degrees != full:
             s = self._fitted(name, js, pos, full)
@@ -150,7 +158,9 @@ class ParametricMatrices:
             coef = np.moveaxis(np.tensordot(_GRIDS[d][1], coef, axes=([1], [axis])), 0, axis)
         exps = np.array(list(np.ndindex(*coef.shape[:k])), dtype=np.int64).reshape(-1, k)
         coef = coef.reshape(-1, 2, pos.size)
-        keep = np.abs(coef).max(axis=(1, 2)) > 1e-12 * (np.abs(coef).max() or 1.0)  # E and springs enter linearly
+        size = np.abs(coef).max(axis=2)  # (n_monomials, 2): each monomial's largest K and M entries
+        # E and springs enter linearly; K and M apart, as M's entries are 1e-12 of K's on a housing
+        keep = np.any(size > 1e-12 * np.maximum(size.max(axis=0), 1e-300), axis=1)
         whole = pos.size > FULL_SHARE * self.asm.nnz
         if whole:  # a set over most of the pattern is added without an index
             full = np.zeros((int(keep.sum()), 2, self.asm.nnz))

@@ -68,9 +68,29 @@ def test_a_degree_learned_too_low_falls_back_to_the_full_grid(models):
     t = next(j for j in part.js if j != e)
     fresh = ParametricMatrices(models.models[0], models.names)
     fresh._degree = {e: 1, t: 1}
-    s = fresh._interpolated(part.name, part.js, part.pos)
+    s = fresh._interpolated(part.name, part.js, part.pos, [None, None])
     assert s.coef is not None and s.exps[:, part.js.index(t)].max() == DEGREE
     x = np.zeros(len(models.names))
     x[part.js] = (-0.41, 0.63)
     direct = fresh._direct(part.name, fresh.centre + fresh.half * x)
     assert np.abs(s.values(x) - direct).max() <= 1e-9 * np.abs(direct).max()
+
+
+def test_a_housing_plate_on_its_modulus_and_density_and_ribs_on_their_height():
+    """The example housing's parameters: its upper plate's E (K alone) and rho (M alone), which its
+    maker declares linear, and rib heights (a Timoshenko beam's shear term and a torsion constant: not
+    polynomials). The plate's set is interpolated on two points per parameter, though each of its
+    monomials is zero in one of the two matrices and M's entries are 1e-12 of K's on the example's mesh
+    (a cut relative to the largest coefficient of either dropped rho's monomial, and the set failed its
+    check); the ribs' sets are made at each call; both equal a model built at the same values."""
+    from pcbdyn.box import load_box
+
+    box = StructureModels(load_box(EXAMPLE.parents[1] / "ribbed_box" / "box.toml"), [None])
+    pmx = box.parametric[0]
+    by_name = {s.name: s for s in pmx.sets}
+    plate = by_name["plates.upper"]
+    assert plate.coef is not None and plate.exps.max() == 1 and len(plate.exps) == 3  # 1, E, rho
+    assert all(s.coef is None for n, s in by_name.items() if n.startswith("ribs."))
+    p1 = box.p0 * np.linspace(0.8, 1.25, box.p0.size)
+    for got, built in zip(pmx.matrices(p1), assemble(box.build(p1)[0])):
+        assert relative(got, built) < 1e-9
