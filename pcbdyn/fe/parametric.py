@@ -8,10 +8,11 @@ Each element set is made by a function of a dictionary of named quantities (``bo
 A :class:`Parameter` is a named, bounded scalar shared by one or more quantities (the thickness of
 both PGA regions, the k_rot of both card guides). Its derivatives come from the element sets that
 depend on those quantities only, by a central difference of their element matrices,
-(A(p + h) - A(p - h)) / 2h. Quantities enter element matrices as polynomials of degree <= 3 (E, rho,
-k, m linearly; a thickness through t, t^2, t^3), for which the central difference is exact up to
+(A(p + h) - A(p - h)) / 2h. Most quantities enter element matrices as polynomials of degree <= 3 (E,
+rho, k, m linearly; a thickness through t, t^2, t^3), for which the central difference is exact up to
 h^2/6 times the third derivative: a relative error of about (h/p)^2 / 3 = 3e-9 with the default
-step, and no full re-assembly.
+step, and no full re-assembly. A beam's section sides are not (its shear term and torsion constant):
+its maker says so (:attr:`SetMaker.powers`).
 """
 
 from __future__ import annotations
