@@ -100,16 +100,16 @@ class ParametricMatrices:
         self._degree: dict = {}  # {j: the highest power of parameter j in the sets of it alone}
         for name in self.asm.names:
             mk = pm.makers.get(name)
-            js = [j for j in own if mk is not None and targets[j] & set(mk.deps)]
+            shared = {j: targets[j] & set(mk.deps) for j in own} if mk is not None else {}
+            js = [j for j in own if shared.get(j)]
             pos = self.asm.positions(name)
             if not js:
                 self.const[:, pos] += np.array(self.asm.values(name))
                 continue
-            known = [[mk.powers[t] for t in targets[j] & set(mk.deps) if t in mk.powers] for j in js]
-            if len(js) > MAX_PARAMS or any(None in k for k in known):
+            if len(js) > MAX_PARAMS or any(mk.powers.get(t, 0) is None for j in js for t in shared[j]):
                 self.sets.append(_Set(name, js, pos))
                 continue
-            declared = [max(k) if len(k) == len(targets[j] & set(mk.deps)) else None for j, k in zip(js, known)]
+            declared = [max(mk.powers[t] for t in shared[j]) if shared[j] <= mk.powers.keys() else None for j in js]
             self.sets.append(self._interpolated(name, js, pos, declared))
         touched = {j: np.zeros(self.asm.nnz, bool) for j in range(len(self.names))}
         for s in self.sets:

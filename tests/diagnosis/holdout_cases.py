@@ -69,7 +69,8 @@ BY_NAME = {c.name: c for c in CASES}
 #: the hold-out cases ``make test`` runs (as :data:`bench_cases.IN_SUITE`: the others are
 #: ``benchmarks/bench_diagnose.py``'s): one per effect kind and one control. ho_spring_wedge (a spring
 #: to ground: ho_bracket's spring on this data, gs_standoff's in test_diagnose_options) and ho_noise_card
-#: (a control, as ho_noise_wedge and the generated s0006 and s0016) left to the benchmark, so that the suite keeps near its 20 minutes
+#: (a control, as ho_noise_wedge and the generated s0006 and s0016) left to the benchmark, to shorten a suite
+#: over its 20 minutes
 IN_SUITE = ("ho_noise_wedge", "ho_edge_wedge", "ho_line_mass_card", "ho_al_bar", "ho_bracket")
 
 
