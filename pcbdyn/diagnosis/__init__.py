@@ -25,7 +25,8 @@ from .catalogue import (
     place,
 )
 from .layout import Layout, from_model, from_structure
-from .select import Selection, forward_select
+from .select import forward_select
+from .selection import Selection
 
 __all__ = ["KINDS", "Candidate", "CatalogueError", "Layout", "Selection", "add_effect", "derivatives", "place",
            "eigenvalue_columns", "forward_select", "frequency_columns", "from_model", "from_structure", "generate", "kind"]

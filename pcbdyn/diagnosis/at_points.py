@@ -10,7 +10,7 @@ from .catalogue import weighted_centre
 from .mass_lines import masses_found, walked_in
 from .merge import groups
 from .moves import at_grid_node
-from .select import ALPHA, penalty
+from .selection import ALPHA, penalty
 
 
 def _springs(chosen, values, groups) -> list:

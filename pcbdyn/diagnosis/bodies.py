@@ -20,7 +20,7 @@ import numpy as np
 
 from .catalogue import weighted_centre
 from .fitting import estimate, pattern_search
-from .select import ALPHA, adopt, penalty
+from .selection import ALPHA, adopt, penalty
 
 #: fixed-point iterations on the radius of gyration, and the relative change that ends them
 RADIUS_ITERATIONS, RADIUS_TOL = 5, 0.02

@@ -26,7 +26,7 @@ from .fitting import RANK_STEPS, estimate, pattern_search
 from .line_mass import KIND
 from .merge import groups
 from .reanalysis import Reanalysis
-from .select import ALPHA, adopt, penalty
+from .selection import ALPHA, adopt, penalty
 
 #: a line's length over the distance between the two point masses that stand in for it
 SPREAD = np.sqrt(3.0)

@@ -16,7 +16,7 @@ from ..correlation.mac import mac, paired_mac
 from ..problems.error_budget import richardson
 from ..updating.solvers import covariance
 from .fitting import estimate
-from .select import ALPHA, adopt, penalty, worth
+from .selection import ALPHA, adopt, penalty, worth
 
 #: a mode is resolved by the model's mesh when the twice finer mesh changes its shape at the
 #: points by less than this (sqrt(1 - MAC)): only then is its frequency change an O(h^2) error
@@ -85,7 +85,7 @@ def fit_plate_share(res, candidates, sel, shifts, sigma_f, bounds=None, alpha: f
     Kirchhoff limit), fitted with the declared parameters and the effects of ``sel``: linearised,
     then the rest re-estimated by Gauss-Newton, in noise units ``sigma_f`` (per observation, the
     frequency sigmas without the plate theory's gap, which the search counted as noise). Theta
-    moves from 0 only where its chi^2 drop is significant (:func:`.select.worth`, the penalty of
+    moves from 0 only where its chi^2 drop is significant (:func:`.selection.worth`, the penalty of
     one more column): on data of the model's own form it stays 0. Either way the data have now
     bounded it, so the frequency sigmas keep only its uncertainty's part of the gap, and ``sel``
     is re-estimated with them, in the residual of observations with those sigmas and with ``f_scale``

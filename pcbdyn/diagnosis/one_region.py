@@ -18,7 +18,8 @@ import shapely
 from .merge import groups, linked
 from .moves import REGION_KINDS, overlap, rectangle
 from .fitting import estimate
-from .select import ALPHA, Selection, adopt, penalty, refine
+from .select import refine
+from .selection import ALPHA, Selection, adopt, penalty
 
 #: [m] rectangles this close along an axis touch there (their sides lie on one grid line)
 TOUCH = 1e-9

@@ -21,7 +21,8 @@ whether what remains is noise, and otherwise find, place and size the effects th
    (thesis section 5.2.3) and nothing is invented.
 4. Otherwise the catalogue's candidates are searched (:func:`.select.search`) from the fitted
    parameters (and from the declared values where that fit pairs the frequencies worse than they do:
-   :func:`.parameter_stage.declared_origin`), the effects' magnitudes estimated together with the
+   :func:`.parameter_stage.declared_origin`; the starts end at the first whose effects leave what
+   noise gives, :mod:`.starts`), the effects' magnitudes estimated together with the
    declared parameters, each effect kept only if it also predicts data it was not fitted to; runs
    along the sides, stiffener lines, rectangular regions and point masses are walked to where they fit
    best (:func:`.select.refine`, :class:`.moves.LocalMoves`), overlapping regions refitted as one
@@ -56,12 +57,14 @@ from .layout import from_structure
 from .mass_lines import LINE_LIKE, as_lines
 from .merge import MERGE_REACH, groups, mean_path, reported
 from .model_form import MESH_LEVELS, fit_plate_share
-from .moves import REGION_KINDS, LocalMoves, at_grid_node, movable, on_node
+from .moves import REGION_KINDS, LocalMoves, at_grid_node, movable
 from .one_region import as_one_region
 from .parameter_stage import declared_origin, paired_start, parameter_stage, range_test, update_start
 from .residual import ModalResidual
 from .scan import Runner
-from .select import ALPHA, Selection, adopt, noticed, penalty, refine, search, without_vanished
+from .select import noticed, refine, search, without_vanished
+from .selection import ALPHA, adopt, penalty
+from .starts import Starts
 from .unpaired import partners
 
 #: where candidates go: sides cut into 16 pieces (every run of consecutive pieces is a candidate);
@@ -154,23 +157,6 @@ def _supports(res, p0, before, models, kinds, say) -> tuple:
         say("test modes without a partner: the model lacks "
             + ", ".join(f"{c.name} ({v:.3g} {c.spec.unit})" for c, v in found))
     return found, state
-
-
-def _walked(res, cands, held, fit, moves, bounds, alpha, runner, say) -> tuple:
-    """(fit, candidate indices) of the effects ``held`` (placed from the modes without a partner, fitted
-    with the declared parameters in ``fit``) after their masses walk to where they fit best
-    (:func:`.select.refine`) before the search: placed with the model's elastic modes at the
-    parameters' starting values, a mass sits where that model puts it, and the search is to find what
-    else is missing, not to make up for a misplaced one. (A spring on a free board is placed between
-    nodes from its mode's rigid-body part, which the parameters do not change; it stays.)"""
-    if not any(on_node(cands[i]) for i in held):
-        return fit, held
-    say("walking the masses to where the fitted parameters put them")
-    sel = refine(res, cands, adopt(Selection(), held, fit, penalty(res.n_rows, len(cands), alpha)),
-                 lambda i: moves(i) if on_node(cands[i]) else [], bounds, alpha=alpha, runner=runner)
-    if sel.chosen == list(held):
-        return fit, held
-    return estimate(res, sel.p, [cands[i] for i in sel.chosen], sel.values, 10, bounds), list(sel.chosen)
 
 
 def diagnose(structure, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_size=None, kinds=None,
@@ -270,26 +256,12 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
     held = list(range(len(cands) - len(support), len(cands)))
     moves = LocalMoves(layout, cands, h)
 
-    def searched(begin, **kw):
+    def search_from(begin, **kw):
         return search(res, cands, p0, models.bounds, max_effects=max_effects, shortlist=1 if quick else 2, alpha=alpha,
                       base=begin, runner=runner, moves=moves, **kw)
-    sels = []
-    for origin in origins:
-        begin, placed = origin, held
-        if held:
-            say("fitting the support with the declared parameters")
-            begin = estimate(res, origin.p, [cands[i] for i in held], [v for _, v in support], 10, models.bounds)
-            begin, placed = _walked(res, cands, held, begin, moves, models.bounds, alpha, runner, say)
-        sels.append(searched(begin, held=placed))
-    if held:  # placed from the starting values' modes, a support can lead the search astray: it runs without too
-        say("searching again without the effects the modes without a partner showed")
-        sels.append(free := searched(estimate(res, origins[0].p, [], [], 10, models.bounds)))
-    declared = None if held else declared_origin(res, base, start, models, say)
-    stats["searched_from_declared"] = declared is not None
-    if declared is not None:
-        sels.append(searched(declared, without=base.chi2))
-    sel = min(sels, key=lambda s: s.criterion[-1])
-    if held and sel is free:
+    plan = Starts(res, cands, held, support, moves, models.bounds, alpha, runner, say)
+    sel, free = plan.best(search_from, origins, lambda: declared_origin(res, base, start, models, say), stats)
+    if free:
         say("  the search without them fits better")
         support, shown = [], {}
         stats["support_test_modes"] = shown

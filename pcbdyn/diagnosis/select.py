@@ -37,10 +37,7 @@ After each addition an earlier effect that the others make redundant is dropped 
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 import numpy as np
-from scipy.stats import chi2 as chi2_dist
 
 from .catalogue import kind, moved_value
 from .fitting import RANK_STEPS, UPPER, Fit, estimate  # noqa: F401  (re-exported)
@@ -48,36 +45,7 @@ from .halves import Halves, bodies, body_moves, per_kind
 from .held_out import HELD_OUT_SHARE, predicts, refit_share, secant
 from .reanalysis import Reanalysis
 from .scan import Runner, rank, resonant, saturated, worth_full
-
-#: probability that noise alone makes one of the candidates look like an effect (family-wise)
-ALPHA = 0.01
-
-
-@dataclass
-class Selection:
-    """``chosen``: candidate indices in the order found; ``values``: their magnitudes (SI) and
-    ``sigma`` their standard deviations (``cov`` their covariance); ``p``: the declared parameters estimated with them;
-    ``chi2[s]``, ``criterion[s]``: after step s (s = 0: the declared parameters alone);
-    ``state``: the final :class:`.residual.State`; ``frequencies``: the paired model frequencies of
-    the first configuration."""
-
-    chosen: list = field(default_factory=list)
-    values: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    sigma: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    cov: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
-    p: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    chi2: list = field(default_factory=list)
-    criterion: list = field(default_factory=list)
-    state: object = None
-
-    @property
-    def frequencies(self) -> np.ndarray:
-        return self.state.configs[0].f_a
-
-
-def penalty(n_obs: int, n_candidates: int, alpha: float = ALPHA) -> float:
-    """Criterion cost of one more effect: max(ln n, chi^2_1 quantile at 1 - alpha / P)."""
-    return max(np.log(n_obs), float(chi2_dist.isf(alpha / max(n_candidates, 1), 1)))
+from .selection import ALPHA, Selection, adopt, penalty, worth
 
 
 def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_steps: int = 8, shortlist: int = 3,
@@ -133,7 +101,7 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
         step = (res, candidates, sel, fit, held, A, scale, value, P, rx, newton_steps, bounds, pen, p0.size, runner,
                 moves, alpha)
         new, idx = _weighed(step, adds, start)
-        if new is None and not resonant_tried and chi2_dist.sf(sel.chi2[-1], n - p0.size - len(sel.chosen)) < alpha:
+        if new is None and not resonant_tried and not sel.within_noise(n - p0.size, alpha):
             resonant_tried = True
             screened = resonant(rx, [candidates[i] for i in sel.chosen], sel.values, candidates, halves.pairs,
                                halves.gains(A_p, r_p, scale, lower, sel.chosen), shortlist)
@@ -233,17 +201,6 @@ def _kept(res, candidates, sel, fit, idx, trial, held, column, scale, newton_ste
     return None
 
 
-def adopt(sel: Selection, idx: list, fit: Fit, pen: float) -> Selection:
-    """``sel`` updated in place to the effects ``idx`` estimated by ``fit`` (one more step)."""
-    n_par = np.size(fit.p)
-    sel.chosen, sel.values, sel.p, sel.state = list(idx), fit.values, fit.p, fit.state
-    sel.cov = fit.cov[n_par:, n_par:]
-    sel.sigma = np.sqrt(np.clip(np.diag(sel.cov), 0.0, None))
-    sel.chi2.append(fit.chi2)
-    sel.criterion.append(fit.chi2 + len(idx) * pen)
-    return sel
-
-
 def without_vanished(res, candidates, sel: Selection, bounds=None, newton_steps: int = 8,
                      alpha: float = ALPHA) -> Selection:
     """``sel`` without the effects that later steps left within one standard deviation of zero
@@ -327,12 +284,6 @@ def moved_values(candidates, idx, swap, values) -> np.ndarray:
     that moved at its kind's (:func:`.catalogue.moved_value`)."""
     return np.array([v if i == j else moved_value(candidates[i], candidates[j], v)
                      for i, j, v in zip(idx, swap, values)], float)
-
-
-def worth(chi2_before, chi2_after, n, k, pen) -> bool:
-    """The drop exceeds the penalty in stated noise units and in units of the variance left."""
-    drop = chi2_before - chi2_after
-    return drop > pen and drop / max(chi2_after / max(n - k, 1), 1.0) > pen
 
 
 def orth(A):

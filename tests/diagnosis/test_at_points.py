@@ -8,7 +8,8 @@ from pcbdyn import diagnosis as dg
 from pcbdyn.diagnosis.at_points import as_points
 from pcbdyn.diagnosis.catalogue import kind as spec
 from pcbdyn.diagnosis.residual import ModalResidual, Observation
-from pcbdyn.diagnosis.select import Selection, estimate, penalty
+from pcbdyn.diagnosis.select import estimate
+from pcbdyn.diagnosis.selection import Selection, penalty
 from pcbdyn.fe.modal import solve_modes
 from pcbdyn.testdata import MeasuredModes
 

@@ -9,7 +9,8 @@ from pcbdyn import diagnosis as dg
 from pcbdyn.diagnosis.line_mass import KIND
 from pcbdyn.diagnosis.mass_lines import as_lines
 from pcbdyn.diagnosis.residual import ModalResidual, Observation
-from pcbdyn.diagnosis.select import Selection, estimate, penalty
+from pcbdyn.diagnosis.select import estimate
+from pcbdyn.diagnosis.selection import Selection, penalty
 from pcbdyn.fe import MassProperty, Model, ShellProperty
 from pcbdyn.fe.assembly import assemble
 from pcbdyn.fe.generate import rectangle

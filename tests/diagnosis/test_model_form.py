@@ -13,7 +13,7 @@ from pcbdyn.diagnosis import finer
 from pcbdyn.diagnosis.model_form import fit_plate_share, kirchhoff_shift
 from pcbdyn.diagnosis.residual import ModalResidual, Observation
 from pcbdyn.diagnosis.scan import Runner
-from pcbdyn.diagnosis.select import Selection
+from pcbdyn.diagnosis.selection import Selection
 from pcbdyn.fe.modal import solve_modes
 from pcbdyn.fe.probe import model_probe
 from pcbdyn.problems import StructureModels

@@ -11,7 +11,8 @@ import pytest
 
 from pcbdyn import diagnosis as dg
 from pcbdyn.diagnosis.residual import ModalResidual, Observation
-from pcbdyn.diagnosis.select import Selection, estimate, noticed
+from pcbdyn.diagnosis.select import estimate, noticed
+from pcbdyn.diagnosis.selection import Selection
 from pcbdyn.fe.modal import solve_modes
 from pcbdyn.testdata import MeasuredModes
 

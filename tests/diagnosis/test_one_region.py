@@ -12,7 +12,8 @@ from pcbdyn.diagnosis.moves import LocalMoves, rectangle
 from pcbdyn.diagnosis.one_region import as_one_region, side_by_side, starts
 from pcbdyn.diagnosis.region_stiffness import KIND
 from pcbdyn.diagnosis.residual import ModalResidual, Observation
-from pcbdyn.diagnosis.select import Selection, estimate, penalty, refine
+from pcbdyn.diagnosis.select import estimate, refine
+from pcbdyn.diagnosis.selection import Selection, penalty
 from pcbdyn.fe.modal import solve_modes
 from pcbdyn.testdata import MeasuredModes
 

@@ -100,7 +100,8 @@ def test_refine_moves_a_segment_found_too_short_to_the_true_run(card):
     recovers its mass."""
     from pcbdyn.diagnosis.moves import LocalMoves
     from pcbdyn.diagnosis.residual import ModalResidual, Observation
-    from pcbdyn.diagnosis.select import Selection, estimate, refine
+    from pcbdyn.diagnosis.select import estimate, refine
+    from pcbdyn.diagnosis.selection import Selection
 
     m, cands = card
     runs = {c.data["run"]: i for i, c in enumerate(cands) if c.kind == "line_mass" and "run" in c.data}
@@ -123,7 +124,8 @@ def test_refine_walks_a_point_mass_placed_nodes_away_to_its_node(card):
     node (:class:`LocalMoves`, the eight nodes around) to its node and recovers its mass."""
     from pcbdyn.diagnosis.moves import LocalMoves, on_node
     from pcbdyn.diagnosis.residual import ModalResidual, Observation
-    from pcbdyn.diagnosis.select import Selection, estimate, refine
+    from pcbdyn.diagnosis.select import estimate, refine
+    from pcbdyn.diagnosis.selection import Selection
 
     m, cands = card
     cands = list(cands)
@@ -149,7 +151,8 @@ def test_a_mass_with_an_inertia_beside_it_is_refitted_as_one_body(card):
     0.8 mm off) and recovers m and J (the radius is a fixed point of the fit)."""
     from pcbdyn.diagnosis.bodies import as_bodies
     from pcbdyn.diagnosis.residual import ModalResidual, Observation
-    from pcbdyn.diagnosis.select import Selection, estimate, penalty
+    from pcbdyn.diagnosis.select import estimate
+    from pcbdyn.diagnosis.selection import Selection, penalty
     from pcbdyn.fixtures.supports import disc_footprint
 
     m, cands = card
@@ -181,7 +184,8 @@ def test_refine_walks_a_region_found_on_the_patch_grid_to_the_true_rectangle(car
     its stiffness change."""
     from pcbdyn.diagnosis.moves import LocalMoves, rectangle
     from pcbdyn.diagnosis.residual import ModalResidual, Observation
-    from pcbdyn.diagnosis.select import Selection, estimate, refine
+    from pcbdyn.diagnosis.select import estimate, refine
+    from pcbdyn.diagnosis.selection import Selection
 
     m, cands = card
     layout = dg.from_model(m)
@@ -309,7 +313,8 @@ def test_refine_walks_a_heat_sink_found_on_the_patch_grid_to_its_rectangle_as_on
     element at a time, to the true rectangle, with both magnitudes."""
     from pcbdyn.diagnosis.moves import LocalMoves, rectangle
     from pcbdyn.diagnosis.residual import ModalResidual, Observation
-    from pcbdyn.diagnosis.select import Selection, estimate, refine
+    from pcbdyn.diagnosis.select import estimate, refine
+    from pcbdyn.diagnosis.selection import Selection
 
     m, cands = card
     layout = dg.from_model(m)
@@ -336,10 +341,26 @@ def test_a_spring_that_pins_the_plate_is_not_dropped_for_its_standard_deviation(
     """A spring to ground at the kind's bound (rigid) has a standard deviation far above its stiffness (the
     frequencies no longer change with it) and is far from no spring: ``without_vanished`` keeps it (its
     removal is weighed by chi^2, :func:`pcbdyn.diagnosis.select.noticed`)."""
-    from pcbdyn.diagnosis.select import Selection, without_vanished
+    from pcbdyn.diagnosis.select import without_vanished
+    from pcbdyn.diagnosis.selection import Selection
 
     _, cands = card
     spring = next(i for i, c in enumerate(cands) if c.kind == "ground_spring")
     sel = Selection(chosen=[spring], values=np.array([1e7]), sigma=np.array([3e7]), p=np.zeros(0))
     assert without_vanished(None, cands, sel) is sel and sel.chosen == [spring]
 
+
+
+def test_a_selection_is_within_the_noise_by_the_chi_square_test_on_the_rows_its_fit_leaves_free():
+    """:meth:`Selection.within_noise` (thesis section 5.2.3): 100 rows less 3 declared parameters and the 2
+    effects chosen leave 95 degrees of freedom. A chi^2 between the 1 % points of 95 and 97 degrees lies
+    beyond the noise at 95 (it would pass if the effects were not counted); the median of 95 passes."""
+    from scipy.stats import chi2 as chi2_dist
+
+    from pcbdyn.diagnosis.selection import Selection
+
+    between = 0.5 * (chi2_dist.isf(0.01, 95) + chi2_dist.isf(0.01, 97))
+    assert chi2_dist.sf(between, 97) > 0.01 > chi2_dist.sf(between, 95)
+    assert not Selection(chosen=[4, 7], chi2=[3e3, between]).within_noise(97, alpha=0.01)
+    assert Selection(chosen=[4, 7], chi2=[3e3, chi2_dist.median(95)]).within_noise(97, alpha=0.01)
+    assert Selection(chosen=[], chi2=[between]).within_noise(95 + 2, alpha=0.01)
