@@ -13,8 +13,7 @@ is a line search: the declared parameters and all magnitudes fitted by the one f
 (:func:`.fitting.estimate`, thesis ch. 4) at two places either side, and the rib taken to the vertex
 of the parabola through the three chi^2 (:func:`vertex`); its step grows while the vertex lies
 beyond the outer places and shrinks once it lies between them; a move is taken only where chi^2 falls
-by more than the data resolve (:func:`resolved`), and a round of moves that gains less than the mesh's
-own noise (:data:`ROUND_GAIN`) ends the fit.
+by more than the data resolve (:func:`resolved`), and a round of moves that takes none ends the fit.
 Each place is a mesh of its own, so chi^2 carries the mesh's changes as noise (a few % of it on a card
 with parts: 906 at the bar's line, 950 and 960 a quarter of a millimetre to either side); a parabola
 through places an element apart reads through it where finite differences at a fraction of an element
@@ -46,14 +45,10 @@ from .stiffener import extent, in_its_plane, in_plane, normal
 MOVES = {"across": 0.25, "turn": 0.25, "end0": 0.5, "end1": 0.5, "height": 0.25}
 #: a move's step grows and shrinks within these multiples of its first step
 STEP_RANGE = (0.25, 8.0)
-#: rounds over all moves, at most (a round that gains less than :data:`ROUND_GAIN` ends the search): dev
-#: seed 15's steel bar on a 0.91 mm board still lost half its chi^2 per round after two (18785 there; rounds
-#: more from that place took it to 1013, both ends within 1 mm of the bar's)
+#: rounds over all moves, at most (a round that improves nothing ends the search): dev seed 15's steel bar
+#: on a 0.91 mm board still lost half its chi^2 per round after two (18785 there; rounds more from that
+#: place took it to 1013, both ends within 1 mm of the bar's)
 ROUNDS = 12
-#: a round of moves that lowers chi^2 by less than this share of it ends the search: re-meshing a rib a
-#: quarter of an element aside changes chi^2 by a few % (module doc), so smaller gains are the mesh's, not
-#: the data's (the housing wall bar's end crept 0.17 mm per move, 0.1 % of chi^2 each, for 30 line searches)
-ROUND_GAIN = 0.01
 #: [element sizes] the forward-difference step of an end coordinate (and, in ln h, of the height)
 STEP = 0.125
 #: Gauss-Newton steps (each 1 + 5 re-meshed solves per rib, and halvings)
@@ -134,7 +129,7 @@ def parabola(offsets, chi2, x: float) -> float:
 def resolved(fit, n_rows: int, n_ribs: int) -> float:
     """The least fall of chi^2 that a move of a rib must make to be taken: one unit of chi^2 (the edge
     of a parameter's 1-sigma interval), in units of the variance the fit leaves where that exceeds the
-    stated noise (as :func:`.selection.worth` weighs an effect). A move that gains less lies within the
+    stated noise (as :func:`.select.worth` weighs an effect). A move that gains less lies within the
     geometry's own uncertainty: the data cannot tell the two places apart, and each move costs re-meshed
     solves (dev seed 9: its last four moves gained 0.8 of chi^2 1854.3)."""
     k = np.size(fit.p) + np.size(fit.values) + len(MOVES) * n_ribs
@@ -256,7 +251,7 @@ def fit_ribs(structure, configs, names, h: float, observations, chosen: list, p,
             say(f"  ends and sections by Gauss-Newton: chi^2 {here[3].chi2:.5g}")
     step = {(k, m): s for k in ribs for m, s in MOVES.items()}
     for _ in range(rounds):
-        start = here[3].chi2
+        improved = False
         for k in ribs:
             for m in MOVES:
                 scale = 1.0 if m == "height" else h
@@ -274,10 +269,10 @@ def fit_ribs(structure, configs, names, h: float, observations, chosen: list, p,
                 trial = None if there is None else _fit_at(base, observations, [*chosen[:k], there, *chosen[k + 1:]],
                                                            fit.p, fit.values, conforming.STEPS)
                 if trial is not None and trial[3].chi2 < fit.chi2 - need:
-                    chosen, here = [*chosen[:k], there, *chosen[k + 1:]], trial
+                    chosen, here, improved = [*chosen[:k], there, *chosen[k + 1:]], trial, True
                     if say:
                         by = f"{x:+.3g} in ln h" if m == "height" else f"{1e3 * x:+.3g} mm"
                         say(f"  {chosen[k].name}: {m} {by}, chi^2 {trial[3].chi2:.5g}")
-        if here[3].chi2 > (1.0 - ROUND_GAIN) * start:
+        if not improved:
             break
     return Ribs(*here)
