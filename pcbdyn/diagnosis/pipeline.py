@@ -260,7 +260,8 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
         return search(res, cands, p0, models.bounds, max_effects=max_effects, shortlist=1 if quick else 2, alpha=alpha,
                       base=begin, runner=runner, moves=moves, **kw)
     plan = Starts(res, cands, held, support, moves, models.bounds, alpha, runner, say)
-    sel, free = plan.best(search_from, origins, lambda: declared_origin(res, base, start, models, say), stats)
+    sel, free, stats["searched_from_declared"] = plan.best(search_from, origins,
+                                                          lambda: declared_origin(res, base, start, models, say))
     if free:
         say("  the search without them fits better")
         support, shown = [], {}

@@ -38,23 +38,23 @@ class Starts:
     runner: object
     say: object
 
-    def best(self, search, origins, declared, stats) -> tuple:
-        """(the selection of least criterion, whether it ran without the support) over the starts, from
-        the fits ``origins`` of the declared parameters (the first: the one the noise test weighed, whose
-        chi^2 a search from the declared values must beat); ``search(fit, **kw)`` runs one search,
-        ``declared()`` gives the declared values' start or None; ``stats`` gains
-        ``searched_from_declared``."""
-        stats["searched_from_declared"] = False
+    def best(self, search, origins, declared) -> tuple:
+        """(the selection of least criterion, whether it ran without the support, whether a search ran from
+        the declared values) over the starts, from the fits ``origins`` of the declared parameters (the
+        first: the one the noise test weighed, whose chi^2 a search from the declared values must beat);
+        ``search(fit, **kw)`` runs one search, ``declared()`` gives the declared values' start or None."""
         found = []
-        for sel, free in self._runs(search, origins, declared, stats):
-            found.append((sel, free))
-            if sel.within_noise(self.res.n_rows - len(origins[0].p), self.alpha):
+        for run in self._runs(search, origins, declared):
+            found.append(run)
+            if run[0].within_noise(self.res.n_rows - len(origins[0].p), self.alpha):
                 self.say("  what the effects found leave is within the noise: the search's other starts are not run")
                 break
-        return min(found, key=lambda s: s[0].criterion[-1])
+        sel, free, _ = min(found, key=lambda r: r[0].criterion[-1])
+        return sel, free, any(r[2] for r in found)
 
-    def _runs(self, search, origins, declared, stats):
-        """(selection, whether it ran without the support) of each start, one at a time."""
+    def _runs(self, search, origins, declared):
+        """(selection, whether it ran without the support, whether from the declared values) of each start,
+        one at a time."""
         res, held = self.res, self.held
         for origin in origins:
             begin, placed = origin, held
@@ -63,15 +63,14 @@ class Starts:
                 begin = estimate(res, origin.p, [self.cands[i] for i in held], [v for _, v in self.support], 10,
                                  self.bounds)
                 begin, placed = self._walked(begin)
-            yield search(begin, held=placed), False
+            yield search(begin, held=placed), False, False
         if held:
             self.say("searching again without the effects the modes without a partner showed")
-            yield search(estimate(res, origins[0].p, [], [], 10, self.bounds)), True
+            yield search(estimate(res, origins[0].p, [], [], 10, self.bounds)), True, False
             return
         at = declared()
-        stats["searched_from_declared"] = at is not None
         if at is not None:
-            yield search(at, without=origins[0].chi2), False
+            yield search(at, without=origins[0].chi2), False, True
 
     def _walked(self, fit) -> tuple:
         """(fit, candidate indices) of the held effects (fitted with the declared parameters in ``fit``) after
