@@ -20,7 +20,9 @@ the declared parameters one after the other), 135 s with update's fit on the spa
 own; update 44-45 s. Again after the drilling rotations' stand-in inertia was lowered (bab79e3, load 0.6):
 the same figures; diagnose 120 s, update 42 s. Again with the truth's lumped parts corrected (0f3f95d; the box
 has none) and the support rule of d7a2f58: the same figures; diagnose 335 s, update 73 s at load 2.4 with three
-benchmark cases running beside it.
+benchmark cases running beside it. Again 2026-12-05 (b0fe0d4, the truth solved again, load 0.7): relay 0.7 mm off,
+83.8 g (+4.7 %); 29.72 % as given, 2.80 % parameters only, 0.72 % after, update 27.43 %; diagnose 99 s, update
+27 s; beside the relay one invented effect, a spring to ground of 94 N/mm 17 mm below it.
 """
 
 from __future__ import annotations
