@@ -41,6 +41,7 @@ from . import conforming
 from .catalogue import kind
 from .fitting import UPPER, Fit, estimate
 from .layout import from_structure
+from .selection import variance_left
 from .stiffener import extent, in_its_plane, in_plane, normal
 
 #: the moves of a rib and their first steps ([element sizes]; the height's in ln h)
@@ -134,21 +135,21 @@ def parabola(offsets, chi2, x: float) -> float:
 def resolved(fit, n_rows: int, n_ribs: int) -> float:
     """The least fall of chi^2 that a move of a rib must make to be taken: one unit of chi^2 (the edge
     of a parameter's 1-sigma interval), in units of the variance the fit leaves where that exceeds the
-    stated noise (as :func:`.select.worth` weighs an effect). A move that gains less lies within the
+    stated noise (as :func:`.selection.worth` weighs an effect). A move that gains less lies within the
     geometry's own uncertainty: the data cannot tell the two places apart, and each move costs re-meshed
     solves (dev seed 9: its last four moves gained 0.8 of chi^2 1854.3)."""
     k = np.size(fit.p) + np.size(fit.values) + len(MOVES) * n_ribs
-    return max(fit.chi2 / max(n_rows - k, 1), 1.0)
+    return variance_left(fit.chi2, n_rows, k)
 
 
-def settled(start: float, end: float, took: bool, strode: bool) -> bool:
-    """Whether a round of moves from chi^2 ``start`` to ``end`` ends the fit: it took no move, or it
-    gained less than :data:`ROUND_GAIN` of chi^2 and none of its moves (``strode``) reached its outer
-    place. Smaller gains are the mesh's, not the data's (the housing wall bar's end crept 0.17 mm a move
+def settled(start: float, end: float, strode: bool) -> bool:
+    """Whether a round of moves from chi^2 ``start`` to ``end`` ends the fit: it gained less than
+    :data:`ROUND_GAIN` of chi^2 (none, where it took no move) and none of the moves it took (``strode``)
+    reached its outer place. Smaller gains are the mesh's, not the data's (the housing wall bar's end crept 0.17 mm a move
     for ten rounds, 0.1 % of chi^2 each); but a move taken to its outer place is still striding towards
     a minimum (report seed 1023, far from it: a round of 0.9 % followed by steps that doubled, 46730 to
     43141)."""
-    return not took or (end > (1.0 - ROUND_GAIN) * start and not strode)
+    return end >= (1.0 - ROUND_GAIN) * start and not strode
 
 
 def _fit_at(base, observations, effects, p, values, steps: int):
@@ -266,7 +267,7 @@ def fit_ribs(structure, configs, names, h: float, observations, chosen: list, p,
             say(f"  ends and sections by Gauss-Newton: chi^2 {here[3].chi2:.5g}")
     step = {(k, m): s for k in ribs for m, s in MOVES.items()}
     for _ in range(rounds):
-        start, took, strode = here[3].chi2, False, False
+        start, strode = here[3].chi2, False
         for k in ribs:
             for m in MOVES:
                 scale = 1.0 if m == "height" else h
@@ -285,10 +286,10 @@ def fit_ribs(structure, configs, names, h: float, observations, chosen: list, p,
                 trial = None if there is None else _fit_at(base, observations, [*chosen[:k], there, *chosen[k + 1:]],
                                                            fit.p, fit.values, conforming.STEPS)
                 if trial is not None and trial[3].chi2 < fit.chi2 - need:
-                    chosen, here, took, strode = [*chosen[:k], there, *chosen[k + 1:]], trial, True, strode or outer
+                    chosen, here, strode = [*chosen[:k], there, *chosen[k + 1:]], trial, strode or outer
                     if say:
                         by = f"{x:+.3g} in ln h" if m == "height" else f"{1e3 * x:+.3g} mm"
                         say(f"  {chosen[k].name}: {m} {by}, chi^2 {trial[3].chi2:.5g}")
-        if settled(start, here[3].chi2, took, strode):
+        if settled(start, here[3].chi2, strode):
             break
     return Ribs(*here)

@@ -59,7 +59,13 @@ def adopt(sel: Selection, idx: list, fit: Fit, pen: float) -> Selection:
     return sel
 
 
+def variance_left(chi2: float, n: int, k: int) -> float:
+    """The variance per row that a fit of ``k`` unknowns to ``n`` rows leaves with ``chi2``, at least the
+    stated noise's (1): the unit in which a noise or model error larger than stated is weighed."""
+    return max(chi2 / max(n - k, 1), 1.0)
+
+
 def worth(chi2_before, chi2_after, n, k, pen) -> bool:
     """The drop exceeds the penalty in stated noise units and in units of the variance left."""
     drop = chi2_before - chi2_after
-    return drop > pen and drop / max(chi2_after / max(n - k, 1), 1.0) > pen
+    return drop > pen and drop / variance_left(chi2_after, n, k) > pen

@@ -35,6 +35,7 @@ from .catalogue import moved_value
 from .fitting import RANK_STEPS, UPPER, estimate
 from .held_out import fit_without, folds
 from .reanalysis import Reanalysis
+from .selection import variance_left
 
 #: the model-form budget: one standard deviation as a share of the magnitude, for every reported type.
 #: Calibrated with ``benchmarks/bench_coverage.py --calibrate`` on the bench and hold-out cases other
@@ -126,7 +127,7 @@ def place_range(res, state, effects, j: int, neighbours, bounds=None, at=None) -
     interval of [0.84, 3.07], has places within the rise at 0.35 to 2.64. ``at``: :func:`at_state`."""
     rx, P = at or at_state(res, state)
     v = np.asarray(state.values, float)
-    s2 = _variance(res, state, effects)
+    s2 = variance_left(state.chi2, res.n_rows, np.size(state.p) + len(effects))
 
     def fit(c, start):
         trial = effects[:j] + [c] + effects[j + 1:]
@@ -149,11 +150,6 @@ def place_range(res, state, effects, j: int, neighbours, bounds=None, at=None) -
                 kept.append(f.values[j])
                 todo.append((c, f.values[j]))
     return min(kept), max(kept)
-
-
-def _variance(res, state, effects) -> float:
-    """The variance the fit at ``state`` leaves per row, at least the stated noise's (1)."""
-    return max(1.0, state.chi2 / max(res.n_rows - np.size(state.p) - len(effects), 1))
 
 
 def model_form(kind_name: str) -> float:
@@ -193,7 +189,7 @@ def profile_interval(res, state, effects, j: int, bounds=None, at=None) -> tuple
     v = np.asarray(state.values, float)
     others, rest = effects[:j] + effects[j + 1:], np.delete(v, j)
     spec = effects[j].spec
-    s2 = _variance(res, state, effects)
+    s2 = variance_left(state.chi2, res.n_rows, np.size(state.p) + len(effects))
 
     def chi2(x):
         fit = estimate(res, state.p, others, rest, RANK_STEPS, bounds, param_columns=P, reduced=rx,

@@ -101,8 +101,8 @@ def test_a_round_of_moves_settles_only_when_it_creeps():
     place goes on (report seed 1023: such rounds took chi^2 from 46730 to 43141)."""
     from pcbdyn.diagnosis.geometry_fit import settled
 
-    assert settled(1744.8, 1744.8, took=False, strode=False)
-    assert settled(1620.0, 1618.3, took=True, strode=False)  # the wall bar's end creeping 0.17 mm
-    assert not settled(46730.0, 46310.0, took=True, strode=True)
-    assert settled(46730.0, 46310.0, took=True, strode=False)
-    assert not settled(18785.0, 9000.0, took=True, strode=False)  # dev seed 15: half its chi^2 a round
+    assert settled(1744.8, 1744.8, strode=False)
+    assert settled(1620.0, 1618.3, strode=False)  # the wall bar's end creeping 0.17 mm
+    assert not settled(46730.0, 46310.0, strode=True)
+    assert settled(46730.0, 46310.0, strode=False)
+    assert not settled(18785.0, 9000.0, strode=False)  # dev seed 15: half its chi^2 a round
