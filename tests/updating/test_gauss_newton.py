@@ -43,3 +43,32 @@ def test_a_step_is_halved_in_turn_until_the_model_can_be_evaluated():
     gn = gauss_newton(evaluate, lambda st: np.ones((1, 1)), np.zeros(1), np.full(1, -10.0), np.full(1, 10.0),
                       np.ones(1), 1, lambda y: np.full(1, 1e-12))
     assert gn.y[0] == pytest.approx(0.25, abs=1e-12)
+
+
+def test_a_converged_fit_tries_no_further_step():
+    """A mildly nonlinear residual r(y) = b - (y + 0.01 y^3) in noise units, from y = 0 with twenty steps and
+    a step tolerance nothing meets: the fit reaches the least-squares solution (to the statistical
+    precision CHI2_TOL asks, 0.1 of a standard deviation, here 0.1 in y) and then stops instead of
+    spending its remaining steps on round-off and its halvings; once it has converged its last
+    Jacobian is the one it already made there."""
+    b = np.array([3.0, 3.2, 2.9])
+    calls = {"evaluate": 0, "jacobian": 0}
+
+    def evaluate(y):
+        calls["evaluate"] += 1
+        st = _State(b - (y[0] + 0.01 * y[0] ** 3))
+        st.y = float(y[0])
+        return st
+
+    def jacobian(st):
+        calls["jacobian"] += 1
+        return np.full((3, 1), 1.0 + 0.03 * st.y**2)
+
+    gn = gauss_newton(evaluate, jacobian, np.zeros(1), np.full(1, -10.0), np.full(1, 10.0), np.ones(1), 20,
+                      lambda y: np.full(1, 1e-15))
+    roots = np.roots([0.01, 0.0, 1.0, -b.mean()])
+    exact = roots.real[np.abs(roots.imag) < 1e-12][0]
+    sigma = 1.0 / (np.sqrt(3.0) * (1.0 + 0.03 * exact**2))  # one standard deviation of y at unit noise
+    assert abs(gn.y[0] - exact) < 0.1 * sigma
+    assert calls["evaluate"] <= 4  # the start and a few Gauss-Newton steps (seven without the rule), not twenty
+    assert calls["jacobian"] == calls["evaluate"]  # one per state stood on, none made twice
