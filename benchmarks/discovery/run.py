@@ -110,7 +110,19 @@ def summary(rows: list) -> dict:
         "median_after_pct": float(np.median(after)) if after else None,
         "after_le_0.5": (sum(a <= 0.5 for a in after), len(after)),
         "median_wall_s": float(np.median(walls)) if walls else None, "max_wall_s": max(walls) if walls else None,
+        "stage_share": stage_share([r for _, r, _ in rows]),
     }
+
+
+def stage_share(results: list) -> dict:
+    """{diagnosis stage: its share of the summed wall time of the diagnoses that kept their stages'
+    seconds} (statistics.stage_seconds), the largest first: where a speed-up is to be looked for."""
+    summed: dict = {}
+    for r in results:
+        for key, t in (((r.get("diagnosis") or {}).get("statistics") or {}).get("stage_seconds") or {}).items():
+            summed[key] = summed.get(key, 0.0) + t
+    total = sum(summed.values())
+    return {k: t / total for k, t in sorted(summed.items(), key=lambda kv: -kv[1])} if total else {}
 
 
 def main(argv=None):
@@ -178,6 +190,8 @@ def _print(s: dict) -> None:
           f"1-sigma {_pct(*s['covered_1sigma'])} (stated 68 %)")
     print(f"  error after: median {s['median_after_pct']} %, <= 0.5 %: {_pct(*s['after_le_0.5'])}")
     print(f"  wall per case: median {s['median_wall_s']:.0f} s, slowest {s['max_wall_s']:.0f} s")
+    if s["stage_share"]:
+        print("  where the time went: " + ", ".join(f"{k} {100 * v:.0f} %" for k, v in s["stage_share"].items()))
 
 
 if __name__ == "__main__":

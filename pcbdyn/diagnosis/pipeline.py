@@ -45,6 +45,7 @@ import numpy as np
 
 from ..domain import StructureError
 from ..parallel import spare_cores
+from ..progress import Stages
 from ..problems.models import StructureModels
 from . import conforming, geometry_fit
 from .at_points import as_points
@@ -118,7 +119,7 @@ def _on_lines(models, res, cands, sel, forms, h, levels: int, runner, alpha, say
     keep.sort()
     idx, chosen, values = [idx[k] for k in keep], [chosen[k] for k in keep], values[keep]
     base = (models.structure, models.configs, models.names, h)
-    say("meshing along the stiffeners found; the mesh correction with every effect found carried")
+    say.stage("ribs meshed", "meshing along the stiffeners found; the mesh correction with every effect found carried")
     try:
         models, res, placed = conforming.remeshed(*base, res.observations, chosen)
     except StructureError as exc:
@@ -126,7 +127,7 @@ def _on_lines(models, res, cands, sel, forms, h, levels: int, runner, alpha, say
         return None
     res = with_carried(models, res, sel.p, list(zip(placed, values)), forms, h, levels, runner, kirchhoff=True)
     fit = estimate(res, sel.p, placed, values, conforming.STEPS, models.bounds)
-    say("fitting the stiffeners' ends, directions and sections on meshes along them")
+    say.stage("rib geometry", "fitting the stiffeners' ends, directions and sections on meshes along them")
     ribs = geometry_fit.fit_ribs(*base, res.observations, placed, fit.p, fit.values, runner, say)
     if ribs is not None and ribs.fit.chi2 < fit.chi2:
         moved = max(float(np.abs(np.asarray(a.geometry["path"]) - np.asarray(b.geometry["path"])).max())
@@ -174,7 +175,8 @@ def diagnose(structure, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_s
     re-solve share the local cores (:func:`pcbdyn.parallel.spare_cores`). ``record``: a dict that the
     diagnosis fills as it goes (``before``, ``parameters_only``: summaries of the states;
     ``parameters``, ``statistics``), so that a caller still has what was computed when a later step
-    fails. ``search_effects`` False: stop after the parameters and the noise test (steps 1-3)."""
+    fails. ``search_effects`` False: stop after the parameters and the noise test (steps 1-3). The wall
+    seconds of each step are kept as ``statistics["stage_seconds"]``."""
     with spare_cores(workers):
         return _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kinds, max_effects, alpha,
                          progress, workers, scheduler, quick, {} if record is None else record, search_effects)
@@ -182,16 +184,16 @@ def diagnose(structure, tests, freq_noise_pct=None, shape_noise_pct=None, mesh_s
 
 def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kinds, max_effects, alpha, progress,
               workers, scheduler, quick, record, search_effects) -> Diagnosis:
-    say = progress or (lambda msg: None)
+    say = Stages(progress)
     runner = Runner(workers, scheduler, lambda msg: say(f"  {msg}"))
     h = mesh_size or structure.mesh_size
-    say("building the models")
+    say.stage("models", "building the models")
     models = StructureModels(structure, [c for c, _ in tests], mesh_size=h, shared_mesh=True)
     names, p0 = models.names, models.p0
     obs = observations(tests, models.models)
     res = ModalResidual.of_models(models, obs)
     updated = update_start(structure, tests, (freq_noise_pct, shape_noise_pct), h, say) if names else None
-    say("solving the model as given")
+    say.stage("as given", "solving the model as given")
     before = res.evaluate(p0)
     record["before"] = before.summary(obs)
     start, at = paired_start(models, obs, p0, before, say)
@@ -207,14 +209,14 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
         obs = [ob.subset(cs.matched) for ob, cs in zip(obs, paired.configs)]
         bounce = [b[cs.matched] for b, cs in zip(bounce, paired.configs)]
         res = ModalResidual.of_models(models, obs)
-    say("estimating the noise and the model's discretisation error")
+    say.stage("error budget", "estimating the noise and the model's discretisation error")
     levels = 1 if quick else MESH_LEVELS
     say("  finer meshes: " + ", ".join(f"level {j} of {levels} ({1e3 * h / 2**j:.3g} mm)" for j in range(1, levels + 1)))
     seed = res.evaluate(start, [c for c, _ in support], [v for _, v in support])
     obs, forms = set_noise(models, h, obs, seed, freq_noise_pct, shape_noise_pct, levels, runner, support)
     res = res.on(obs)
     before = res.evaluate(p0)
-    say(f"fitting the {len(names)} declared parameter(s)" if names else "no declared parameters")
+    say.stage("parameters", f"fitting the {len(names)} declared parameter(s)" if names else "no declared parameters")
     # the declared parameters alone, on the modes they can pair (a support's bounce has no partner without it)
     plain = ModalResidual.of_models(models, [ob.subset(~b) for ob, b in zip(obs, bounce)]) if support else res
     own = estimate(plain, start, [], [], 10, models.bounds)
@@ -245,13 +247,14 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
                f"effects not searched; what the declared parameters leave is "
                f"{'within' if stats['p_value_noise'] > alpha else 'beyond'} the noise ({test})")
         stats["after_worse_than_parameters_only"] = False  # "after" is the parameters-only fit
+        stats["stage_seconds"] = say.seconds()
         return Diagnosis([], noise_only, msg, after=out["parameters_only"], **out)
-    say("generating the candidate effects")
+    say.stage("candidates", "generating the candidate effects")
     grid = QUICK_CANDIDATE_OPTIONS if quick else CANDIDATE_OPTIONS
     options = {k: v * h if k == "path_spacing" else v for k, v in grid.items() if k in _options(kinds)}
     layout = from_structure(models.models[0])
     cands = generate(layout, kinds, **options)
-    say(f"searching {len(cands)} candidate effects")
+    say.stage("search", f"searching {len(cands)} candidate effects")
     cands += [c for c, _ in support]
     held = list(range(len(cands) - len(support), len(cands)))
     moves = LocalMoves(layout, cands, h)
@@ -267,21 +270,21 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
         support, shown = [], {}
         stats["support_test_modes"] = shown
     if any(movable(cands[i]) for i in sel.chosen):
-        say("refining where the effects along the sides begin and end, where stiffeners run, what regions cover "
+        say.stage("refine", "refining where the effects along the sides begin and end, where stiffeners run, what regions cover "
             "and where masses sit")
         sel = refine(res, cands, sel, moves, models.bounds, alpha=alpha, runner=runner)
     if sum(cands[i].kind in REGION_KINDS for i in sel.chosen) > 1:
-        say("fitting overlapping or side-by-side regions found as one region")
+        say.stage("one region", "fitting overlapping or side-by-side regions found as one region")
         sel = as_one_region(res, cands, sel, moves, MERGE_REACH * h, models.bounds, alpha=alpha, runner=runner)
     if {"point_mass", "point_inertia"} <= {cands[i].kind for i in sel.chosen}:
-        say("fitting a part found as a mass with an inertia beside it as one body")
+        say.stage("bodies", "fitting a part found as a mass with an inertia beside it as one body")
         sel = as_bodies(res, cands, sel, groups([cands[i] for i in sel.chosen], MERGE_REACH * h),
                         MERGE_REACH * h, models.bounds, alpha=alpha)
     if any(at_grid_node(cands[i]) for i in sel.chosen):
-        say("placing the masses and springs found on nodes at their points between the nodes")
+        say.stage("at points", "placing the masses and springs found on nodes at their points between the nodes")
         sel = as_points(res, cands, sel, MERGE_REACH * h, layout, h / 2, models.bounds, alpha=alpha)
     if any(cands[i].kind in LINE_LIKE for i in sel.chosen):
-        say("fitting masses found as masses along lines")
+        say.stage("mass lines", "fitting masses found as masses along lines")
         sel = as_lines(res, cands, sel, MERGE_REACH * h, layout, h / 2, models.bounds, alpha=alpha)
     sel = without_vanished(res, cands, sel, models.bounds, alpha=alpha)
     carried = [(cands[i], v) for i, v in zip(sel.chosen, sel.values) if cands[i].kind in MASS_KINDS or cands[i].between_nodes]
@@ -291,7 +294,7 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
     if lined is not None:
         models, res, cands, sel = lined
     elif carried and not quick:
-        say("measuring the mesh correction again with the masses (and supports) found on the finer meshes")
+        say.stage("carried", "measuring the mesh correction again with the masses (and supports) found on the finer meshes")
         res = with_carried(models, res, sel.p, carried, forms, h, levels, runner)
         sel = adopt(sel, sel.chosen, estimate(res, sel.p, [cands[i] for i in sel.chosen], sel.values, 8, models.bounds),
                     penalty(res.n_rows, len(cands), alpha))
@@ -299,16 +302,16 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
         stats["mesh_resolved"] = [f.resolved for f in forms]
         stats["mesh_correction_pct"] = [np.round(100 * (o.f_scale - 1.0), 4).tolist() for o in res.observations]
         stats["plate_theory_pct"] = [np.round(100 * f.shift, 4).tolist() for f in forms]
-    say("fitting the plate theory's share with the effects")
+    say.stage("plate theory", "fitting the plate theory's share with the effects")
     sel, theta, theta_sigma, res = fit_plate_share(res, cands, sel, [f.shift for f in forms], [f.plain for f in forms],
                                               models.bounds, alpha=alpha)
     stats.update(plate_theory_share=theta, plate_theory_share_sigma=theta_sigma)
     near = moves if lined is None else LocalMoves(from_structure(models.models[0]), cands, h)
     if any(movable(cands[i]) for i in sel.chosen):  # the residual's weights have changed since the walk
-        say("walking the effects' places again with the plate theory's share fitted")
+        say.stage("refine again", "walking the effects' places again with the plate theory's share fitted")
         sel = refine(res, cands, sel, near, models.bounds, alpha=alpha, runner=runner)
     if sel.chosen:
-        say("checking that the data notice each effect's removal")
+        say.stage("noticed", "checking that the data notice each effect's removal")
         found = len(sel.chosen)
         sel = noticed(res, cands, sel, models.bounds, alpha=alpha)
         stats["effects_not_noticed"] = found - len(sel.chosen)
@@ -336,6 +339,7 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
     after = out["parameters_only"] if bare else sel.state.summary(res.observations)
     po, worse = worst_on_common(out["parameters_only"], after)
     stats["after_worse_than_parameters_only"] = bool(worse > po)
+    stats["stage_seconds"] = say.seconds()
     msg += worse_note(po, worse, bool(effects), theta)
     return Diagnosis(effects, False, msg, after=after, evidence=evidence(plain, base.state, searched),
                      candidates=chosen, **out)

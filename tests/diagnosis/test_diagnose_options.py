@@ -72,6 +72,11 @@ def test_quick_finds_what_the_full_run_finds(case, default, tmp_path):
     _same_findings(data, default, 0.10, 1e3 * bc.MODEL_MESH)
     assert "level 1 of 1" in output and "level 2 of" not in output
     assert data["statistics"]["quick"] and not default["statistics"]["quick"]
+    # where its time went: the steps it ran, each within the run (their sum no more than the run's wall time)
+    stages = data["statistics"]["stage_seconds"]
+    assert {"models", "error budget", "parameters", "search"} <= stages.keys()
+    assert min(stages.values()) >= 0.0
+    assert sum(stages.values()) <= float(re.search(r"done in ([\d.]+) s", output).group(1)) + 0.1
     # the page shows the effects found on the modes of the model that declares them (issue 44)
     page = (tmp_path / "o" / "report.html").read_text()
     assert 'data-title="Effects found"' in page and "Effects found, on the modes of the model" in page
