@@ -270,8 +270,8 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
         support, shown = [], {}
         stats["support_test_modes"] = shown
     if any(movable(cands[i]) for i in sel.chosen):
-        say.stage("refine", "refining where the effects along the sides begin and end, where stiffeners run, what regions cover "
-            "and where masses sit")
+        say.stage("refine", "refining where the effects along the sides begin and end, where stiffeners run, what "
+                  "regions cover and where masses sit")
         sel = refine(res, cands, sel, moves, models.bounds, alpha=alpha, runner=runner)
     if sum(cands[i].kind in REGION_KINDS for i in sel.chosen) > 1:
         say.stage("one region", "fitting overlapping or side-by-side regions found as one region")
@@ -294,7 +294,8 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
     if lined is not None:
         models, res, cands, sel = lined
     elif carried and not quick:
-        say.stage("carried", "measuring the mesh correction again with the masses (and supports) found on the finer meshes")
+        say.stage("carried",
+                  "measuring the mesh correction again with the masses (and supports) found on the finer meshes")
         res = with_carried(models, res, sel.p, carried, forms, h, levels, runner)
         sel = adopt(sel, sel.chosen, estimate(res, sel.p, [cands[i] for i in sel.chosen], sel.values, 8, models.bounds),
                     penalty(res.n_rows, len(cands), alpha))
