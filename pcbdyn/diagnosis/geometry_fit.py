@@ -22,7 +22,8 @@ through places an element apart reads through it where finite differences at a f
 would not. The line searches polish; the long way from the search's full-span line to a bar that stops
 short of the edges at its own angle is covered first by the bounded Gauss-Newton (thesis ch. 4) on the
 ends and ln h with the declared parameters and magnitudes, the geometry's columns by forward
-differences an eighth of an element long (:data:`STEP`), each a re-mesh run as a job. Far from the bar
+differences (:data:`STEP` half an element along the ends, :data:`HEIGHT_STEP` in ln h), each a re-mesh
+run as a job. Far from the bar
 those columns can point its step uphill, however halved: it then tries Marquardt's damped steps
 (:data:`pcbdyn.updating.gauss_newton.DAMPING`; a steel bar 25 mm short of where the search put it:
 chi^2 2.5e5 where it stopped without them, 1.6e4 with); where the mesh's noise still defeats it,
@@ -55,8 +56,13 @@ ROUNDS = 12
 #: a round that lowers chi^2 by less than this share of it, creeping inside its steps, ends the search:
 #: re-meshing a rib a quarter of an element aside changes chi^2 by a few % (module doc)
 ROUND_GAIN = 0.01
-#: [element sizes] the forward-difference step of an end coordinate (and, in ln h, of the height)
-STEP = 0.125
+#: [element sizes] the forward-difference step of an end coordinate: half an element, so that the mesh's
+#: own noise (a few % of chi^2 between re-meshes, module doc) is a small part of the difference (an eighth
+#: of an element: the fit ended wherever its start sent it; housing dev h3-h7, found 1/9 against 4/9 now)
+STEP = 0.5
+#: the forward-difference step of ln h: the height's change re-meshes nothing, and 0.5 in ln h would be a
+#: factor 4.5 in EI, far from a first-order difference
+HEIGHT_STEP = 0.125
 #: Gauss-Newton steps (each 1 + 5 re-meshed solves per rib, and halvings)
 GN_STEPS = 12
 #: Gauss-Newton steps of each trial fit (from the values at the present place)
@@ -219,7 +225,7 @@ def _gauss_newton(base, observations, chosen, ribs, h, fit, bounds, runner, plat
                       np.concatenate([np.r_[lo, lo, np.log(HEIGHT[0])] for lo, _ in plates])]
         upper = np.r_[np.log(hi_p), v_hi, np.concatenate([np.r_[hi, hi, np.log(HEIGHT[1])] for _, hi in plates])]
     scale = np.r_[np.ones(npar), [c.spec.scale for c in chosen], np.tile([h, h, h, h, 1.0], len(ribs))]
-    step = np.tile(np.r_[np.full(4, STEP * h), STEP], len(ribs))
+    step = np.tile(np.r_[np.full(4, STEP * h), HEIGHT_STEP], len(ribs))
     standing: list = []  # [(y, effects, solved)] of the state the fit stands on: trials it does not take are let go
 
     def evaluate(y):
