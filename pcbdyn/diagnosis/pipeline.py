@@ -35,6 +35,8 @@ whether what remains is noise, and otherwise find, place and size the effects th
    (:func:`_on_lines`, :mod:`.conforming`, :mod:`.geometry_fit`). Last, the plate theory's share is
    fitted with the effects found (:func:`.model_form.fit_plate_share`; kept only where significant), and
    the effects walked again in the residual it leaves (its noise units differ from the search's).
+5. What the data do not notice is dropped (:func:`.select.noticed`), and what they notice without resolving its
+   size from none is listed apart, not put in the model (:func:`.merge.resolved`).
 """
 
 from __future__ import annotations
@@ -56,7 +58,7 @@ from .evidence import evidence
 from .fitting import estimate
 from .layout import from_structure
 from .mass_lines import LINE_LIKE, as_lines
-from .merge import MERGE_REACH, groups, mean_path, reported
+from .merge import MERGE_REACH, groups, mean_path, resolved
 from .model_form import MESH_LEVELS, fit_plate_share
 from .moves import REGION_KINDS, LocalMoves, at_grid_node, movable
 from .one_region import as_one_region
@@ -316,18 +318,25 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
         found = len(sel.chosen)
         sel = noticed(res, cands, sel, models.bounds, alpha=alpha)
         stats["effects_not_noticed"] = found - len(sel.chosen)
+    sel, effects, unresolved = resolved(res, cands, sel, near.around, MERGE_REACH * h, models.bounds,
+                                        penalty(res.n_rows, len(cands), alpha))
     bare = not sel.chosen and theta == 0.0  # nothing added to the model: it is the parameters-only one reported
-    stats.update(chi2_after=res.evaluate(told.p).chi2 if bare else sel.chi2[-1], candidates=len(cands))
+    stats.update(chi2_after=res.evaluate(told.p).chi2 if bare else sel.chi2[-1], candidates=len(cands),
+                 unresolved_effects=unresolved)
     for n, v in zip(names, told.p if bare else sel.p):
         out["parameters"][n]["final"] = float(v)
     chosen = [cands[i] for i in sel.chosen]
-    effects = reported(res, sel, chosen, near.around, MERGE_REACH * h, models.bounds)
     if effects:
         msg = f"{len(effects)} effect(s) the model lacks: " + "; ".join(
             f"{e['type']} ({e['parameter']}) at {e['at_mm']} mm" for e in effects)
+    elif unresolved:
+        msg = "the residual exceeds the noise, but no effect found is resolved: nothing is put in the model"
     else:
         msg = ("the residual exceeds the noise but no candidate effect explains it beyond chance: "
                "nothing is reported (check the noise level, the pairing and the declared parameters)")
+    if unresolved:
+        msg += ("; noticed but not resolved, so not in the model (one standard deviation at least the magnitude: "
+                "statistics.unresolved_effects): " + ", ".join(f"{e['type']} at {e['at_mm']} mm" for e in unresolved))
     if theta > 0.0:
         msg += (f"; the frequencies lie {100 * theta:.0f} +- {100 * theta_sigma:.0f} % of the way from the declared "
                 "Mindlin shells to the Kirchhoff limit (statistics.plate_theory_share): the board's transverse shear "
