@@ -31,7 +31,8 @@ is refused, the next best is weighed: they must not hide what the linear shortli
 card in guides, behind a guide's stiffness or a heat sink refused). Where a step keeps nothing and the
 chi^2 left exceeds the noise, the bodies with a spring are once tried at a grid of magnitudes on the
 reanalysis (:func:`.scan.resonant`: a bracket whose own mode falls among the structure's), and such a body
-that both first-order predictions refuse is weighed by refits of the folds (:func:`.held_out.refit_share`).
+that both first-order predictions refuse is weighed by refits of the folds (:func:`.held_out.refit_predicts`),
+as is a body's two halves from the linear shortlist, each half then refitted beside the other.
 After each addition an earlier effect that the others make redundant is dropped (backward check).
 """
 
@@ -41,8 +42,8 @@ import numpy as np
 
 from .catalogue import kind, moved_value
 from .fitting import RANK_STEPS, UPPER, Fit, estimate  # noqa: F401  (re-exported)
-from .halves import Halves, bodies, body_moves, per_kind
-from .held_out import HELD_OUT_SHARE, predicts, refit_share, secant
+from .halves import Halves, bodies, body_moves, per_kind, together
+from .held_out import predicts, refit_predicts, secant
 from .reanalysis import Reanalysis
 from .scan import Runner, rank, resonant, saturated, worth_full
 from .selection import ALPHA, Selection, adopt, penalty, worth
@@ -121,8 +122,9 @@ def _weighed(step, adds: list, start: dict, refit: bool = False) -> tuple:
     of a ``coarse`` kind first walked: :func:`_walked`); (None, None) where none is. A screened support
     or body refused gives way to the next best; a candidate of the linear shortlist refused ends the
     step. ``step``: the search's state at this step (:func:`search`); ``refit``: the additions are the bodies
-    of :func:`.scan.resonant`, which the folds' refits may keep (:func:`_kept`; the linear shortlist's are not:
-    so weighed, a spring rode along a box's hidden mass and a line mass of the hold-out's card)."""
+    of :func:`.scan.resonant`, which the folds' refits may keep (:func:`_kept`; of the linear shortlist's, only
+    a body's two halves, each also beside the other: single additions so weighed, a spring rode along a box's
+    hidden mass and a line mass of the hold-out's card)."""
     res, candidates, sel, fit, held, A, scale, value, P, rx, newton_steps, bounds, pen, n_params, runner, moves, \
         alpha = step
     trials = [([candidates[i] for i in sel.chosen + list(add)],
@@ -134,8 +136,9 @@ def _weighed(step, adds: list, start: dict, refit: bool = False) -> tuple:
             break
         add = list(adds[best])
         idx = sel.chosen + add
+        body = len(add) == 2 and together(candidates[add[0]], candidates[add[1]])
         new = _kept(res, candidates, sel, fit, idx, fits[best], held, A[:, add], scale[idx], newton_steps,
-                    bounds, pen, n_params, len(add), (rx, P) if refit else None)
+                    bounds, pen, n_params, len(add), (rx, P) if refit or body else None, halves=body and not refit)
         if new is None and moves is not None and len(add) == 1 and \
                 worth(sel.chi2[-1], fits[best].chi2, res.n_rows, n_params + len(idx), pen):
             new, idx = _walked(res, candidates, sel, fit, add[0], fits[best], held, moves, newton_steps, bounds,
@@ -177,7 +180,7 @@ def _walked(res, candidates, sel, fit, j, trial, held, moves, newton_steps, boun
 
 
 def _kept(res, candidates, sel, fit, idx, trial, held, column, scale, newton_steps, bounds, pen, n_params,
-          n_added: int = 1, refit=None):
+          n_added: int = 1, refit=None, halves: bool = False):
     """The estimate of effects ``idx`` (the chosen ones and an addition of its last ``n_added``, whose
     trial fit is ``trial`` and columns at the state without it ``column``) when the addition is kept: its
     chi^2 drop is worth ``n_added`` penalties ``pen`` (:func:`worth`) and it predicts the held-out folds
@@ -185,8 +188,9 @@ def _kept(res, candidates, sel, fit, idx, trial, held, column, scale, newton_ste
     state with it (:func:`.held_out.secant`); else None. Either first-order model can fail a real effect
     where the modes respond nonlinearly (a share of a mass beside another: the secant; a bar across the
     card: the state without it); a model error taken for an effect fails both. ``refit``: (reanalysis, the
-    parameters' columns there) for a body with a mode of its own, which is then also weighed by its folds'
-    refits (:func:`.held_out.refit_share`) where both first-order models fail it."""
+    parameters' columns there) for a body, which is then also weighed by its folds' refits where both
+    first-order models fail it (:func:`.held_out.refit_predicts`): a body with a mode of its own as one
+    addition, the two halves of one found by the linear shortlist (``halves``) each beside the other too."""
     new = estimate(res, fit.p, [candidates[i] for i in idx], trial.values, newton_steps, bounds)
     if not worth(sel.chi2[-1], new.chi2, res.n_rows, n_params + len(idx), n_added * pen):
         return None
@@ -195,8 +199,8 @@ def _kept(res, candidates, sel, fit, idx, trial, held, column, scale, newton_ste
         return new
     if predicts(res, r, *secant(res, held, column, new, [candidates[i] for i in idx], scale)):
         return new
-    if refit is not None and refit_share(res, *refit, fit, new, [candidates[i] for i in idx], n_added,
-                                         bounds) >= HELD_OUT_SHARE:
+    if refit is not None and refit_predicts(res, *refit, fit, new, [candidates[i] for i in idx], n_added, bounds,
+                                            newton_steps, halves):
         return new
     return None
 
