@@ -42,10 +42,11 @@ def as_points(res, candidates: list, sel, reach: float, layout, step: float, bou
     if not layout.planar:
         return sel
     pen = penalty(res.n_rows, len(candidates), alpha)
-    chosen = [candidates[i] for i in sel.chosen]
+    start = list(sel.chosen)  # a walk re-orders and shortens sel.chosen: groups hold positions in this one
+    chosen = [candidates[i] for i in start]
     grouped = groups(chosen, reach)
     for g, gm, m, centre in masses_found(chosen, sel.values, grouped) + _springs(chosen, sel.values, grouped):
-        ids = [sel.chosen[k] for k in g]
+        ids = [start[k] for k in g]
         if len(g) != len(gm) or not all(at_grid_node(chosen[k]) for k in gm) or not m > 0 or not set(ids) <= set(sel.chosen):
             continue
         build = _points(layout, chosen[gm[0]])
