@@ -84,8 +84,10 @@ def run_case(name: str, options: dict, shared=None) -> dict:
 #: without a partner; 1022: its point mass beside a hinged edge (2026-11-30); 1023: a scan of the kept
 #: results for parameters fitted onto a bound listed it beside dev seeds 20 and 21 (2026-12-01). 1002, 1005:
 #: a scan of kept results for effects whose standard deviation reaches their size listed their effects
-#: beside the dev ones that led to :func:`pcbdyn.diagnosis.merge.resolved` (2026-12-05).
-SEEN = {1002, 1005, 1021, 1022, 1023}
+#: beside the dev ones that led to :func:`pcbdyn.diagnosis.merge.resolved` (2026-12-05). 1020: its internal
+#: error followed into :func:`pcbdyn.diagnosis.at_points.as_points` and its truth read beside the fix's result
+#: (2026-12-05, later).
+SEEN = {1002, 1005, 1020, 1021, 1022, 1023}
 
 
 def _pct(k: int, n: int) -> str:
