@@ -107,7 +107,7 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
             screened = resonant(rx, [candidates[i] for i in sel.chosen], sel.values, candidates, halves.pairs,
                                halves.gains(A_p, r_p, scale, lower, sel.chosen), shortlist)
             new, idx = _weighed(step, [pair for pair, _ in screened],
-                                {j: v for pair, vs in screened for j, v in zip(pair, vs)}, refit=True)
+                                {j: v for pair, vs in screened for j, v in zip(pair, vs)}, resonant=True)
         if new is None:
             break
         idx, fit = _prune(res, candidates, idx, new, newton_steps, bounds, pen, p0.size, runner)
@@ -115,16 +115,14 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
     return sel
 
 
-def _weighed(step, adds: list, start: dict, refit: bool = False) -> tuple:
+def _weighed(step, adds: list, start: dict, resonant: bool = False) -> tuple:
     """(estimate, effects) of the first of the additions ``adds`` (tuples of candidate indices), ranked by
     the criterion of their trial fits (:func:`.scan.rank`, from the magnitudes ``start`` gives or else
     their linear estimates; a pair pays for its second effect), that is kept (:func:`_kept`, an addition
     of a ``coarse`` kind first walked: :func:`_walked`); (None, None) where none is. A screened support
     or body refused gives way to the next best; a candidate of the linear shortlist refused ends the
-    step. ``step``: the search's state at this step (:func:`search`); ``refit``: the additions are the bodies
-    of :func:`.scan.resonant`, which the folds' refits may keep (:func:`_kept`; of the linear shortlist's, only
-    a body's two halves, each also beside the other: single additions so weighed, a spring rode along a box's
-    hidden mass and a line mass of the hold-out's card)."""
+    step. ``step``: the search's state at this step (:func:`search`); ``resonant``: the additions are the
+    bodies of :func:`.scan.resonant` (:func:`_kept`)."""
     res, candidates, sel, fit, held, A, scale, value, P, rx, newton_steps, bounds, pen, n_params, runner, moves, \
         alpha = step
     trials = [([candidates[i] for i in sel.chosen + list(add)],
@@ -136,9 +134,8 @@ def _weighed(step, adds: list, start: dict, refit: bool = False) -> tuple:
             break
         add = list(adds[best])
         idx = sel.chosen + add
-        body = len(add) == 2 and together(candidates[add[0]], candidates[add[1]])
         new = _kept(res, candidates, sel, fit, idx, fits[best], held, A[:, add], scale[idx], newton_steps,
-                    bounds, pen, n_params, len(add), (rx, P) if refit or body else None, halves=body and not refit)
+                    bounds, pen, n_params, len(add), (rx, P), resonant)
         if new is None and moves is not None and len(add) == 1 and \
                 worth(sel.chi2[-1], fits[best].chi2, res.n_rows, n_params + len(idx), pen):
             new, idx = _walked(res, candidates, sel, fit, add[0], fits[best], held, moves, newton_steps, bounds,
@@ -180,7 +177,7 @@ def _walked(res, candidates, sel, fit, j, trial, held, moves, newton_steps, boun
 
 
 def _kept(res, candidates, sel, fit, idx, trial, held, column, scale, newton_steps, bounds, pen, n_params,
-          n_added: int = 1, refit=None, halves: bool = False):
+          n_added: int = 1, refit=None, resonant: bool = False):
     """The estimate of effects ``idx`` (the chosen ones and an addition of its last ``n_added``, whose
     trial fit is ``trial`` and columns at the state without it ``column``) when the addition is kept: its
     chi^2 drop is worth ``n_added`` penalties ``pen`` (:func:`worth`) and it predicts the held-out folds
@@ -188,19 +185,21 @@ def _kept(res, candidates, sel, fit, idx, trial, held, column, scale, newton_ste
     state with it (:func:`.held_out.secant`); else None. Either first-order model can fail a real effect
     where the modes respond nonlinearly (a share of a mass beside another: the secant; a bar across the
     card: the state without it); a model error taken for an effect fails both. ``refit``: (reanalysis, the
-    parameters' columns there) for a body, which is then also weighed by its folds' refits where both
-    first-order models fail it (:func:`.held_out.refit_predicts`): a body with a mode of its own as one
-    addition, the two halves of one found by the linear shortlist (``halves``) each beside the other too."""
-    new = estimate(res, fit.p, [candidates[i] for i in idx], trial.values, newton_steps, bounds)
+    parameters' columns there) with which a body (:func:`.halves.together`) that both first-order models fail
+    is weighed by its folds' refits (:func:`.held_out.refit_predicts`), each half also beside the other unless
+    it is ``resonant`` (a body of :func:`.scan.resonant`: a bracket's halves move the modes in opposite senses,
+    neither alone predicts anything). Single additions are not: so weighed, a spring rode along a box's hidden
+    mass and a line mass of the hold-out's card."""
+    effects = [candidates[i] for i in idx]
+    new = estimate(res, fit.p, effects, trial.values, newton_steps, bounds)
     if not worth(sel.chi2[-1], new.chi2, res.n_rows, n_params + len(idx), n_added * pen):
         return None
     r = fit.state.r
-    if predicts(res, r, held, column):
+    if predicts(res, r, held, column) or predicts(res, r, *secant(res, held, column, new, effects, scale)):
         return new
-    if predicts(res, r, *secant(res, held, column, new, [candidates[i] for i in idx], scale)):
-        return new
-    if refit is not None and refit_predicts(res, *refit, fit, new, [candidates[i] for i in idx], n_added, bounds,
-                                            newton_steps, halves):
+    body = n_added == 2 and together(effects[-2], effects[-1])
+    if refit is not None and body and refit_predicts(res, *refit, fit, new, effects, n_added, bounds, newton_steps,
+                                                     halves=not resonant):
         return new
     return None
 
