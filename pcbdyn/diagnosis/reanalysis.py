@@ -32,6 +32,8 @@ from .residual import ConfigState, State, beyond_basis, paired_state
 RANK_TOL = 1e-8
 #: a load's singular values below this share of its largest are dropped before its static solves
 COLUMN_TOL = 1e-12
+#: static corrections are solved for this many directions at a time (:meth:`_Config.corrections`)
+SOLVE_BLOCK = 32
 #: eigenvalues below this share of the state's first elastic one are rigid-body modes
 RIGID_SHARE = 1e-6
 
@@ -77,16 +79,28 @@ class _Config:
         self.X, self.KX, self.MX, self.read_X = {}, {}, {}, {}
         self._moved: dict = {}
         self._on_phi: dict = {}
+        self._products: dict = {}
 
-    def correction(self, key, dK, dM) -> None:
-        """The compressed static correction of direction ``key`` (dK, dM), kept."""
-        if key in self.X:
-            return
-        X = beyond_basis(self.cs, self.phi, _column_space(dK @ self.paired - (dM @ self.paired) * self.lam_p[None, :]))
-        MX = self.cs.M @ X
+    def corrections(self, loads) -> None:
+        """The compressed static corrections of the directions ``loads`` = [(key, dK, dM)] not yet made, kept:
+        their static solves in blocks of :data:`SOLVE_BLOCK` directions (a block of right-hand sides reads the
+        factor once: a screen of many candidates costs a few solves, not one each)."""
+        items = list({key: (dK, dM) for key, dK, dM in loads if key not in self.X}.items())
+        for at in range(0, len(items), SOLVE_BLOCK):
+            chunk = items[at:at + SOLVE_BLOCK]
+            F = [_column_space(dK @ self.paired - (dM @ self.paired) * self.lam_p[None, :]) for _, (dK, dM) in chunk]
+            F_all = np.hstack(F)
+            X_all = beyond_basis(self.cs, self.phi, F_all) if F_all.shape[1] else F_all
+            MX_all = self.cs.M @ X_all
+            ends = np.cumsum([0] + [f.shape[1] for f in F])
+            for (key, _), a, b in zip(chunk, ends[:-1], ends[1:]):
+                self._keep(key, X_all[:, a:b], MX_all[:, a:b])
+
+    def _keep(self, key, X, MX) -> None:
+        """Direction ``key``'s correction X (and M X) made M-orthogonal to the modes and compressed to its rank."""
         along = self.phi.T @ MX
-        X -= self.phi @ along  # M-orthogonal to the modes (to round-off already)
-        MX -= self.M_phi @ along
+        X = X - self.phi @ along  # M-orthogonal to the modes (to round-off already)
+        MX = MX - self.M_phi @ along
         d, U = np.linalg.eigh(X.T @ MX)
         keep = d > RANK_TOL * max(d.max(initial=0.0), 1e-300)
         W = U[:, keep] / np.sqrt(d[keep])
@@ -120,12 +134,20 @@ class _Config:
             self._moved[full] = tuple(blocks)
         return self._moved[full]
 
+    def _product(self, a, b) -> tuple:
+        """(B_a^T K B_b, B_a^T M B_b) of two blocks of the basis (None: the modes; else a direction's key),
+        each made once: a screen's bases share the modes and the effects already chosen."""
+        if (a, b) not in self._products:
+            left = self.phi if a is None else self.X[a]
+            right = (self.K_phi, self.M_phi) if b is None else (self.KX[b], self.MX[b])
+            self._products[(a, b)] = (left.T @ right[0], left.T @ right[1])
+        return self._products[(a, b)]
+
     def basis(self, keys) -> tuple:
         """(K_B, M_B, T, points): the state's pencil on [phi, X_k], the M-orthonormal change of
         basis T that drops dependent columns, and the basis at the points (None without shapes)."""
-        B = np.column_stack([self.phi] + [self.X[k] for k in keys])
-        KB = B.T @ np.column_stack([self.K_phi] + [self.KX[k] for k in keys])
-        MB = B.T @ np.column_stack([self.M_phi] + [self.MX[k] for k in keys])
+        blocks = [None] + list(keys)
+        KB, MB = (np.block([[self._product(a, b)[t] for b in blocks] for a in blocks]) for t in (0, 1))
         KB, MB = 0.5 * (KB + KB.T), 0.5 * (MB + MB.T)
         d, U = np.linalg.eigh(MB)
         keep = d > 1e-10 * d.max()
@@ -160,9 +182,14 @@ class Reanalysis:
         models = [cs.model for cs in st.configs]
         self.param_derivs = res.derivatives(st.p, models) if res.n_params else [[] for _ in models]
         self._bases: dict = {}
+        self._derivatives: dict = {}
 
     def _derivative(self, k: int, c):
-        return self.res.effects.derivative(k, self.st.configs[k].model, c, self.st.p)
+        """(dK, dM) of candidate ``c`` in configuration k, made once (every basis of a screen moves the chosen
+        effects too)."""
+        if (k, c.name) not in self._derivatives:
+            self._derivatives[(k, c.name)] = self.res.effects.derivative(k, self.st.configs[k].model, c, self.st.p)
+        return self._derivatives[(k, c.name)]
 
     def _moved_effect(self, k: int, c, names) -> tuple:
         return self.configs[k].moved(c.name, *self._derivative(k, c), names)
@@ -179,14 +206,25 @@ class Reanalysis:
         key = (k, tuple(c.name for c in dirs))
         if key not in self._bases:
             cfg = self.configs[k]
-            for c in dirs:
-                cfg.correction(c.name, *self._derivative(k, c))
+            cfg.corrections([(c.name, *self._derivative(k, c)) for c in dirs])
             names = [c.name for c in dirs]
             KB, MB, T, points = cfg.basis(names)
             params = [partial(cfg.moved_parameter, j, dK, dM, names) for j, (dK, dM) in enumerate(self.param_derivs[k])]
             effects = [partial(self._moved_effect, k, c, names) for c in dirs]
             self._bases[key] = (KB, MB, T, points, _Moves(params + effects))
         return self._bases[key]
+
+    def prepare(self, candidates) -> None:
+        """The static corrections of ``candidates`` made together before a screen evaluates them one by one
+        (:meth:`_Config.corrections`)."""
+        for k, cfg in enumerate(self.configs):
+            loads = []
+            for c in candidates:
+                try:
+                    loads.append((c.name, *self._derivative(k, c)))
+                except ValueError:  # not on this state's mesh: its evaluations fail as they would alone
+                    continue
+            cfg.corrections(loads)
 
     def evaluate(self, p, candidates=(), values=()) -> State:
         """The state at parameters ``p`` [SI] with ``candidates`` at ``values`` (the solved state's

@@ -114,7 +114,9 @@ def _screen(res, state, trials: list, p, bounds, P, steps: int, runner: Runner |
     if not trials:
         return []
     local = Runner() if runner is None else Runner(runner.workers, None, runner.progress)
-    shared = (res, reduced or Reanalysis(res, state), p, bounds, P, steps)
+    rx = reduced or Reanalysis(res, state)
+    rx.prepare([c for cands, _ in trials for c in cands])
+    shared = (res, rx, p, bounds, P, steps)
     return local.map(_quick_fit, trials, shared, "trials screened on the reanalysis")
 
 
@@ -170,6 +172,7 @@ def _on_grid(rx, effects, values, candidates, adds: list, grids: list, keep: int
     ``values``), each at the best row of its grid of magnitudes (``grids``: one (n, len(addition))
     array per addition): the screens of :func:`saturated` and :func:`resonant`."""
     best = []
+    rx.prepare([candidates[j] for add in adds for j in add])
     for add, grid in zip(adds, grids):
         cands = list(effects) + [candidates[j] for j in add]
         best.append((*min((_reduced_chi2(rx, rx.st.p, cands, np.r_[values, v]), tuple(v)) for v in grid), add))
