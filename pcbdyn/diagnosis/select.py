@@ -8,8 +8,8 @@ projects out the columns of the declared parameters and of the effects already c
 every candidate by the chi^2 its column removes (the cos^2 criterion of thesis eqs. 5.51-5.54
 applied to the residual), among those whose estimated value is physical (``lower`` of its kind).
 The best ``shortlist`` of every kind are re-estimated nonlinearly (a spring's effect on the
-frequencies saturates, so the linear score alone under-rates large ones; :func:`.scan.rank`: quick
-fits on a reanalysis of the state, the best of them with full re-solves) and the least criterion
+frequencies saturates, so the linear score alone under-rates large ones; :class:`.scan.Ranking`: quick
+fits on a reanalysis of the state, those that could be best with full re-solves) and the least criterion
 (below) wins; of the kinds that saturate, so do the ``shortlist`` best at large magnitudes among more
 of their candidates (:func:`.scan.saturated`). The two halves of a body at one place (a heat sink's
 stiffness and mass, a bracket's mass and spring: :mod:`.halves`) are also tried as one addition,
@@ -45,7 +45,7 @@ from .fitting import RANK_STEPS, UPPER, Fit, estimate  # noqa: F401  (re-exporte
 from .halves import Halves, bodies, body_moves, per_kind, together
 from .held_out import predicts, refit_predicts, secant
 from .reanalysis import Reanalysis
-from .scan import Runner, rank, resonant, saturated, worth_full
+from .scan import Ranking, Runner, resonant, saturated, worth_full
 from .selection import ALPHA, Selection, adopt, penalty, worth
 
 
@@ -117,7 +117,7 @@ def search(res, candidates, p0=(), bounds=None, max_effects: int = 3, newton_ste
 
 def _weighed(step, adds: list, start: dict, resonant: bool = False) -> tuple:
     """(estimate, effects) of the first of the additions ``adds`` (tuples of candidate indices), ranked by
-    the criterion of their trial fits (:func:`.scan.rank`, from the magnitudes ``start`` gives or else
+    the criterion of their trial fits (:class:`.scan.Ranking`, from the magnitudes ``start`` gives or else
     their linear estimates; a pair pays for its second effect), that is kept (:func:`_kept`, an addition
     of a ``coarse`` kind first walked: :func:`_walked`); (None, None) where none is. A screened support
     or body refused gives way to the next best; a candidate of the linear shortlist refused ends the
@@ -127,11 +127,9 @@ def _weighed(step, adds: list, start: dict, resonant: bool = False) -> tuple:
         alpha = step
     trials = [([candidates[i] for i in sel.chosen + list(add)],
                np.r_[sel.values, [start.get(j, max(value[j], 0.0)) for j in add]]) for add in adds]
-    fits = rank(res, fit.state, trials, fit.p, bounds, P, runner, rx)
-    crit = np.array([np.inf if f is None else f.chi2 + len(add) * pen for f, add in zip(fits, adds)])
-    for best in np.argsort(crit, kind="stable"):
-        if not np.isfinite(crit[best]):
-            break
+    ranking = Ranking(res, fit.state, trials, fit.p, bounds, P, runner, rx, [len(add) * pen for add in adds])
+    fits = ranking.fits
+    for best in iter(ranking.next, None):
         add = list(adds[best])
         idx = sel.chosen + add
         new = _kept(res, candidates, sel, fit, idx, fits[best], held, A[:, add], scale[idx], newton_steps,
@@ -253,7 +251,7 @@ def refine(res, candidates, sel: Selection, neighbours, bounds=None, newton_step
     Forward selection adds effects greedily on a coarse set of places; this lets a place found
     early move to where the effects found later leave it best; the two halves of a body move
     together (:func:`.halves.body_moves`). The swaps are ranked by
-    :func:`.scan.rank` (``runner``: where their full fits run)."""
+    :class:`.scan.Ranking` (``runner``: where their full fits run)."""
     pen = penalty(res.n_rows, len(candidates), alpha)
     n_par = np.size(sel.p)
     idx = list(sel.chosen)
@@ -261,22 +259,20 @@ def refine(res, candidates, sel: Selection, neighbours, bounds=None, newton_step
     improved = bool(idx)
     while improved:
         improved = False
-        best = None
         P = res.param_columns(fit.state)  # held while ranking the swaps, as in :func:`search`
         found = bodies(candidates, idx) if hasattr(neighbours, "half") else []
         halves = {k for pair in found for k in pair}
         swaps = [idx[:k] + [j] + idx[k + 1:] for k, i in enumerate(idx) if k not in halves
                  for j in neighbours(i) if j not in idx]
         swaps = [list(sw) for sw in dict.fromkeys(map(tuple, swaps + body_moves(candidates, idx, found, neighbours)))]
-        trials = rank(res, fit.state, [([candidates[t] for t in sw], moved_values(candidates, idx, sw, fit.values))
-                                       for sw in swaps], fit.p, bounds, P, runner, beat=fit.chi2 * (1 - 1e-6))
-        for trial_idx, trial in zip(swaps, trials):
-            if trial is not None and trial.chi2 < (fit.chi2 if best is None else best[1].chi2) * (1 - 1e-6):
-                best = (trial_idx, trial)
-        if best is not None:
-            new = estimate(res, best[1].p, [candidates[t] for t in best[0]], best[1].values, newton_steps, bounds)
+        ranking = Ranking(res, fit.state, [([candidates[t] for t in sw], moved_values(candidates, idx, sw, fit.values))
+                                           for sw in swaps], fit.p, bounds, P, runner, beat=fit.chi2 * (1 - 1e-6))
+        k = ranking.next()
+        if k is not None:
+            trial = ranking.fits[k]
+            new = estimate(res, trial.p, [candidates[t] for t in swaps[k]], trial.values, newton_steps, bounds)
             if new.chi2 < fit.chi2 * (1 - 1e-6):
-                idx, fit, improved = best[0], new, True
+                idx, fit, improved = swaps[k], new, True
     if idx == list(sel.chosen):
         return sel
     return adopt(sel, *_prune(res, candidates, idx, fit, newton_steps, bounds, pen, n_par, runner), pen)

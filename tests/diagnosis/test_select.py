@@ -396,3 +396,36 @@ def test_an_effect_whose_size_the_data_cannot_tell_from_none_is_listed_apart():
     assert apart[0]["uncertainty"] >= apart[0]["magnitude"]
     assert len(effects) == 1 and effects[0]["uncertainty"] < effects[0]["magnitude"]
     assert sel.values[0] == pytest.approx(0.013, rel=0.05)
+
+
+@pytest.mark.parametrize("kind, xy, value", [("stiffener", (0.08, 0.11), 0.5), ("point_mass", (0.11, 0.15), 0.013)])
+def test_the_trial_ranking_re_solves_fewer_trials_and_picks_the_one_every_re_solve_would(card, kind, xy, value):
+    """:class:`pcbdyn.diagnosis.scan.Ranking` re-solves only the trials whose fit on the reanalysis could still
+    be the best: of single additions of every kind (ribs, which a reanalysis does not follow, among them),
+    it picks the trial that full fits of all of them rank first, and the true effect, with fewer re-solves."""
+    from pcbdyn.diagnosis.residual import ModalResidual, Observation
+    from pcbdyn.diagnosis.fitting import RANK_STEPS
+    from pcbdyn.diagnosis.scan import FULL_RANK, Ranking, Runner, _followed, _full_fit, _screen
+    from pcbdyn.diagnosis.select import estimate
+
+    m, cands = card
+    hidden = nearest_candidate(cands, kind, xy)
+    f_test = measured(m, hidden, value, seed=3)
+    res = ModalResidual([Observation(None, MeasuredModes.frequencies_only(f_test), np.full(N_MODES, SIGMA))],
+                        lambda p: [m])
+    base = estimate(res, np.zeros(0), [], [], 8)
+    near = sorted(range(len(cands)), key=lambda i: np.hypot(cands[i].at[0] - xy[0], cands[i].at[1] - xy[1]))
+    picked = [i for k in ("stiffener", "point_mass", "region_stiffness", "line_mass")
+              for i in [j for j in near if cands[j].kind == k][:6]]
+    trials = [([cands[i]], np.array([cands[i].spec.scale])) for i in picked]
+    ranking = Ranking(res, base.state, trials, np.zeros(0), None, np.zeros((res.n_rows, 0)))
+    first = ranking.next()
+    quick = np.asarray(_screen(res, base.state, trials, np.zeros(0), None, np.zeros((res.n_rows, 0)), RANK_STEPS))
+    followed = [k for k, (c, _) in enumerate(trials) if _followed(base.state, c)]
+    eligible = sorted(k for k in followed if quick[k] <= np.sort(quick[followed])[FULL_RANK - 1]) + \
+        [k for k in range(len(trials)) if k not in followed]
+    every = Runner().map(_full_fit, [(trials[k][0], trials[k][1], np.zeros(0)) for k in eligible],
+                         (res, None, np.zeros((res.n_rows, 0))))
+    assert first == eligible[int(np.argmin([chi2 for chi2, _, _ in every]))]
+    assert cands[picked[first]].name == hidden.name
+    assert sum(f is not None for f in ranking.fits) < len(eligible)
