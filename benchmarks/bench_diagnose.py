@@ -19,6 +19,7 @@ import argparse
 import json
 import os
 import resource
+import statistics
 import sys
 import time
 from pathlib import Path
@@ -107,6 +108,10 @@ def main(argv=None):
     n_known = sum(r["outcome"] == "FAIL (known miss)" for r in rows)
     print(f"\n{n_pass}/{len(rows)} cases pass, {n_known} known misses (tests/diagnosis/test_holdout.py KNOWN); "
           f"diagnose total {sum(r['diagnose_s'] for r in rows):.1f} s")
+    walls = [r["diagnose_s"] for r in rows]
+    print(f"wall per case (issue 37 asks median <= 30 s, slowest <= 120 s on 2 cores): median "
+          f"{statistics.median(walls):.1f} s, slowest {max(walls):.1f} s; machine load "
+          f"{min(r['load'] for r in rows):.2f}-{max(r['load'] for r in rows):.2f} on {os.cpu_count()} cores")
     if a.json:
         Path(a.json).write_text(json.dumps(rows, indent=1))
 

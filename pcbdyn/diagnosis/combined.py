@@ -21,6 +21,9 @@ from .catalogue import BlockCache, derivatives, kind
 
 #: patterns of effect sets kept (least recently used dropped first)
 PLANS_KEPT = 64
+#: derivatives of the kinds that depend on the parameters kept (least recently used dropped first): many more
+#: than a reanalysis asks for (at most 17 on dev seed 2), whose bases and corrections ask for each again
+MOVING_KEPT = 4 * PLANS_KEPT
 
 
 class EffectPlan:
@@ -59,7 +62,7 @@ class Effects:
     def __init__(self):
         self.blocks = BlockCache()
         self._fixed: dict = {}
-        self._moving: dict = {}
+        self._moving: OrderedDict = OrderedDict()
         self._plans: OrderedDict = OrderedDict()
         self._own: dict = {}  # configuration -> the pattern of its K alone
 
@@ -67,10 +70,12 @@ class Effects:
         """(dK, dM) of ``cand`` on configuration ``k``'s ``model`` at parameters ``p``, canonical CSR."""
         if getattr(kind(cand.kind), "uses_properties", False):
             key = (k, cand.name, np.asarray(p, float).tobytes())
-            if key not in self._moving:
-                if len(self._moving) > 4 * PLANS_KEPT:
-                    self._moving.clear()
+            if key in self._moving:
+                self._moving.move_to_end(key)
+            else:
                 self._moving[key] = tuple(canonical_csr(A) for A in derivatives(model, cand, self.blocks))
+                while len(self._moving) > MOVING_KEPT:
+                    self._moving.popitem(last=False)
             return self._moving[key]
         if (k, cand.name) not in self._fixed:
             self._fixed[k, cand.name] = tuple(canonical_csr(A) for A in derivatives(model, cand, self.blocks))

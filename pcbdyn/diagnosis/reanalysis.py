@@ -75,11 +75,11 @@ class _Config:
         self.paired = cs.modes.shapes[:, cs.pairs]
         self.lam_p = cs.modes.omega2[cs.pairs]
         self.read_phi = None if ob.shapes is None else np.asarray(ob.read @ self.phi)
-        self.K_phi, self.M_phi = cs.K @ self.phi, cs.M @ self.phi
-        self.X, self.KX, self.MX, self.read_X = {}, {}, {}, {}
+        self.M_phi = cs.M @ self.phi
+        self.X, self.read_X = {}, {}
         self._moved: dict = {}
-        self._on_phi: dict = {}
-        self._products: dict = {}
+        self._local: dict = {}
+        self._grams: dict = {}
 
     def corrections(self, loads) -> None:
         """The compressed static corrections of the directions ``loads`` = [(key, dK, dM)] not yet made, kept:
@@ -105,7 +105,7 @@ class _Config:
         keep = d > RANK_TOL * max(d.max(initial=0.0), 1e-300)
         W = U[:, keep] / np.sqrt(d[keep])
         X = X @ W
-        self.X[key], self.KX[key], self.MX[key] = X, self.cs.K @ X, MX @ W
+        self.X[key] = X
         self.read_X[key] = None if self.read_phi is None else np.asarray(self.ob.read @ X)
 
     def moved(self, key, dK, dM, keys) -> tuple:
@@ -113,41 +113,47 @@ class _Config:
         the rows the direction touches (a candidate's dK and dM are local)."""
         full = (key, tuple(keys))
         if full not in self._moved:
-            coo = [D.tocoo() for D in (dK, dM)]
-            rows, cols = (np.union1d(*(getattr(D, ax) for D in coo)) for ax in ("row", "col"))
+            if key not in self._local:
+                coo = [D.tocoo() for D in (dK, dM)]
+                rows, cols = (np.union1d(*(getattr(D, ax) for D in coo)) for ax in ("row", "col"))
+                self._local[key] = rows, cols, [D.tocsr()[rows][:, cols] for D in (dK, dM)]
+            rows, cols, local = self._local[key]
             B_rows, B_cols = (np.column_stack([self.phi[at]] + [self.X[k][at] for k in keys]) for at in (rows, cols))
-            self._moved[full] = tuple(B_rows.T @ (D.tocsr()[rows][:, cols] @ B_cols) for D in (dK, dM))
+            self._moved[full] = tuple(B_rows.T @ (D @ B_cols) for D in local)
         return self._moved[full]
 
     def moved_parameter(self, j: int, dK, dM, keys) -> tuple:
-        """:meth:`moved` of the declared parameter ``j``, whose dK and dM span the structure: their products
-        with the modes are made once, those with the corrections of each candidate set (a few columns) anew."""
-        full = (("p", j), tuple(keys))
-        if full not in self._moved:
-            if j not in self._on_phi:
-                self._on_phi[j] = [(D @ self.phi, self.phi.T @ (D @ self.phi)) for D in (dK, dM)]
-            X = np.column_stack([self.phi[:, :0]] + [self.X[k] for k in keys])
-            blocks = []
-            for D, (D_phi, phi_D_phi) in zip((dK, dM), self._on_phi[j]):
-                D_X = D @ X
-                blocks.append(np.block([[phi_D_phi, self.phi.T @ D_X], [X.T @ D_phi, X.T @ D_X]]))
-            self._moved[full] = tuple(blocks)
-        return self._moved[full]
+        """:meth:`moved` of the declared parameter ``j``, whose dK and dM span the structure (:meth:`_gram`)."""
+        blocks = [None] + list(keys)
+        return tuple(self._gram(D, ("p", j, t), blocks) for t, D in enumerate((dK, dM)))
 
-    def _product(self, a, b) -> tuple:
-        """(B_a^T K B_b, B_a^T M B_b) of two blocks of the basis (None: the modes; else a direction's key),
-        each made once: a screen's bases share the modes and the effects already chosen."""
-        if (a, b) not in self._products:
-            left = self.phi if a is None else self.X[a]
-            right = (self.K_phi, self.M_phi) if b is None else (self.KX[b], self.MX[b])
-            self._products[(a, b)] = (left.T @ right[0], left.T @ right[1])
-        return self._products[(a, b)]
+    def _gram(self, D, name, blocks) -> np.ndarray:
+        """B^T D B on the basis of ``blocks`` (None: the modes; else a direction's key) for the symmetric
+        structure-wide matrix ``D`` called ``name`` (the stiffness, the mass, a declared parameter's derivative):
+        each block pair made once and read transposed the other way round, so that a screen's bases, which share
+        the modes and the chosen effects, pay one product with D for each trial's new direction."""
+        def made(a, b):
+            return (name, a, b) in self._grams or (name, b, a) in self._grams
+
+        while True:
+            missing = {b: [a for a in blocks if not made(a, b)] for b in blocks}
+            b = max(blocks, key=lambda b: len(missing[b]))
+            if not missing[b]:
+                break
+            D_b = D @ self._block(b)
+            for a in missing[b]:
+                self._grams[(name, a, b)] = self._block(a).T @ D_b
+        return np.block([[self._grams[(name, a, b)] if (name, a, b) in self._grams else self._grams[(name, b, a)].T
+                          for b in blocks] for a in blocks])
+
+    def _block(self, a) -> np.ndarray:
+        return self.phi if a is None else self.X[a]
 
     def basis(self, keys) -> tuple:
         """(K_B, M_B, T, points): the state's pencil on [phi, X_k], the M-orthonormal change of
         basis T that drops dependent columns, and the basis at the points (None without shapes)."""
         blocks = [None] + list(keys)
-        KB, MB = (np.block([[self._product(a, b)[t] for b in blocks] for a in blocks]) for t in (0, 1))
+        KB, MB = (self._gram(D, name, blocks) for D, name in ((self.cs.K, "K"), (self.cs.M, "M")))
         KB, MB = 0.5 * (KB + KB.T), 0.5 * (MB + MB.T)
         d, U = np.linalg.eigh(MB)
         keep = d > 1e-10 * d.max()
@@ -182,14 +188,11 @@ class Reanalysis:
         models = [cs.model for cs in st.configs]
         self.param_derivs = res.derivatives(st.p, models) if res.n_params else [[] for _ in models]
         self._bases: dict = {}
-        self._derivatives: dict = {}
 
     def _derivative(self, k: int, c):
-        """(dK, dM) of candidate ``c`` in configuration k, made once (every basis of a screen moves the chosen
-        effects too)."""
-        if (k, c.name) not in self._derivatives:
-            self._derivatives[(k, c.name)] = self.res.effects.derivative(k, self.st.configs[k].model, c, self.st.p)
-        return self._derivatives[(k, c.name)]
+        """(dK, dM) of candidate ``c`` in configuration k at the state's parameters (kept by the residual's
+        :class:`.combined.Effects`)."""
+        return self.res.effects.derivative(k, self.st.configs[k].model, c, self.st.p)
 
     def _moved_effect(self, k: int, c, names) -> tuple:
         return self.configs[k].moved(c.name, *self._derivative(k, c), names)

@@ -68,3 +68,26 @@ def test_corrections_made_together_for_a_screen_are_those_made_one_at_a_time(sol
         value = 10.0 * c.spec.scale
         a, b = (paired_hz(r.evaluate([], [mass, c], [0.02, value])) for r in (together, alone))
         assert np.allclose(a, b, rtol=1e-6, atol=0.0)
+
+
+def test_a_basis_pencil_is_its_blocks_products_whichever_bases_made_them_before(solved):
+    """A basis's reduced matrices B^T D B (the stiffness, the mass, and a declared parameter's structure-wide
+    dK, dM, for which K and 2 M stand in) are those of the basis taken whole, to round-off, after bases that
+    share some of its blocks, in another order, made and kept them (:meth:`_Config._gram`)."""
+    res, cands, mass, st = solved
+    near = sorted((c for c in cands if c.kind in ("point_mass", "ground_spring")),
+                  key=lambda c: np.hypot(c.at[0] - 0.08, c.at[1] - 0.09))[:3]
+    rx = Reanalysis(res, st)
+    rx.prepare(near + [mass])
+    cfg = rx.configs[0]
+    K, M = cfg.cs.K, cfg.cs.M
+    a, b, c = (n.name for n in near)
+    cfg.basis([mass.name, a])
+    cfg.moved_parameter(0, K, 2.0 * M, [b, mass.name])
+    keys = [b, mass.name, a, c]
+    B = np.column_stack([cfg.phi] + [cfg.X[k] for k in keys])
+    assert B.shape[1] > cfg.phi.shape[1] + 3
+    KB, MB, _, _ = cfg.basis(keys)
+    for got, D in zip((KB, MB, *cfg.moved_parameter(0, K, 2.0 * M, keys)), (K, M, K, 2.0 * M)):
+        want = B.T @ (D @ B)
+        assert np.allclose(got, want, rtol=0.0, atol=1e-9 * np.abs(want).max())
