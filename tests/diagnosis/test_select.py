@@ -429,3 +429,28 @@ def test_the_trial_ranking_re_solves_fewer_trials_and_picks_the_one_every_re_sol
     assert first == eligible[int(np.argmin([chi2 for chi2, _, _ in every]))]
     assert cands[picked[first]].name == hidden.name
     assert sum(f is not None for f in ranking.fits) < len(eligible)
+
+
+def test_the_ranking_re_solves_the_single_addition_that_pairs_beat_on_chi2_alone(monkeypatch):
+    """The trials a reanalysis follows that a ranking may re-solve are the FULL_RANK best by quick criterion
+    (chi^2 plus the penalties of what each adds): four pairs of lower chi^2, each paying a second penalty, do
+    not crowd out the single addition of least criterion, which the ranking then picks (quick and full fits
+    agree here, so the pick is the least criterion of all)."""
+    from types import SimpleNamespace
+
+    from pcbdyn.diagnosis import scan
+
+    pen = 10.0
+    chi2 = np.array([100.0, 95.0, 96.0, 97.0, 98.0])  # a single addition, then four pairs
+    monkeypatch.setattr(scan, "_followed", lambda state, cands: True)
+    monkeypatch.setattr(scan, "_screen", lambda res, state, trials, *args: [chi2[c[0]] for c, _ in trials])
+
+    class Resolves:
+        def map(self, fn, jobs, shared, what=""):
+            return [(chi2[c[0]], np.zeros(1), np.zeros(0)) for c, _, _ in jobs]
+
+    trials = [([k], np.zeros(1)) for k in range(chi2.size)]
+    ranking = scan.Ranking(None, SimpleNamespace(chi2=200.0), trials, np.zeros(0), None, None, Resolves(),
+                           cost=pen * np.array([1, 2, 2, 2, 2]))
+    assert ranking.next() == 0
+    assert ranking.criterion(0) == pytest.approx(110.0)
