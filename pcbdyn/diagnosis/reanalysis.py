@@ -110,7 +110,7 @@ class _Config:
 
     def moved(self, key, dK, dM, keys) -> tuple:
         """(B^T dK B, B^T dM B) of direction ``key`` on the basis [phi, X_k for k in ``keys``], from
-        the rows the direction touches (a candidate's dK and dM are local)."""
+        the rows the direction touches (a candidate's dK and dM are local), cut out once."""
         full = (key, tuple(keys))
         if full not in self._moved:
             if key not in self._local:
