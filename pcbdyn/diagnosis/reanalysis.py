@@ -77,7 +77,6 @@ class _Config:
         self.read_phi = None if ob.shapes is None else np.asarray(ob.read @ self.phi)
         self.M_phi = cs.M @ self.phi
         self.X, self.read_X = {}, {}
-        self._moved: dict = {}
         self._local: dict = {}
         self._grams: dict = {}
 
@@ -110,17 +109,15 @@ class _Config:
 
     def moved(self, key, dK, dM, keys) -> tuple:
         """(B^T dK B, B^T dM B) of direction ``key`` on the basis [phi, X_k for k in ``keys``], from
-        the rows the direction touches (a candidate's dK and dM are local), cut out once."""
-        full = (key, tuple(keys))
-        if full not in self._moved:
-            if key not in self._local:
-                coo = [D.tocoo() for D in (dK, dM)]
-                rows, cols = (np.union1d(*(getattr(D, ax) for D in coo)) for ax in ("row", "col"))
-                self._local[key] = rows, cols, [D.tocsr()[rows][:, cols] for D in (dK, dM)]
-            rows, cols, local = self._local[key]
-            B_rows, B_cols = (np.column_stack([self.phi[at]] + [self.X[k][at] for k in keys]) for at in (rows, cols))
-            self._moved[full] = tuple(B_rows.T @ (D @ B_cols) for D in local)
-        return self._moved[full]
+        the rows the direction touches (a candidate's dK and dM are local), cut out once; each basis's
+        :class:`_Moves` keeps what this returns."""
+        if key not in self._local:
+            coo = [D.tocoo() for D in (dK, dM)]
+            rows, cols = (np.union1d(*(getattr(D, ax) for D in coo)) for ax in ("row", "col"))
+            self._local[key] = rows, cols, [D.tocsr()[rows][:, cols] for D in (dK, dM)]
+        rows, cols, local = self._local[key]
+        B_rows, B_cols = (np.column_stack([self.phi[at]] + [self.X[k][at] for k in keys]) for at in (rows, cols))
+        return tuple(B_rows.T @ (D @ B_cols) for D in local)
 
     def moved_parameter(self, j: int, dK, dM, keys) -> tuple:
         """:meth:`moved` of the declared parameter ``j``, whose dK and dM span the structure (:meth:`_gram`)."""

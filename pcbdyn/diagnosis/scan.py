@@ -73,6 +73,12 @@ class Runner:
         return [result for _, result in out]
 
 
+def reach(state) -> float:
+    """How far a quick fit on the reanalysis of the solved ``state`` may lie from its full fit, in chi^2
+    (:data:`SCREEN_MARGIN` of the state's): the one margin of every screen that decides what is re-solved."""
+    return SCREEN_MARGIN * state.chi2
+
+
 def _full_fit(k, cands, v0, p, shared):
     """One full trial fit (a job): (chi^2, magnitudes, parameters)."""
     res, bounds, P = shared
@@ -101,7 +107,7 @@ def worth_full(res, state, trials: list, p, bounds, limit: float, steps: int = R
                    runner)
     out = [True] * len(trials)
     for k, c in zip(idx, chi2):
-        out[k] = bool(c <= limit + SCREEN_MARGIN * state.chi2)
+        out[k] = bool(c <= limit + reach(state))
     return out
 
 
@@ -204,7 +210,7 @@ class Ranking:
         self.trials, self.p, self.bounds, self.P, self.beat = trials, p, bounds, P, beat
         self.runner, self.res = runner or Runner(), res
         self.cost = np.zeros(len(trials)) if cost is None else np.asarray(cost, float)
-        self.reach = SCREEN_MARGIN * state.chi2
+        self.reach = reach(state)
         followed = np.array([_followed(state, cands) for cands, _ in trials], bool)
         k_f = np.flatnonzero(followed)
         few = k_f.size <= FULL_RANK and not np.isfinite(beat)
