@@ -127,11 +127,11 @@ def seeds(text: str) -> list:
 
 
 def case_names(text: str) -> list:
-    """'0-9,h2-3' -> ['s0000', ..., 's0009', 'h0002', 'h0003']: boards (s) and housings (h) by seed."""
+    """'0-9,h2-3' (or 'h2-h3') -> ['s0000', ..., 's0009', 'h0002', 'h0003']: boards (s) and housings (h) by seed."""
     out = []
     for part in text.split(","):
         kind = "h" if part.startswith("h") else "s"
-        out += [f"{kind}{s:04d}" for s in seeds(part.lstrip("hs"))]
+        out += [f"{kind}{s:04d}" for s in seeds("-".join(end.lstrip("hs") for end in part.split("-")))]
     return out
 
 

@@ -128,3 +128,11 @@ def test_a_housing_effect_is_judged_in_three_dimensions():
     far = {"type": "stiffener", "path_mm": [[0.0, 50.0, 60.0], [0.0, 150.0, 60.0]], "magnitude": 1.0}
     assert judge(truth, {"effects": [near]}, 100.0)["atoms"][0]["found"]
     assert not judge(truth, {"effects": [far]}, 100.0)["atoms"][0]["placed"]
+
+
+def test_splits_are_named_by_seed_ranges_with_or_without_the_kind_repeated():
+    from make import case_names
+
+    assert case_names("3-4,h5") == ["s0003", "s0004", "h0005"]
+    assert case_names("h1000-h1002,s7-s8") == case_names("h1000-1002,7-8") == ["h1000", "h1001", "h1002", "s0007",
+                                                                            "s0008"]
