@@ -34,6 +34,7 @@ from cases import DEV, REPORT  # noqa: E402
 from detectability import DETECTABLE_CHI2  # noqa: E402
 from make import cache_dir, case_names, made  # noqa: E402
 from score import judge  # noqa: E402
+from truth_error import largest_error  # noqa: E402
 
 
 def _tag() -> str:
@@ -86,8 +87,9 @@ def run_case(name: str, options: dict, shared=None) -> dict:
 #: a scan of kept results for effects whose standard deviation reaches their size listed their effects
 #: beside the dev ones that led to :func:`pcbdyn.diagnosis.merge.resolved` (2026-12-05). 1020: its internal
 #: error followed into :func:`pcbdyn.diagnosis.at_points.as_points` and its truth read beside the fix's result
-#: (2026-12-05, later).
-SEEN = {1002, 1005, 1020, 1021, 1022, 1023}
+#: (2026-12-05, later). 1000, 1006, 1024: their effects and intervals read beside their truths while looking
+#: for a pattern among the invented effects (2026-12-06; nothing was changed from them).
+SEEN = {1000, 1002, 1005, 1006, 1020, 1021, 1022, 1023, 1024}
 
 
 def _pct(k: int, n: int) -> str:
@@ -104,6 +106,7 @@ def summary(rows: list) -> dict:
     cov1 = [a["covered_1sigma"] for a in det if a.get("covered_1sigma") is not None]
     after = [v["after"] for _, _, v in rows if "after" in v]
     walls = [r["wall_s"] for _, r, _ in rows]
+    own = [v["truth_error_pct"] for _, _, v in rows if v.get("truth_error_pct") is not None]
     return {
         "cases": len(rows), "crashed": sum(r["exit"] != 0 for _, r, _ in rows),
         "found_detectable": (sum(a["found"] for a in det), len(det)),
@@ -113,6 +116,7 @@ def summary(rows: list) -> dict:
         "covered_2sigma": (sum(cov), len(cov)), "covered_1sigma": (sum(cov1), len(cov1)),
         "median_after_pct": float(np.median(after)) if after else None,
         "after_le_0.5": (sum(a <= 0.5 for a in after), len(after)),
+        "median_truth_error_pct": float(np.median(own)) if own else None,
         "median_wall_s": float(np.median(walls)) if walls else None, "max_wall_s": max(walls) if walls else None,
         "stage_share": stage_share([r for _, r, _ in rows]),
     }
@@ -162,12 +166,14 @@ def main(argv=None):
             continue
         truth = json.loads((options["cache"] / name / "truth.json").read_text())
         v = judge(truth, result["diagnosis"], DETECTABLE_CHI2)
+        v["truth_error_pct"] = own = largest_error(options["cache"] / name)
         rows.append((truth, result, v))
         kinds = ",".join(e["kind"] for e in truth["case"]["effects"]) or "-"
         marks = " ".join(f"{x['type'][:6]}{'+' if x['found'] else ('~' if x['placed'] else '-')}"
                          f"{'' if x['detectable'] else '(u)'}" for x in v["atoms"])
         print(f"{name} {truth['case']['hold']:<9} {kinds:<26} {marks:<34} inv {len(v['invented'])} "
-              f"after {v.get('after', float('nan')):6.2f} % (po {v.get('parameters_only', float('nan')):6.2f}) "
+              f"after {v.get('after', float('nan')):6.2f} % (po {v.get('parameters_only', float('nan')):6.2f}, "
+              f"truth's own {float('nan') if own is None else own:4.2f}) "
               f"{result['wall_s']:5.0f} s{'' if result['exit'] == 0 else ' EXIT ' + str(result['exit'])} "
               f"[load {os.getloadavg()[0]:.1f}]", flush=True)
     print(f"\n{len(rows)} cases in {time.perf_counter() - t0:.0f} s")
@@ -178,9 +184,8 @@ def main(argv=None):
         print(f"without the report seeds read case by case ({', '.join(map(str, sorted(SEEN)))}: SEEN):")
         _print(summary(unseen))
     if a.json:
-        Path(a.json).write_text(json.dumps({"summary": s, "summary_unseen": summary(unseen),
-                                            "rows": [v | {"seed": t["case"]["seed"], "housing": t["case"]["hold"] == "housing"}
-                                                     for t, _, v in rows]},
+        listed = [v | {"seed": t["case"]["seed"], "housing": t["case"]["hold"] == "housing"} for t, _, v in rows]
+        Path(a.json).write_text(json.dumps({"summary": s, "summary_unseen": summary(unseen), "rows": listed},
                                            indent=1, default=float))
 
 
@@ -193,6 +198,8 @@ def _print(s: dict) -> None:
     print(f"  coverage of the magnitudes placed: 2-sigma {_pct(*s['covered_2sigma'])} (stated 95 %), "
           f"1-sigma {_pct(*s['covered_1sigma'])} (stated 68 %)")
     print(f"  error after: median {s['median_after_pct']} %, <= 0.5 %: {_pct(*s['after_le_0.5'])}")
+    print(f"  the truth's own discretisation error (truth_error.py, the largest over a case's modes): median "
+          f"{s['median_truth_error_pct']} %")
     print(f"  wall per case: median {s['median_wall_s']:.0f} s, slowest {s['max_wall_s']:.0f} s")
     if s["stage_share"]:
         print("  where the time went: " + ", ".join(f"{k} {100 * v:.0f} %" for k, v in s["stage_share"].items()))

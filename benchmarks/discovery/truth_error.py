@@ -49,6 +49,21 @@ def truth_error(folder: Path) -> np.ndarray:
     return 100.0 * 4.0 / 3.0 * (f[0] / f[1] - 1.0)
 
 
+def largest_error(folder: Path) -> float | None:
+    """[%] the largest of :func:`truth_error` over the test modes of the board case in ``folder`` (None for a
+    housing), kept in ``truth_error.json`` beside the case once computed."""
+    if not (folder / "truth.toml").exists() or (folder / "box.toml").exists():
+        return None
+    kept = folder / "truth_error.json"
+    if kept.exists():
+        return json.loads(kept.read_text())["largest_pct"]
+    e = truth_error(folder)
+    tmp = kept.with_suffix(".json.tmp")
+    tmp.write_text(json.dumps({"per_mode_pct": e.tolist(), "largest_pct": float(np.abs(e).max())}))
+    tmp.replace(kept)
+    return float(np.abs(e).max())
+
+
 def main(argv=None) -> None:
     worst, every = [], []
     for seed in seeds((argv or sys.argv[1:] or ["0-9"])[0]):
