@@ -51,15 +51,16 @@ def truth_error(folder: Path) -> np.ndarray:
 
 def largest_error(folder: Path) -> float | None:
     """[%] the largest of :func:`truth_error` over the test modes of the board case in ``folder`` (None for a
-    housing), kept in ``truth_error.json`` beside the case once computed."""
+    housing), kept in ``truth_error.json`` beside the case with the key of the truth it was computed for."""
     if not (folder / "truth.toml").exists() or (folder / "box.toml").exists():
         return None
+    key = json.loads((folder / "truth.json").read_text())["key"]
     kept = folder / "truth_error.json"
-    if kept.exists():
-        return json.loads(kept.read_text())["largest_pct"]
+    if kept.exists() and (old := json.loads(kept.read_text())).get("key") == key:
+        return old["largest_pct"]
     e = truth_error(folder)
     tmp = kept.with_suffix(".json.tmp")
-    tmp.write_text(json.dumps({"per_mode_pct": e.tolist(), "largest_pct": float(np.abs(e).max())}))
+    tmp.write_text(json.dumps({"key": key, "per_mode_pct": e.tolist(), "largest_pct": float(np.abs(e).max())}))
     tmp.replace(kept)
     return float(np.abs(e).max())
 
