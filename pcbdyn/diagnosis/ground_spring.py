@@ -14,7 +14,7 @@ import numpy as np
 
 from ..fe import SpringProperty
 from ..fe.elements.discrete import point_spring
-from ..fe.probe import ProbeError, model_probe
+from ..fe.probe import model_probe
 from .catalogue import register, Blocks, Candidate, node_candidates, on_nearest_node
 
 
@@ -40,14 +40,11 @@ class _GroundSpring:
 
     def at_point(self, layout, home, xy):
         """A spring to ground at the point ``xy`` [m] of a board between the nodes (interpolated by the shell
-        cell that holds it); None off the board or on a structure in 3-D. ``home``: the candidate it moves
-        from (the same call as :meth:`.point_mass._Lumped.at_point`)."""
-        if not layout.planar:
-            return None
-        try:
-            return _at(layout, xy)
-        except ProbeError:
-            return None
+        cell that holds it; a point just past an edge on the edge, :meth:`.layout.Layout.onto_plate`); None
+        off the board or on a structure in 3-D. ``home``: the candidate it moves from (the same call as
+        :meth:`.point_mass._Lumped.at_point`)."""
+        on = layout.onto_plate(xy) if layout.planar else None
+        return None if on is None else _at(layout, on)
 
     def blocks(self, model, candidates) -> list:
         """A block per number of nodes: a spring at a node, or at a point between the nodes of an edge or a

@@ -23,7 +23,7 @@ from matplotlib.path import Path as PolyPath
 from scipy.spatial import cKDTree
 
 from ..fe.model import SHELL_TYPES
-from ..fe.probe import Locator
+from ..fe.probe import Locator, ProbeError, model_probe
 
 #: direction change [deg] above which a boundary node is a corner that ends a straight side
 CORNER_DEG = 15.0
@@ -32,6 +32,8 @@ CORNER_DEG = 15.0
 #: of a cell, took a rib end 0.02 mm past an edge as on it and made a piece of no length there: a beam
 #: of unbounded stiffness that left the finer meshes indefinite)
 ON_PLATE = 1e-6
+#: [m] how far from the cells a point may lie and count as on them when placed between nodes (round-off)
+OFF_EDGE = 1e-9
 
 
 @dataclass
@@ -96,6 +98,22 @@ class Layout:
 
     def shell_nodes(self) -> np.ndarray:
         return np.unique(np.concatenate([c.ravel() for _, c in self.cells()]))
+
+    def onto_plate(self, xy) -> tuple | None:
+        """The point of a planar plate's shell cells nearest to ``xy`` [m] (x, y): ``xy`` itself on the plate,
+        its projection onto the outline where it lies past an edge within the locator's tolerance (a tenth
+        of a cell), None beyond. A point walked that little past an edge is on this mesh but off the finer
+        ones the mesh correction places it on, whose tolerance is finer (hold-out ``ho_transducer_cfg``: a
+        spring walked to 0.33 mm past the edge of 6.75 mm cells stopped the finer meshes' solve)."""
+        z = float(self.model.nodes[self.shell_nodes()[0], 2])
+        try:
+            loc = model_probe(self.model, [[xy[0], xy[1], z]]).location
+        except ProbeError:
+            return None
+        if loc.distance[0] <= OFF_EDGE:
+            return float(xy[0]), float(xy[1])
+        x, y = loc.weights[0] @ self.xy[loc.nodes[0]]
+        return float(x), float(y)
 
     def grid_nodes(self, spacing: float | None = None) -> np.ndarray:
         """Shell nodes nearest to a square grid of pitch ``spacing`` [m] (None: every shell node)."""

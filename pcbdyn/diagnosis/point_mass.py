@@ -49,9 +49,10 @@ class _Lumped:
 
     def at_point(self, layout, home, xy):
         """A mass like candidate ``home`` at the point ``xy`` [m] of a plate between the nodes (a body of
-        no size, :meth:`place`), named for its point; None where the point lies off the shell or the
-        structure is in 3-D."""
-        if not layout.planar:
+        no size, :meth:`place`; a point just past an edge on the edge, :meth:`.layout.Layout.onto_plate`),
+        named for its point; None where the point lies off the shell or the structure is in 3-D."""
+        xy = layout.onto_plate(xy) if layout.planar else None
+        if xy is None:
             return None
         plain = {k: v for k, v in home.data.items() if k not in ("radius", "centre")}
         c = self.place(layout, replace(home, at=(float(xy[0]), float(xy[1])), data=plain))

@@ -101,3 +101,19 @@ def test_a_mass_and_a_spring_found_on_nodes_are_each_placed_at_their_point(card)
         assert np.linalg.norm(np.subtract(c.at[:2], xy)) < 0.002
         assert v == pytest.approx(value, rel=0.03)
     assert sel.chi2[-1] < fit.chi2
+
+
+@pytest.mark.parametrize("kind", ["point_mass", "ground_spring"])
+def test_a_point_walked_just_past_an_edge_is_placed_on_it_on_any_mesh(card, kind):
+    """A point 0.7 mm past the edge x = 160 mm lies on the card's 13 mm cells to the locator's tolerance (a
+    tenth of a cell) but off the 3.3 mm cells of a mesh four times finer: the effect is placed on the edge,
+    and goes onto the finer mesh at that point (a spring walked past the edge stopped the mesh correction's
+    solve of hold-out ho_transducer_cfg); a point 2 mm past the edge is off the card."""
+    m, layout = card
+    home = next(c for c in dg.generate(layout, kinds=[kind]) if c.at[0] > 1e-6)
+    c = spec(kind).at_point(layout, home, (0.1607, 0.07))
+    assert c.at[:2] == pytest.approx((0.16, 0.07), abs=1e-12)
+    fine = guided_card(48, 56)
+    moved = dg.add_effect(fine, spec(kind).place(dg.from_model(fine), c), 0.02 if kind == "point_mass" else 3e4)
+    assert len(moved.sets) == len(fine.sets) + 1
+    assert spec(kind).at_point(layout, home, (0.162, 0.07)) is None
