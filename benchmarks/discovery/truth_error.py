@@ -58,10 +58,10 @@ def largest_error(folder: Path) -> float | None:
     kept = folder / "truth_error.json"
     if kept.exists() and (old := json.loads(kept.read_text())).get("key") == key:
         return old["largest_pct"]
+    from pcbdyn.report.files import write_json
+
     e = truth_error(folder)
-    tmp = kept.with_suffix(".json.tmp")
-    tmp.write_text(json.dumps({"key": key, "per_mode_pct": e.tolist(), "largest_pct": float(np.abs(e).max())}))
-    tmp.replace(kept)
+    write_json(kept, {"key": key, "per_mode_pct": e.tolist(), "largest_pct": float(np.abs(e).max())})
     return float(np.abs(e).max())
 
 
