@@ -15,8 +15,8 @@ the walked one must be at least two elements long: a shorter line is not one the
 mass the data want spread over less than that is the coarse mesh's way of holding a point (dev seed 0's
 50 g point mass had become a 7.8 mm line on 6 mm elements; hold-out ``ho_mass_card``'s 18 g point mass,
 whose lines through it fit best at one element long, was walked from two elements to a 15 mm line on
-6.75 mm elements). The same walk places a mass or a spring to ground found
-on nodes at its point between them (:mod:`.at_points`)."""
+6.75 mm elements). The same walk places a mass or a spring to ground found on nodes at its point between
+them (:mod:`.at_points`)."""
 
 from __future__ import annotations
 
@@ -181,7 +181,7 @@ def as_lines(res, candidates: list, sel, reach: float, layout, step: float, boun
         others = [i for i in sel.chosen if i not in single]
         ends, chi2 = _oriented(res, sel, [candidates[i] for i in others], [sel.values[pos[i]] for i in others], m,
                                centre, length, layout, bounds)
-        # else no line is worth walking, or the best one is too short for the mesh to tell from a point
+        # walked only where it fits better than the mass and is long enough for the mesh to tell from a point
         if ends is not None and chi2 < sel.chi2[-1] and np.linalg.norm(ends[1] - ends[0]) >= 2.0 * h * (1 - 1e-9):
             _as_line(res, candidates, sel, single, m, ends, layout, step, bounds, newton_steps, pen, pen, 2.0 * h)
     return sel
