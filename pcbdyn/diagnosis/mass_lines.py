@@ -174,6 +174,7 @@ def as_lines(res, candidates: list, sel, reach: float, layout, step: float, boun
         if set(pair) <= set(sel.chosen) and m > 0:  # not a mass already taken by another line
             _as_line(res, candidates, sel, pair, m, ends, layout, step, bounds, newton_steps, pen, 0.0)
     h = 2.0 * step  # the element size
+    shortest = 2.0 * h  # the shortest line the mesh tells from a point, tried or walked
     for single, m, centre, length in _singles(candidates, sel, mass_groups(), h, reach):
         if not (set(single) <= set(sel.chosen) and m > 0):
             continue
@@ -182,6 +183,6 @@ def as_lines(res, candidates: list, sel, reach: float, layout, step: float, boun
         ends, chi2 = _oriented(res, sel, [candidates[i] for i in others], [sel.values[pos[i]] for i in others], m,
                                centre, length, layout, bounds)
         # walked only where it fits better than the mass and is long enough for the mesh to tell from a point
-        if ends is not None and chi2 < sel.chi2[-1] and np.linalg.norm(ends[1] - ends[0]) >= 2.0 * h * (1 - 1e-9):
-            _as_line(res, candidates, sel, single, m, ends, layout, step, bounds, newton_steps, pen, pen, 2.0 * h)
+        if ends is not None and chi2 < sel.chi2[-1] and np.linalg.norm(ends[1] - ends[0]) >= shortest * (1 - 1e-9):
+            _as_line(res, candidates, sel, single, m, ends, layout, step, bounds, newton_steps, pen, pen, shortest)
     return sel
