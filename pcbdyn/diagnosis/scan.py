@@ -4,10 +4,10 @@ Forward selection (:func:`.select.search`) ranks a shortlist of candidates, each
 effects already chosen and the declared parameters for a few Gauss-Newton steps; the local search
 (:func:`.select.refine`) ranks the moves of each effect found. Every trial starts from one solved
 state, so each is first fitted on that state's reanalysis (:mod:`.reanalysis`: no sparse solve),
-and only those whose quick fit could still be the best (:class:`Ranking`), of the :data:`FULL_RANK` best
-of them and the trials a reanalysis cannot follow (adding or removing a rib changes the modes beyond a
-first-order basis: kinds with ``reanalysed = False``), are fitted again with full re-solves, which
-decide. Both kinds of fits are independent jobs: they
+and of the :data:`FULL_RANK` best of them only those whose quick fit could still be the best
+(:class:`Ranking`) are fitted again with full re-solves, which decide; so is every trial a reanalysis
+cannot follow (adding or removing a rib changes the modes beyond a first-order basis: kinds with
+``reanalysed = False``), which is never fitted on it. Both kinds of fits are independent jobs: they
 run in local worker processes (the quick ones always there) or on a Dask cluster
 (:func:`pcbdyn.parallel.run_jobs`) when a :class:`Runner` says so, with the same results as in
 this process."""
@@ -202,8 +202,9 @@ class Ranking:
     pairs crowded out the single addition that won: dev seed 20, whose pick then hung on round-off); where no more
     than that compete outside a local search, all are re-solved unscreened (a few brackets of the resonant
     screen: a mass on a spring near its own mode is where a first-order basis is worst). The others (a rib added or
-    removed) are ranked on it too, which only chooses what is re-solved: on dev seeds 2 and 19, 56 such
-    quick fits were at most 1.7 % of the state's chi^2 above their full ones (45 below)."""
+    removed) are always re-solved and never fitted on the reanalysis, as :func:`worth_full` never screens them:
+    such quick fits were within 1.7 % of the state's chi^2 on dev seeds 2 and 19, but 36 % above the full fit of the
+    rib move that won on the bench's ``stiffener_col_wedge``."""
 
     def __init__(self, res, state, trials: list, p, bounds, P, runner: Runner | None = None, reduced=None,
                  cost=None, beat: float = np.inf):
@@ -213,8 +214,7 @@ class Ranking:
         self.reach = reach(state)
         followed = np.array([_followed(state, cands) for cands, _ in trials], bool)
         k_f = np.flatnonzero(followed)
-        few = k_f.size <= FULL_RANK and not np.isfinite(beat)
-        screened = np.flatnonzero(~followed) if few else np.arange(len(trials))
+        screened = k_f if k_f.size > FULL_RANK or np.isfinite(beat) else k_f[:0]
         quick = np.full(len(trials), np.nan)
         quick[screened] = _screen(res, state, [trials[k] for k in screened], p, bounds, P, RANK_STEPS, runner,
                                   reduced)
@@ -235,10 +235,11 @@ class Ranking:
         while True:
             done = [k for k, f in enumerate(self.fits) if f is not None and k not in self.tried]
             best = min(done, key=self.criterion, default=None)
-            bound = min(np.inf if best is None else self.criterion(best), self.beat)
-            if best is None:  # a full fit can be up to the margin worse than its quick one
-                bound = min([bound] + [self.quick[k] + self.reach for k in self.pending if self.quick[k] > -np.inf])
-            need = sorted(k for k in self.pending if self.quick[k] - self.reach < bound or self.quick[k] == -np.inf)
+            # the best full fit lies below that of every trial re-solved and, up to the margin, every quick one
+            bound = min([self.beat] + [self.criterion(k) for k in done]
+                        + [self.quick[k] + self.reach for k in self.pending if self.quick[k] > -np.inf])
+            need = (sorted(k for k in self.pending if self.quick[k] == -np.inf)
+                    or sorted(k for k in self.pending if self.quick[k] - self.reach < bound))
             if not need:
                 break
             self.pending -= set(need)

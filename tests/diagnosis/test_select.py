@@ -400,9 +400,10 @@ def test_an_effect_whose_size_the_data_cannot_tell_from_none_is_listed_apart():
 
 @pytest.mark.parametrize("kind, xy, value", [("stiffener", (0.08, 0.11), 0.5), ("point_mass", (0.11, 0.15), 0.013)])
 def test_the_trial_ranking_re_solves_fewer_trials_and_picks_the_one_every_re_solve_would(card, kind, xy, value):
-    """:class:`pcbdyn.diagnosis.scan.Ranking` re-solves only the trials whose fit on the reanalysis could still
-    be the best: of single additions of every kind (ribs, which a reanalysis does not follow, among them),
-    it picks the trial that full fits of all of them rank first, and the true effect, with fewer re-solves."""
+    """:class:`pcbdyn.diagnosis.scan.Ranking` re-solves every trial a reanalysis does not follow (ribs) and of the
+    others only those whose fit on the reanalysis could still be the best: of single additions of every kind
+    it picks the trial that full fits of all of them rank first, and the true effect; with a rib hidden, its
+    full fit leaves no other kind's quick fit within reach, so none of those is re-solved."""
     from pcbdyn.diagnosis.residual import ModalResidual, Observation
     from pcbdyn.diagnosis.fitting import RANK_STEPS
     from pcbdyn.diagnosis.scan import FULL_RANK, Ranking, Runner, _followed, _full_fit, _screen
@@ -428,7 +429,10 @@ def test_the_trial_ranking_re_solves_fewer_trials_and_picks_the_one_every_re_sol
                          (res, None, np.zeros((res.n_rows, 0))))
     assert first == eligible[int(np.argmin([chi2 for chi2, _, _ in every]))]
     assert cands[picked[first]].name == hidden.name
-    assert sum(f is not None for f in ranking.fits) < len(eligible)
+    resolved = {k for k, f in enumerate(ranking.fits) if f is not None}
+    assert set(range(len(trials))) - set(followed) <= resolved
+    assert all(ranking.quick[k] - ranking.reach >= ranking.criterion(first) for k in set(eligible) - resolved)
+    assert kind != "stiffener" or resolved.isdisjoint(followed)
 
 
 def test_the_ranking_re_solves_the_single_addition_that_pairs_beat_on_chi2_alone(monkeypatch):
