@@ -214,7 +214,8 @@ class Ranking:
         self.reach = reach(state)
         followed = np.array([_followed(state, cands) for cands, _ in trials], bool)
         k_f = np.flatnonzero(followed)
-        screened = k_f if k_f.size > FULL_RANK or np.isfinite(beat) else k_f[:0]
+        few = k_f.size <= FULL_RANK and not np.isfinite(beat)  # then all are re-solved unscreened
+        screened = k_f[:0] if few else k_f
         quick = np.full(len(trials), np.nan)
         quick[screened] = _screen(res, state, [trials[k] for k in screened], p, bounds, P, RANK_STEPS, runner,
                                   reduced)

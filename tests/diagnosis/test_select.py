@@ -399,7 +399,7 @@ def test_an_effect_whose_size_the_data_cannot_tell_from_none_is_listed_apart():
 
 
 @pytest.mark.parametrize("kind, xy, value", [("stiffener", (0.08, 0.11), 0.5), ("point_mass", (0.11, 0.15), 0.013)])
-def test_the_trial_ranking_re_solves_fewer_trials_and_picks_the_one_every_re_solve_would(card, kind, xy, value):
+def test_the_trial_ranking_re_solves_every_rib_and_picks_the_one_every_re_solve_would(card, kind, xy, value):
     """:class:`pcbdyn.diagnosis.scan.Ranking` re-solves every trial a reanalysis does not follow (ribs) and of the
     others only those whose fit on the reanalysis could still be the best: of single additions of every kind
     it picks the trial that full fits of all of them rank first, and the true effect; with a rib hidden, its
