@@ -50,7 +50,8 @@ def _distance(p, seg) -> float:
     return float(np.linalg.norm(a + t * (b - a) - p))
 
 
-def test_a_finite_oblique_bar_found_from_the_nearest_row(tmp_path):
+def _plate_with_bar(tmp_path):
+    """(models, observations) of the plate on its 8 mm mesh, tested with the bar on a 4 mm mesh."""
     (tmp_path / "model.toml").write_text(PLATE.replace("MESH", "8 mm"))
     (tmp_path / "truth.toml").write_text(PLATE.replace("MESH", "4 mm") + TRUTH)
     truth = load_board(tmp_path / "truth.toml").build().model
@@ -63,6 +64,11 @@ def test_a_finite_oblique_bar_found_from_the_nearest_row(tmp_path):
     ob = Observation(None, test, np.full(test.n_modes, 0.002 / np.sqrt(3)),
                      read=reading(models.models[0].model, test.xyz, test.directions),
                      sigma_s=np.full(test.n_modes, 0.02 / np.sqrt(3)))
+    return models, ob
+
+
+def test_a_finite_oblique_bar_found_from_the_nearest_row(tmp_path):
+    models, ob = _plate_with_bar(tmp_path)
     res = ModalResidual.of_models(models, [ob])
     layout = dg.from_structure(models.models[0])
     rib = dg.kind("stiffener")
@@ -76,6 +82,31 @@ def test_a_finite_oblique_bar_found_from_the_nearest_row(tmp_path):
     assert max(_distance(p, path) for p in np.asarray(BAR)) < 4e-3  # and reach its ends within half an element
     assert found.fit.values[0] == pytest.approx(BAR_EI, rel=0.05)
     assert rib.mass(found.placed[0], found.fit.values[0]) == pytest.approx(BAR_MASS, rel=0.05)
+
+
+def test_a_rib_slid_along_the_bar_and_too_low_restarts_on_it(tmp_path):
+    """A rib on the bar's line, slid an eighth of its length along it and 1/1.6 of its height: its ends
+    and section must change together, which no line search does one coordinate at a time; one of the
+    restarts (:func:`.geometry_fit.restarts`) is the bar, at its stiffness, and the screen takes it."""
+    from pcbdyn.diagnosis import conforming, geometry_fit as gf
+
+    models, ob = _plate_with_bar(tmp_path)
+    bar = np.asarray(BAR, float)
+    slid = bar - gf.RESTARTS[2][0] * (bar[1] - bar[0])  # the restart slid back by an eighth lies on the bar
+    layout = dg.from_structure(models.models[0])
+    rib = dg.kind("stiffener")
+    start = rib.candidate(layout, None, *slid, height=H / gf.HEIGHT_LADDER)
+    moved = gf.moved(start, "slide", 0.01, 8e-3)  # a slide keeps the line and its length
+    assert np.allclose(np.asarray(moved.geometry["path"]) - np.asarray(start.geometry["path"]),
+                       0.01 * (bar[1] - bar[0]) / np.linalg.norm(bar[1] - bar[0]), atol=1e-9)
+    base = (models.structure, [None], [], 8e-3)
+    here = gf._fit_at(base, [ob], [start], np.zeros(0), [BAR_EI], conforming.STEPS)
+    chosen, there = gf._restarted(base, [ob], [start], [0], here, 8e-3, Runner(1))
+    assert there[3].chi2 < 0.01 * here[3].chi2
+    path = np.asarray(chosen[0].geometry["path"], float)
+    assert max(_distance(p, BAR) for p in path) < 1e-3 and max(_distance(p, path) for p in bar) < 1e-3
+    assert chosen[0].data["height"] == pytest.approx(H)
+    assert there[3].values[0] == pytest.approx(BAR_EI, rel=0.1)
 
 
 def test_vertex_of_the_parabola_through_three_places():
@@ -106,3 +137,16 @@ def test_a_round_of_moves_settles_only_when_it_creeps():
     assert not settled(46730.0, 46310.0, strode=True)
     assert settled(46730.0, 46310.0, strode=False)
     assert not settled(18785.0, 9000.0, strode=False)  # dev seed 15: half its chi^2 a round
+
+
+def test_restarts_are_screened_only_where_the_noise_does_not_explain_the_fit():
+    """The chi-square test at ALPHA = 1 %: 1000 rows less 9 unknowns leave chi^2 1000 within the noise
+    (its 99th percentile is 1097.5), 1200 beyond it."""
+    from pcbdyn.diagnosis.fitting import Fit
+    from pcbdyn.diagnosis.geometry_fit import explained
+
+    def fit(chi2):
+        return Fit(np.ones(3), np.ones(1), None, np.zeros((4, 4)), chi2_value=chi2)
+
+    assert explained(fit(1000.0), 1000, 1)
+    assert not explained(fit(1200.0), 1000, 1)
