@@ -42,7 +42,6 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.stats import chi2 as chi2_dist
 
 from ..domain import StructureError
 from ..updating.gauss_newton import DAMPING, gauss_newton, taken
@@ -50,7 +49,7 @@ from . import conforming
 from .catalogue import kind
 from .fitting import UPPER, Fit, estimate
 from .layout import from_structure
-from .selection import ALPHA, variance_left
+from .selection import noise_explains, variance_left
 from .stiffener import extent, in_its_plane, in_plane, normal
 
 #: a rib's coordinates: its ends in its plate's plane and ln h (a slide moves both ends)
@@ -176,11 +175,10 @@ def resolved(fit, n_rows: int, n_ribs: int) -> float:
 
 
 def explained(fit, n_rows: int, n_ribs: int) -> bool:
-    """Whether the noise alone explains what ``fit`` leaves (the chi-square test of thesis section 5.2.3 at
-    :data:`.selection.ALPHA`): the data then show no sign of a rib in the wrong place, and no restart is
-    screened (the bench's six rib cases all end so; housing dev seed 3, whose rib a restart moved, at
-    37 times its rows)."""
-    return bool(chi2_dist.sf(fit.chi2, max(n_rows - _unknowns(fit, n_ribs), 1)) > ALPHA)
+    """Whether the noise alone explains what ``fit`` leaves (:func:`.selection.noise_explains`): the data
+    then show no sign of a rib in the wrong place, and no restart is screened (the bench's six rib cases
+    all end so; housing dev seed 3, whose rib a restart moved, at 37 times its rows)."""
+    return noise_explains(fit.chi2, n_rows - _unknowns(fit, n_ribs))
 
 
 def _unknowns(fit, n_ribs: int) -> int:

@@ -40,7 +40,13 @@ class Selection:
     def within_noise(self, n_free: int, alpha: float = ALPHA) -> bool:
         """Whether the last step's chi^2 is what noise gives with probability above ``alpha`` (the
         chi-square test of thesis section 5.2.3), ``n_free`` the rows less the declared parameters."""
-        return bool(chi2_dist.sf(self.chi2[-1], max(n_free - len(self.chosen), 1)) > alpha)
+        return noise_explains(self.chi2[-1], n_free - len(self.chosen), alpha)
+
+
+def noise_explains(chi2: float, dof: int, alpha: float = ALPHA) -> bool:
+    """Whether noise alone gives ``chi2`` over ``dof`` degrees of freedom (at least 1) with probability
+    above ``alpha`` (the chi-square test of thesis section 5.2.3)."""
+    return bool(chi2_dist.sf(chi2, max(dof, 1)) > alpha)
 
 
 def penalty(n_obs: int, n_candidates: int, alpha: float = ALPHA) -> float:
