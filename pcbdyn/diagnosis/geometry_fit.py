@@ -44,12 +44,13 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..domain import StructureError
+from ..problems.error_budget import noise_explains, variance_left
 from ..updating.gauss_newton import DAMPING, gauss_newton, taken
 from . import conforming
 from .catalogue import kind
 from .fitting import UPPER, Fit, estimate
 from .layout import from_structure
-from .selection import noise_explains, variance_left
+from .selection import ALPHA
 from .stiffener import extent, in_its_plane, in_plane, normal
 
 #: a rib's coordinates: its ends in its plate's plane and ln h (a slide moves both ends)
@@ -175,10 +176,11 @@ def resolved(fit, n_rows: int, n_ribs: int) -> float:
 
 
 def explained(fit, n_rows: int, n_ribs: int) -> bool:
-    """Whether the noise alone explains what ``fit`` leaves (:func:`.selection.noise_explains`): the data
+    """Whether the noise alone explains what ``fit`` leaves (the chi-square test at the diagnosis's
+    ALPHA, :func:`pcbdyn.problems.error_budget.noise_explains`): the data
     then show no sign of a rib in the wrong place, and no restart is screened (the bench's six rib cases
     all end so; housing dev seed 3, whose rib a restart moved, at 37 times its rows)."""
-    return noise_explains(fit.chi2, n_rows - _unknowns(fit, n_ribs))
+    return noise_explains(fit.chi2, n_rows - _unknowns(fit, n_ribs), ALPHA)
 
 
 def _unknowns(fit, n_ribs: int) -> int:

@@ -11,6 +11,7 @@ import numpy as np
 from scipy.stats import chi2 as chi2_dist
 
 from ..parallel import beside, spare
+from ..problems.error_budget import noise_probability
 from ..updating.driver import at_bounds
 from .fitting import estimate
 from .residual import ModalResidual
@@ -150,6 +151,6 @@ def range_test(res, base, n_params, alpha) -> dict:
     A = res.param_columns(base.state)
     level = np.sqrt(chi2_dist.isf(alpha, dof))
     return {"rows": res.n_rows, "dof": dof, "chi2_parameters_only": base.chi2,
-            "p_value_noise": float(chi2_dist.sf(base.chi2, dof)), "alpha": alpha,
+            "p_value_noise": noise_probability(base.chi2, dof), "alpha": alpha,
             "rank_A": int(np.sum(np.linalg.svd(A, compute_uv=False) > level)) if A.size else 0,
             "rank_Ab": int(np.sum(np.linalg.svd(np.column_stack([A, base.state.r]), compute_uv=False) > level))}

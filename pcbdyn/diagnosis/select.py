@@ -41,7 +41,7 @@ from __future__ import annotations
 import numpy as np
 
 from .catalogue import kind, moved_value
-from .fitting import RANK_STEPS, UPPER, Fit, estimate  # noqa: F401  (re-exported)
+from .fitting import Fit, estimate
 from .halves import Halves, bodies, body_moves, per_kind, together
 from .held_out import predicts, refit_predicts, secant
 from .reanalysis import Reanalysis

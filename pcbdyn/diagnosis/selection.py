@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.stats import chi2 as chi2_dist
 
+from ..problems.error_budget import noise_explains, variance_left
 from .fitting import Fit
 
 #: probability that noise alone makes one of the candidates look like an effect (family-wise)
@@ -43,12 +44,6 @@ class Selection:
         return noise_explains(self.chi2[-1], n_free - len(self.chosen), alpha)
 
 
-def noise_explains(chi2: float, dof: int, alpha: float = ALPHA) -> bool:
-    """Whether noise alone gives ``chi2`` over ``dof`` degrees of freedom (at least 1) with probability
-    above ``alpha`` (the chi-square test of thesis section 5.2.3)."""
-    return bool(chi2_dist.sf(chi2, max(dof, 1)) > alpha)
-
-
 def penalty(n_obs: int, n_candidates: int, alpha: float = ALPHA) -> float:
     """Criterion cost of one more effect: max(ln n, chi^2_1 quantile at 1 - alpha / P)."""
     return max(np.log(n_obs), float(chi2_dist.isf(alpha / max(n_candidates, 1), 1)))
@@ -63,12 +58,6 @@ def adopt(sel: Selection, idx: list, fit: Fit, pen: float) -> Selection:
     sel.chi2.append(fit.chi2)
     sel.criterion.append(fit.chi2 + len(idx) * pen)
     return sel
-
-
-def variance_left(chi2: float, n: int, k: int) -> float:
-    """The variance per row that a fit of ``k`` unknowns to ``n`` rows leaves with ``chi2``, at least the
-    stated noise's (1): the unit in which a noise or model error larger than stated is weighed."""
-    return max(chi2 / max(n - k, 1), 1.0)
 
 
 def worth(chi2_before, chi2_after, n, k, pen) -> bool:

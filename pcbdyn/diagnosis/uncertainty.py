@@ -30,12 +30,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..problems.error_budget import variance_left
 from ..updating.solvers import covariance
 from .catalogue import moved_value
 from .fitting import RANK_STEPS, UPPER, estimate
 from .held_out import fit_without, folds
 from .reanalysis import Reanalysis
-from .selection import variance_left
 
 #: the model-form budget: one standard deviation as a share of the magnitude, for every reported type.
 #: Calibrated with ``benchmarks/bench_coverage.py --calibrate`` on the bench and hold-out cases other

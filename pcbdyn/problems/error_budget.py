@@ -13,6 +13,10 @@ all use (issue 37).
   (:func:`pcbdyn.problems.calibration.systematic_shift`), a wedge-lock fit to each mode's tolerance,
   and a diagnosis corrects its frequencies to f0 and keeps a third of the step as uncertainty (part
   edges and the shells' shear layer at free edges converge more slowly than h^2).
+- What the noise explains: chi^2 of a fit in noise units against its degrees of freedom (the
+  chi-square test of thesis section 5.2.3, :func:`noise_probability`, :func:`noise_explains`), and the
+  variance per row a fit leaves, never below the stated noise's (:func:`variance_left`): the unit in
+  which a larger noise or a model error is weighed.
 - Plate theory: the gap from the declared Mindlin shells to the Kirchhoff limit, the same model with
   its transverse shear :data:`KIRCHHOFF_SHEAR` times stiffer (:mod:`pcbdyn.diagnosis.model_form`).
 """
@@ -20,6 +24,7 @@ all use (issue 37).
 from __future__ import annotations
 
 import numpy as np
+from scipy.stats import chi2 as chi2_dist
 
 from ..correlation.mac import mac
 from ..fe.modal import solve_modes
@@ -35,6 +40,24 @@ KIRCHHOFF_SHEAR = 1000.0
 def noise_sigma(bound_pct) -> float | np.ndarray:
     """The relative standard deviation of noise stated as uniform bounds of +-``bound_pct`` %."""
     return np.asarray(bound_pct, float) / 100.0 / np.sqrt(3.0)
+
+
+def noise_probability(chi2: float, dof: int) -> float:
+    """The probability that noise alone gives at least ``chi2`` (in noise units) over ``dof`` >= 1
+    degrees of freedom."""
+    return float(chi2_dist.sf(chi2, dof))
+
+
+def noise_explains(chi2: float, dof: int, alpha: float) -> bool:
+    """Whether noise alone gives ``chi2`` over ``dof`` degrees of freedom (at least 1) with probability
+    above ``alpha`` (the chi-square test of thesis section 5.2.3)."""
+    return noise_probability(chi2, max(dof, 1)) > alpha
+
+
+def variance_left(chi2: float, n: int, k: int) -> float:
+    """The variance per row that a fit of ``k`` unknowns to ``n`` rows leaves with ``chi2``, at least the
+    stated noise's (1)."""
+    return max(chi2 / max(n - k, 1), 1.0)
 
 
 def richardson(f_coarse, f_fine) -> tuple:

@@ -18,6 +18,7 @@ from scipy.stats import f as f_dist
 from ..updating.iteration import build_equations
 from ..updating.solvers import covariance
 from . import guides
+from .error_budget import variance_left
 from .fit import DEFAULT_NOISE, configurations, fit
 from .problem import UpdateProblem
 from .run import correlation_state
@@ -49,7 +50,7 @@ def significance(chi2_simple: float, chi2_rich: float, n: int, extra: int, k_ric
     dof = n - k_rich
     if dof < 1:
         return {"F": None, "critical": None, "p_value": None, "dof": [extra, dof], "significant": False}
-    s2 = max(chi2_rich / dof, 1.0)
+    s2 = variance_left(chi2_rich, n, k_rich)
     F = max(chi2_simple - chi2_rich, 0.0) / extra / s2
     return {"F": float(F), "critical": float(f_dist.isf(alpha, extra, dof)), "p_value": float(f_dist.sf(F, extra, dof)),
             "dof": [extra, dof], "significant": bool(f_dist.sf(F, extra, dof) < alpha)}

@@ -5,12 +5,12 @@ directions the data leave open, and the status and sentences that say so."""
 from __future__ import annotations
 
 import numpy as np
-from scipy.stats import chi2 as chi2_dist
 
 from ..units import from_si
 from ..updating.driver import at_bounds
 from ..updating.iteration import build_equations, objective_rows, unpaired
 from ..updating.solvers import choose_rank
+from .error_budget import noise_probability
 from .run import undetermined_directions, worse_configurations
 
 #: chi^2 with a smaller probability than this under the noise: the model cannot fit the test
@@ -43,7 +43,7 @@ def verdict(cfgs, p, problem) -> dict:
     chi2 = float(sum(r @ r for r in rows))
     scales = sum(np.size(st["used"]) for c, st in zip(cfgs, states) if c.method == "modal")
     dof = int(sum(r.size for r in rows) - len(problem.names) - scales)
-    pv = float(chi2_dist.sf(chi2, dof)) if dof > 0 else None
+    pv = noise_probability(chi2, dof) if dof > 0 else None
     measured = sum(np.size(c.f_x) for c in cfgs)
     paired = measured - sum(unpaired(c, st) for c, st in zip(cfgs, states))
     fits = None if pv is None else bool(pv >= ALPHA_FIT)

@@ -19,13 +19,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.stats import chi2 as chi2_dist
 
 from ..testdata import TestDataError
 from ..updating.driver import evaluate
 from ..updating.scan import grid
 from . import guides
-from .error_budget import noise_sigma
+from .error_budget import noise_explains, noise_sigma
 from .extremes import Extreme, correlate_extreme, mesh_errors
 from .fit import DEFAULT_NOISE
 from .run import pairing_warnings
@@ -229,7 +228,7 @@ def _step2(result: WedgeLockResult, board, tests, per_guide, noise, h, min_mac, 
     shared = result.shared
     if shared.n < 2:
         raise _too_few(shared.n, 2, "a stiffness", result.clamped)
-    misfit = float(chi2_dist.sf(shared.chi2, shared.n - 1)) < ALPHA or shared.fit.verdict["fits"] is False
+    misfit = not noise_explains(shared.chi2, shared.n - 1, ALPHA) or shared.fit.verdict["fits"] is False
     if len(names) > 1 and (per_guide or (per_guide is None and misfit and shared.n >= len(names) + 1)):
         say(f"fitting one stiffness per guide from {shared.values['k_rot']:.4g} N*m/rad/m")
         pg_model = SpringModel(board, tests, guides.spring_groups(board, True), bounds, sigma, noise,
