@@ -179,9 +179,9 @@ def resolved(fit, n_rows: int, n_ribs: int) -> float:
 
 def explained(fit, n_rows: int, n_ribs: int) -> bool:
     """Whether the noise alone explains what ``fit`` leaves (the chi-square test at the diagnosis's
-    ALPHA, :func:`pcbdyn.problems.error_budget.noise_explains`): the data
-    then show no sign of a rib in the wrong place, and no restart is screened (the bench's six rib cases
-    all end so; housing dev seed 3, whose rib a restart moved, at 37 times its rows)."""
+    ALPHA, :func:`pcbdyn.problems.error_budget.noise_explains`): the data then show no sign of a rib in
+    the wrong place, and no restart is screened (the bench's six rib cases all end so; housing dev seed 3,
+    whose rib a restart moved, at 37 times its rows)."""
     return noise_explains(fit.chi2, n_rows - _unknowns(fit, n_ribs), ALPHA)
 
 
