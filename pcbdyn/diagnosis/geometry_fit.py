@@ -132,9 +132,13 @@ def moved(rib, move: str, amount: float, h: float):
         path = path + amount * d
     else:
         height = height * np.exp(amount)
-        if not HEIGHT[0] <= height <= HEIGHT[1]:
-            return None
-    if np.linalg.norm(path[1] - path[0]) < MIN_LENGTH * h:
+    return _on(rib, path, height, h)
+
+
+def _on(rib, path, height: float, h: float):
+    """``rib`` on ``path`` (2, 2) [m] in its plate's plane with section ``height`` [m]; None where it
+    would be shorter than :data:`MIN_LENGTH` elements or its height outside :data:`HEIGHT`."""
+    if not HEIGHT[0] <= height <= HEIGHT[1] or np.linalg.norm(path[1] - path[0]) < MIN_LENGTH * h:
         return None
     return kind("stiffener").along(replace(rib, data={**rib.data, "height": float(height)}), path)
 
@@ -335,8 +339,7 @@ def restarts(rib, h: float) -> list:
     for a, b in RESTARTS:
         piece = path[0] + np.array([[a], [b]]) * (path[1] - path[0])
         for f in (1.0 / HEIGHT_LADDER, 1.0, HEIGHT_LADDER):
-            if np.linalg.norm(piece[1] - piece[0]) >= MIN_LENGTH * h and HEIGHT[0] <= f * height <= HEIGHT[1]:
-                there = kind("stiffener").along(replace(rib, data={**rib.data, "height": f * height}), piece)
+            if (there := _on(rib, piece, f * height, h)) is not None:
                 out += [(there, g / (b - a)) for g in EI_STARTS]
     return out
 
