@@ -67,10 +67,6 @@ def judge_holdout(case, truth: dict, data: dict) -> list:
 #: hold-out cases diagnose misses today, and why (``benchmarks/bench_diagnose.py`` reports a pass of one
 #: as a change to take note of)
 KNOWN: dict = {
-    "ho_rib_card": "rib found as two parallel ribs beside it (x = 115.6 mm, EI 0.48 N m^2, and x = 97.9 mm, EI 0.35, "
-                   "for one at x = 110 mm, EI 0.8: their sum within 4 %); 0.61 % after. Found as one (x = 110.3 mm, "
-                   "EI 0.92) with 0.40 % after while the search tried pieces of lines without the whole line beside "
-                   "each: the margin is thin either way",
     "ho_transducer_cfg": "transducer found in place (3 mm) and size (-19 %); 1.16 % after: the configurations' large "
                          "bodies with rotary inertia are attached differently in the two codes (1.08 % with no "
                          "effect, ho_noise_card_cfg)",
