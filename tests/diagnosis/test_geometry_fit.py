@@ -15,6 +15,7 @@ from pcbdyn.diagnosis.geometry_fit import fit_ribs
 from pcbdyn.diagnosis.residual import ModalResidual, Observation, reading
 from pcbdyn.diagnosis.scan import Runner
 from pcbdyn.fe.modal import solve_modes
+from pcbdyn.fe.probe import segment_parameter
 from pcbdyn.problems.models import StructureModels
 from pcbdyn.testdata.data import Dofs, Points
 from pcbdyn.testdata.simulate import simulate_on_model
@@ -49,9 +50,10 @@ section = {{ E = "200 GPa", rho = "7850 kg/m^3", height = "3 mm" }}
 
 
 def _distance(p, seg) -> float:
-    a, b = (np.asarray(q, float) for q in seg)
-    t = np.clip((p - a) @ (b - a) / ((b - a) @ (b - a)), 0.0, 1.0)
-    return float(np.linalg.norm(a + t * (b - a) - p))
+    """Distance [m] from point ``p`` to the segment ``seg`` (the closest point by :func:`.probe.segment_parameter`)."""
+    a, b = (np.asarray(q, float)[None] for q in seg)
+    t = segment_parameter(np.asarray(p, float)[None], a, b)[0]
+    return float(np.linalg.norm(a[0] + t * (b[0] - a[0]) - p))
 
 
 def _plate_with_bar(tmp_path, bar=BAR):
