@@ -121,7 +121,8 @@ def with_carried(models, res, p, carried, forms, h, levels: int, runner, kirchho
     nodes), on its own mesh and placed on the ``levels`` finer ones: a mass changes the shapes, and
     so what the mesh does to the frequencies, of the modes it sits on (a connector along an edge: a
     third less on the modes it localises). Masses only, and springs at a point between nodes (a
-    support), as they are the same on any mesh; a stiffness effect found on the model's mesh is
+    support), as they are the same on any mesh (not an inertia on a node's cells,
+    :func:`same_on_any_mesh`); a stiffness effect found on the model's mesh is
     partly its discretisation, and is left out on both sides of the comparison (a stiffener on a
     mesh along its line is not: :func:`_on_lines`). ``kirchhoff``: the plate theory's gap measured
     again too, on the finest mesh (a rib makes modes of other shapes, whose gap differs: 0.61 %
