@@ -31,6 +31,13 @@ def same_on_any_mesh(candidate) -> bool:
     return not (candidate.kind == "point_inertia" and "radius" not in candidate.data)
 
 
+def carried_by_the_stage(candidate) -> bool:
+    """Whether the pipeline's carried stage puts an effect found onto the finer meshes
+    (:func:`with_carried`): a mass (:data:`MASS_KINDS`) or a spring at a point between nodes (a
+    support), where it is the same effect on any mesh (:func:`same_on_any_mesh`)."""
+    return (candidate.kind in MASS_KINDS or candidate.between_nodes) and same_on_any_mesh(candidate)
+
+
 def noise_sigmas(ob: Observation, freq_pct, shape_pct, basis_shapes):
     """Per-mode relative standard deviations of the frequencies and of a shape component
     (``basis_shapes``: the model's modes at the points, needed only where the shape noise is not stated)."""

@@ -52,7 +52,7 @@ from ..problems.models import StructureModels
 from . import conforming, geometry_fit
 from .at_points import as_points
 from .bodies import as_bodies
-from .budget import MASS_KINDS, observations, same_on_any_mesh, set_noise, with_carried
+from .budget import carried_by_the_stage, observations, set_noise, with_carried
 from .catalogue import KINDS, generate, kind
 from .evidence import evidence
 from .fitting import estimate
@@ -289,8 +289,7 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
         say.stage("mass lines", "fitting masses found as masses along lines")
         sel = as_lines(res, cands, sel, MERGE_REACH * h, layout, h / 2, models.bounds, alpha=alpha)
     sel = without_vanished(res, cands, sel, models.bounds, alpha=alpha)
-    carried = [(cands[i], v) for i, v in zip(sel.chosen, sel.values)
-               if (cands[i].kind in MASS_KINDS or cands[i].between_nodes) and same_on_any_mesh(cands[i])]
+    carried = [(cands[i], v) for i, v in zip(sel.chosen, sel.values) if carried_by_the_stage(cands[i])]
     searched = cands  # the candidates on the model's own mesh (the evidence map is drawn on it)
     lined = None if quick or not conforming.stiffeners(cands, sel) else \
         _on_lines(models, res, cands, sel, forms, h, levels, runner, alpha, say)
