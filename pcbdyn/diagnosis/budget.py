@@ -20,22 +20,11 @@ from .residual import Observation, reading
 MASS_KINDS = ("point_mass", "point_inertia", "line_mass", "region_mass")
 
 
-def same_on_any_mesh(candidate) -> bool:
-    """Whether an effect found on the model's mesh is the same effect on the finer meshes, and so may be
-    carried onto them (:func:`with_carried`): not a rotary inertia on the cells around a node. Its
-    footprint is the mesh's cells, and a plate's slope under a moment at a point grows without bound
-    as the mesh is refined, so its effect on the frequencies never converges (a heat sink's mass
-    and inertia carried: the finest mesh moved its modes 1.9-4.4 % where the declared model's moved
-    0.4 %, and that correction was left in the frequencies reported after). A body's inertia (with
-    a radius of gyration, :mod:`.bodies`) moves with a disc of its own size on any mesh."""
-    return not (candidate.kind == "point_inertia" and "radius" not in candidate.data)
-
-
 def carried_by_the_stage(candidate) -> bool:
     """Whether the pipeline's carried stage puts an effect found onto the finer meshes
-    (:func:`with_carried`): a mass (:data:`MASS_KINDS`) or a spring at a point between nodes (a
-    support), where it is the same effect on any mesh (:func:`same_on_any_mesh`)."""
-    return (candidate.kind in MASS_KINDS or candidate.between_nodes) and same_on_any_mesh(candidate)
+    (:func:`with_carried`): a mass (:data:`MASS_KINDS`, a rotary inertia on its disc of fixed size
+    included) or a spring at a point between nodes (a support), the same effect on any mesh."""
+    return candidate.kind in MASS_KINDS or candidate.between_nodes
 
 
 def noise_sigmas(ob: Observation, freq_pct, shape_pct, basis_shapes):
@@ -128,14 +117,12 @@ def with_carried(models, res, p, carried, forms, h, levels: int, runner, kirchho
     nodes), on its own mesh and placed on the ``levels`` finer ones: a mass changes the shapes, and
     so what the mesh does to the frequencies, of the modes it sits on (a connector along an edge: a
     third less on the modes it localises). Masses only, and springs at a point between nodes (a
-    support), as they are the same on any mesh (not an inertia on a node's cells,
-    :func:`same_on_any_mesh`); a stiffness effect found on the model's mesh is
+    support), as they are the same on any mesh; a stiffness effect found on the model's mesh is
     partly its discretisation, and is left out on both sides of the comparison (a stiffener on a
     mesh along its line is not: :func:`_on_lines`). ``kirchhoff``: the plate theory's gap measured
     again too, on the finest mesh (a rib makes modes of other shapes, whose gap differs: 0.61 %
     against 0.13 % on the fourth mode of a card with a bar across it).
     Returns ``res`` of the observations with their new ``f_scale`` and frequency sigmas; sets the ``forms``."""
-    carried = [(c, v) for c, v in carried if same_on_any_mesh(c)]
     ref = res.evaluate(p, [c for c, _ in carried], [v for _, v in carried])
     requests = [r for ob, cs in zip(res.observations, ref.configs) for r in _requests(ob, cs, h, levels, carried, kirchhoff)]
     at = parameter_values(models.models[0], models.names, p)

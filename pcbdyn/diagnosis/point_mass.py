@@ -1,8 +1,9 @@
 """``point_mass``: a lumped mass at a node (a transducer, a heavy part, a screw head), and its
 optional rotary inertia about the two in-plane axes as a second, separate parameter
 (``point_inertia``, reported as a point_mass). dM/dm puts 1 on the node's three translations;
-dM/dJ is the unit rotary inertia of a body moving with the cells around the node (the footprint
-of :func:`..fixtures.supports.mass_footprint`, as a board's [[masses]] entry of inertia alone).
+dM/dJ is the unit rotary inertia of a body moving with a disc of fixed size around the node (the
+footprint of :func:`..fixtures.supports.mass_footprint`, as a board's [[masses]] entry of inertia
+alone), so that it is the same effect on the finer meshes of the error budget.
 A candidate with ``data["radius"]`` is one half of a body (:mod:`.bodies`): its mass or inertia
 moves with the disc of that radius of gyration, as a [[masses]] entry with both (radius 0: a mass
 placed from another mesh, at its point between the nodes). dK = 0 (thesis
@@ -17,7 +18,7 @@ import numpy as np
 from ..fe import MassProperty
 from ..fe.elements.discrete import mass_matrices
 from ..fe.model import SHELL_TYPES
-from ..fixtures.supports import disc_footprint, mass_footprint
+from ..fixtures.supports import INERTIA_REACH, disc_footprints
 from .catalogue import register, Blocks, node_candidates, on_nearest_node
 
 
@@ -37,7 +38,7 @@ class _Lumped:
     def place(self, layout, candidate):
         """At ``candidate``'s point: a body keeps its centre and radius, a mass becomes a body of no
         size there (interpolated in the cell that holds the point, so that it sits where it sat on
-        any mesh), an inertia goes on the nearest node (it turns with the cells around a node)."""
+        any mesh), an inertia goes on the nearest node (it turns with the disc around it)."""
         placed = on_nearest_node(layout, candidate)
         if "radius" in candidate.data:
             return replace(placed, at=candidate.at)
@@ -66,15 +67,28 @@ class _Lumped:
         """(cell nodes, sample weights or None) the candidate's body moves with: with
         ``data["radius"]`` (a body of that radius of gyration centred at ``data["centre"]``,
         :mod:`.bodies`) the disc of :func:`..fixtures.supports.disc_footprint`, for its mass and
-        its inertia alike; else its node for a mass and the cells around the node for an inertia."""
-        node = int(candidate.nodes[0])
-        radius = candidate.data.get("radius")
-        if radius is None and self.param == "mass":
-            return np.array([node]), None
-        shells = [(s.etype, s.conn) for s in model.sets.values() if s.etype in SHELL_TYPES]
-        if radius is None:
-            return mass_footprint(model.nodes, shells, node, 0.0, 1.0)[0], None
-        return disc_footprint(model.nodes, shells, candidate.data["centre"], float(radius))
+        its inertia alike; else its node for a mass and, for an inertia, the disc of an inertia
+        alone around the node (:func:`..fixtures.supports.mass_footprint`)."""
+        return self.footprints(model, [candidate])[0]
+
+    def footprints(self, model, candidates) -> list:
+        """:meth:`footprint` of each of ``candidates``, their discs located on the shell at once."""
+        out: list = [None] * len(candidates)
+        discs = []  # (index, centre, radius, first node)
+        for i, c in enumerate(candidates):
+            node = int(c.nodes[0])
+            if "radius" in c.data:
+                discs.append((i, c.data["centre"], float(c.data["radius"]), None))
+            elif self.param == "mass":
+                out[i] = (np.array([node]), None)
+            else:
+                discs.append((i, model.nodes[node], INERTIA_REACH, node))
+        if discs:
+            shells = [(s.etype, s.conn) for s in model.sets.values() if s.etype in SHELL_TYPES]
+            idx, centres, radii, firsts = zip(*discs)
+            for i, f in zip(idx, disc_footprints(model.nodes, shells, centres, radii, firsts)):
+                out[i] = f
+        return out
 
     def _property(self, value: float, weights=None):
         if self.param == "mass":
@@ -82,7 +96,7 @@ class _Lumped:
         return MassProperty(0.0, (value, value, 0.0), footprint=weights)
 
     def blocks(self, model, candidates) -> list:
-        cells = [self.footprint(model, c) for c in candidates]
+        cells = self.footprints(model, candidates)
         groups: dict = {}  # cells without sample weights share a block per size; a body has its own
         for i, (conn, W) in enumerate(cells):
             groups.setdefault(conn.size if W is None else -1 - i, []).append(i)

@@ -187,13 +187,17 @@ class Locator:
         best = np.argmin(d, axis=1)
         rows = np.arange(len(p))
         cell, weight, dist = cand[rows, best], w[rows, best], d[rows, best]
-        for i in np.flatnonzero(dist > tol):  # rare: big cells next to small ones, or points off the mesh
-            more = np.array(self.tree.query_ball_point(p[i], self.reach + tol), dtype=np.int64)
-            if more.size:
-                wi, di = _project(nodes, conn, is_tri, more, np.repeat(p[i : i + 1], more.size, axis=0))
-                j = np.argmin(di)
-                if di[j] < dist[i]:
-                    cell[i], weight[i], dist[i] = more[j], wi[j], di[j]
+        far = np.flatnonzero(dist > tol)  # big cells next to small ones, or points off the mesh
+        if far.size:  # every cell close enough to hold them, projected at once
+            near = self.tree.query_ball_point(p[far], self.reach + tol)
+            owner = np.repeat(far, [len(c) for c in near])
+            more = np.fromiter((j for c in near for j in c), dtype=np.int64, count=owner.size)
+            wi, di = _project(nodes, conn, is_tri, more, p[owner])
+            order = np.lexsort((di, owner))  # per point, its nearest cell first
+            first = order[np.r_[True, owner[order][1:] != owner[order][:-1]]] if owner.size else order
+            better = di[first] < dist[owner[first]]
+            i, j = owner[first][better], first[better]
+            cell[i], weight[i], dist[i] = more[j], wi[j], di[j]
         return Location(cell, conn[cell], weight, dist, dist <= tol)
 
 
