@@ -18,7 +18,7 @@ import numpy as np
 from ..fe import MassProperty
 from ..fe.elements.discrete import mass_matrices
 from ..fe.model import SHELL_TYPES
-from ..fixtures.supports import INERTIA_REACH, disc_footprints
+from ..fixtures.supports import disc_footprints, footprint_radius
 from .catalogue import register, Blocks, node_candidates, on_nearest_node
 
 
@@ -82,7 +82,7 @@ class _Lumped:
             elif self.param == "mass":
                 out[i] = (np.array([node]), None)
             else:
-                discs.append((i, model.nodes[node], INERTIA_REACH, node))
+                discs.append((i, model.nodes[node], footprint_radius(0.0, 1.0), node))
         if discs:
             shells = [(s.etype, s.conn) for s in model.sets.values() if s.etype in SHELL_TYPES]
             idx, centres, radii, firsts = zip(*discs)
