@@ -3,8 +3,8 @@ mass and inertia are refitted together at one point, moving with the disc of the
 gyration r = sqrt(J / m) (as a board's ``[[masses]]`` entry with both, so the enriched board.toml
 builds the model that was fitted).
 
-Forward selection finds the two separately, the inertia on the cells around some node nearby
-(where a body that wide would act on the plate's slope), the mass often as shares on the nodes
+Forward selection finds the two separately, the inertia alone at some node nearby (on a disc of
+fixed size, where a body that wide would act on the plate's slope), the mass often as shares on the nodes
 around it. Here the pair becomes two candidates at the mass shares' centre with the footprint of radius r
 (:mod:`.point_mass`); r depends on the magnitudes, so the fit is repeated with r updated until it
 settles (a fixed point; each fit is linear in m and J at fixed r), and the centre is moved to
