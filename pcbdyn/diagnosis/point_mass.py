@@ -97,7 +97,7 @@ class _Lumped:
 
     def blocks(self, model, candidates) -> list:
         cells = self.footprints(model, candidates)
-        groups: dict = {}  # cells without sample weights share a block per size; a body has its own
+        groups: dict = {}  # masses on their nodes share a block per size; a disc (a body, an inertia) has its own
         for i, (conn, W) in enumerate(cells):
             groups.setdefault(conn.size if W is None else -1 - i, []).append(i)
         out = []
