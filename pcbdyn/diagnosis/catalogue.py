@@ -274,14 +274,15 @@ def frequency_columns(model, modes, candidates) -> np.ndarray:
     return eigenvalue_columns(model, modes, candidates) / (8.0 * np.pi**2 * f)[:, None]
 
 
-def active(model, candidates) -> np.ndarray:
+def active(model, candidates, cache: BlockCache | None = None) -> np.ndarray:
     """True for candidates that touch at least one DOF the constraints leave free (a spring on
-    a clamped edge changes nothing and is dropped)."""
+    a clamped edge changes nothing and is dropped). ``cache``: the :class:`BlockCache` to make the
+    element blocks in, so that the search's first columns of the same candidates find them there."""
     free = np.ones(model.n_dof, dtype=bool)
     free[list(model.fixed)] = False
     keep = np.zeros(len(candidates), dtype=bool)
     for name, idx in _by_kind(candidates).items():
-        for b in kind(name).blocks(model, [candidates[i] for i in idx]):
+        for b in _blocks(model, name, [candidates[i] for i in idx], cache):
             f = free[element_dofs(b.conn)]
             mask = f[:, :, None] & f[:, None, :]
             hit = (np.abs(b.Ke) * mask).max(axis=(1, 2)) + (np.abs(b.Me) * mask).max(axis=(1, 2)) > 0
@@ -289,10 +290,10 @@ def active(model, candidates) -> np.ndarray:
     return keep
 
 
-def generate(layout, kinds=None, **options) -> list:
+def generate(layout, kinds=None, cache: BlockCache | None = None, **options) -> list:
     """Candidates of the given kinds (default: all) on ``layout`` (:mod:`.layout`). ``options`` go
     to the kinds that accept them (``spacing``, ``segments``, ``patch``, ...). Candidates that
-    cannot act on the constrained model are dropped."""
+    cannot act on the constrained model are dropped (:func:`active`, its blocks made in ``cache``)."""
     names = list(KINDS) if kinds is None else list(kinds)
     accepted = {o for name in names for o in kind(name).options}
     unknown = sorted(set(options) - accepted)
@@ -303,7 +304,7 @@ def generate(layout, kinds=None, **options) -> list:
     for name in names:
         k = kind(name)
         out += k.generate(layout, **{o: v for o, v in options.items() if o in k.options})
-    return [c for c, a in zip(out, active(layout.model, out)) if a] if out else []
+    return [c for c, a in zip(out, active(layout.model, out, cache)) if a] if out else []
 
 
 def node_candidates(kind_name: str, layout, spacing: float | None = None) -> list:

@@ -255,7 +255,7 @@ def _diagnose(structure, tests, freq_noise_pct, shape_noise_pct, mesh_size, kind
     grid = QUICK_CANDIDATE_OPTIONS if quick else CANDIDATE_OPTIONS
     options = {k: v * h if k == "path_spacing" else v for k, v in grid.items() if k in _options(kinds)}
     layout = from_structure(models.models[0])
-    cands = generate(layout, kinds, **options)
+    cands = generate(layout, kinds, cache=res.effects.blocks, **options)
     say.stage("search", f"searching {len(cands)} candidate effects")
     cands += [c for c, _ in support]
     held = list(range(len(cands) - len(support), len(cands)))
