@@ -156,15 +156,14 @@ def run_quad_mesh(fn, args, what: str):
     ``mesh.clear()``, it gave one board one of two meshes run to run (frequencies 1e-6 apart, and a
     diagnosis that turned on them)."""
     folded, out = run_gmsh(fn, (*args, QUADS))
-    if not folded:
-        if not any("tri3" in c for c in out[1].values()):
-            return out
-        refolded, subdivided = run_gmsh(fn, (*args, SUBDIVIDED))
-        return out if refolded else subdivided
-    folded, out = run_gmsh(fn, (*args, SUBDIVIDED))
+    if not folded and not any("tri3" in c for c in out[1].values()):
+        return out
+    refolded, subdivided = run_gmsh(fn, (*args, SUBDIVIDED))
+    if not refolded:
+        return subdivided
     if not folded:
         return out
-    refolded, split = run_gmsh(fn, (*args, frozenset(folded)))
+    refolded, split = run_gmsh(fn, (*args, frozenset(refolded)))
     if refolded:
         raise RuntimeError(f"gmsh folded elements of {what} where it recombined triangles into quads; "
                            "change mesh_size slightly")
