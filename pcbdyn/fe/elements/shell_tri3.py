@@ -1,13 +1,20 @@
-"""Three-node flat shell: Allman membrane with drilling rotations, DKT bending.
+"""Three-node flat shell: Allman membrane with drilling rotations, DKMT (Mindlin) bending.
 
 - Membrane: Allman's (1984) triangle. u, v are quadratic; the midside values come from the
   corner displacements plus the normal displacement L (theta_z,j - theta_z,i) / 8 implied by the
   corner drilling rotations. Its one spurious mode (all theta_z equal, no displacement) is
   removed by the Hughes-Brezzi penalty gamma (theta_z - (v_x - u_y) / 2)^2 at the centroid.
-- Bending: discrete Kirchhoff triangle (DKT, Batoz, Bathe and Ho 1980): quadratic normal
-  rotations beta tied to w and the corner rotations by the Kirchhoff condition at the corners
-  and, along each edge, by a cubic w and a linear normal rotation. Thin-plate theory, so free
-  of shear locking by construction (no transverse shear energy).
+- Bending: the discrete Kirchhoff-Mindlin triangle (DKMT, Katili 1993), the Reissner-Mindlin
+  extension of the discrete Kirchhoff triangle (DKT, Batoz, Bathe and Ho 1980) on the same nine
+  DOFs. The rotations beta are quadratic, with a tangential midside increment d_k on each edge k.
+  Along the edge the transverse shear is constant, gamma_k = (w_j - w_i) / L + the mean tangential
+  rotation + 2 d_k / 3, and moment equilibrium ties it to d_k: gamma_k = -2 phi_k d_k / 3 with
+  phi_k = 12 D_ss / (S_ss L^2) (D_ss, S_ss: the section's bending and shear stiffness along the
+  edge). The three edge shears give the element's shear field by the lowest-order rotated
+  Raviart-Thomas interpolation (the tying of MITC3). For phi -> 0 (thin plates, or the Kirchhoff
+  limit ``with_shear_factor`` makes) d_k is DKT's and the shear energy vanishes, so the element
+  is free of shear locking; for thick plates it follows Mindlin theory as MITC4 does, and a mesh
+  mixing triangles and quads keeps one plate theory.
 - Mass: u, v and the rotary inertia with the linear shape functions; w with the cubic of
   Bazeley, Cheung, Irons and Zienkiewicz (BCIZ, 1965) in the same nine bending DOFs, whose
   edge slopes are the DKT ones. A linear w would overestimate bending frequencies by about
@@ -61,20 +68,74 @@ def _edges(xl: np.ndarray):
     return out
 
 
-def _fields(xl: np.ndarray):
-    """Maps (n, 6, 2, 9) to (u, v) from the membrane block (u, v, theta_z per node) and to
-    beta = (beta_x, beta_y) from the bending block (w, theta_x, theta_y per node), at the six
-    points of the quadratic interpolation (corners, then midsides of edges 1-2, 2-3, 3-1)."""
-    n = xl.shape[0]
+def _corners(n: int):
+    """Maps (n, 2, 9) of the corners' (u, v) from the membrane block and beta = (theta_y, -theta_x)
+    from the bending block (w, theta_x, theta_y per node)."""
     U = [_unit(n, [(0, 3 * a, 1.0), (1, 3 * a + 1, 1.0)]) for a in range(3)]
-    B = [_unit(n, [(0, 3 * a + 2, 1.0), (1, 3 * a + 1, -1.0)]) for a in range(3)]  # beta = (theta_y, -theta_x)
-    for (i, j), (L, s, nrm) in zip(_EDGES, _edges(xl)):
+    B = [_unit(n, [(0, 3 * a + 2, 1.0), (1, 3 * a + 1, -1.0)]) for a in range(3)]
+    return U, B
+
+
+def _residuals(n: int, edges, B):
+    """Per edge, the row (n, 9) of (w_j - w_i) / L + s . (beta_i + beta_j) / 2: the edge's mean
+    transverse shear when beta is linear along it (the Kirchhoff condition sets it to zero)."""
+    out = []
+    for (i, j), (L, s, _) in zip(_EDGES, edges):
+        dw = _unit(n, [(0, 3 * j, 1.0), (0, 3 * i, -1.0)])[:, 0] / L[:, None]
+        out.append(dw + 0.5 * np.einsum("ni,nid->nd", s, B[i] + B[j]))
+    return out
+
+
+def _fields(xl: np.ndarray, phi: np.ndarray):
+    """Maps (n, 6, 2, 9) to (u, v) from the membrane block and to beta from the bending block, at
+    the six points of the quadratic interpolation (corners, then midsides of edges 1-2, 2-3, 3-1);
+    and the edges' constant tangential shears (n, 3, 9). ``phi`` (n, 3): the edges' shear
+    parameters; the tangential midside increment is d_k = -3 r_k / (2 (1 + phi_k)) for the
+    residual r_k of :func:`_residuals`, and the edge shear r_k + 2 d_k / 3 = phi_k r_k / (1 + phi_k)."""
+    n = xl.shape[0]
+    U, B = _corners(n)
+    edges = _edges(xl)
+    res = _residuals(n, edges, B)
+    gam = []
+    for k, ((i, j), (L, s, nrm)) in enumerate(zip(_EDGES, edges)):
         tz = _unit(n, [(0, 3 * j + 2, 1.0), (0, 3 * i + 2, -1.0)])[:, 0]  # theta_z,j - theta_z,i
         U.append(0.5 * (U[i] + U[j]) + (L / 8.0)[:, None, None] * nrm[:, :, None] * tz[:, None, :])
-        dw = _unit(n, [(0, 3 * i, 1.0), (0, 3 * j, -1.0)])[:, 0]  # w_i - w_j
-        P = -0.25 * np.einsum("ni,nj->nij", s, s) + 0.5 * np.einsum("ni,nj->nij", nrm, nrm)
-        B.append((1.5 / L)[:, None, None] * s[:, :, None] * dw[:, None, :] + np.matmul(P, B[i] + B[j]))
-    return np.stack(U, axis=1), np.stack(B, axis=1)
+        d = (-1.5 / (1.0 + phi[:, k]))[:, None] * res[k]
+        B.append(0.5 * (B[i] + B[j]) + s[:, :, None] * d[:, None, :])
+        gam.append((phi[:, k] / (1.0 + phi[:, k]))[:, None] * res[k])
+    return np.stack(U, axis=1), np.stack(B, axis=1), np.stack(gam, axis=1)
+
+
+def _along(M: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """t^T M t per cell for matrices M (3, 3), (2, 2) or per cell (n, 1, ., .) and vectors t (n, .)."""
+    M = np.asarray(M)
+    M = np.broadcast_to(M.reshape((-1,) + M.shape[-2:]), (t.shape[0],) + M.shape[-2:])
+    return np.einsum("ni,nij,nj->n", t, M, t)
+
+
+def _shear_parameters(xl: np.ndarray, sec) -> np.ndarray:
+    """phi_k = 12 D_ss / (S_ss L_k^2) per edge (n, 3): D_ss the bending stiffness for curvature
+    along the edge, S_ss the shear stiffness along it."""
+    out = []
+    for L, s, _ in _edges(xl):
+        c, e = s[:, 0], s[:, 1]
+        curvature = np.stack([c * c, e * e, 2 * c * e], axis=1)  # (kxx, kyy, 2 kxy) of a unit k_ss
+        out.append(12.0 * _along(sec.D, curvature) / (_along(sec.S, s) * L * L))
+    return np.stack(out, axis=1)
+
+
+def _shear_rows(xl: np.ndarray, gam: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Rows (n, g, 2, 9) of (gamma_xz, gamma_yz) at ``points`` (n, g, 2) of the field
+    a + c (-(y - y0), x - x0) (x0: centroid) whose tangential component on edge k is gam[:, k]."""
+    x0 = xl.mean(axis=1)
+    A = np.zeros((xl.shape[0], 3, 3))
+    for k, ((i, _), (_, s, _)) in enumerate(zip(_EDGES, _edges(xl))):
+        p = xl[:, i] - x0
+        A[:, k] = np.stack([s[:, 0], s[:, 1], p[:, 0] * s[:, 1] - p[:, 1] * s[:, 0]], axis=1)
+    coef = np.linalg.solve(A, gam)  # (n, 3, 9): a_x, a_y, c
+    r = points - x0[:, None]
+    return np.stack([coef[:, None, 0] - r[..., 1, None] * coef[:, None, 2],
+                     coef[:, None, 1] + r[..., 0, None] * coef[:, None, 2]], axis=2)
 
 
 def _gradients(dNx: np.ndarray, F: np.ndarray):
@@ -131,14 +192,16 @@ def local_matrices(xl: np.ndarray, prop, sec=None):
     J = np.stack([xl[:, 1] - xl[:, 0], xl[:, 2] - xl[:, 0]], axis=1)  # J[k, i] = d x_i / d xi_k
     area = 0.5 * (J[:, 0, 0] * J[:, 1, 1] - J[:, 0, 1] * J[:, 1, 0])
     invJ = np.linalg.inv(J)
-    U, Bt = _fields(xl)
+    U, Bt, gam = _fields(xl, _shear_parameters(xl, sec))
 
     Bm = np.zeros((n, 4, 3, 9))  # 3 Gauss points of membrane strains, then the drilling row
-    Bb = np.zeros((n, 3, 3, 9))
+    Bb = np.zeros((n, 3, 5, 9))  # curvatures, then the transverse shears
     for g, (xi, eta) in enumerate(_GP):
         dNx = np.einsum("nik,kI->niI", invJ, _quadratic(xi, eta))
         Bm[:, g] = _strain_rows(dNx, U)
-        Bb[:, g] = _strain_rows(dNx, Bt)
+        Bb[:, g, :3] = _strain_rows(dNx, Bt)
+    points = xl[:, :1] + np.einsum("gk,nki->ngi", _GP, J)
+    Bb[:, :, 3:] = _shear_rows(xl, gam, points)
     gx, gy = _gradients(np.einsum("nik,kI->niI", invJ, _quadratic(1 / 3, 1 / 3)), U)
     Bm[:, 3, 0] = -0.5 * (gx[:, 1] - gy[:, 0])  # theta_z - (v,x - u,y) / 2 at the centroid
     Bm[:, 3, 0, 2::3] += 1.0 / 3.0
@@ -148,7 +211,9 @@ def local_matrices(xl: np.ndarray, prop, sec=None):
     Cm[..., 3, 0, 0] = np.reshape(sec.drilling, lead)
     w = np.repeat((area / 3.0)[:, None], 3, axis=1)
     Km = btdb(Bm, Cm, np.column_stack([w, area]))
-    Kb = btdb(Bb, sec.D, w)
+    Cb = np.zeros(np.shape(sec.D)[:-2] + (5, 5))  # (n, 1, 5, 5) for sections rotated per cell
+    Cb[..., :3, :3], Cb[..., 3:, 3:] = sec.D, sec.S
+    Kb = btdb(Bb, Cb, w)
 
     L = np.array([[1 - xi - eta, xi, eta] for xi, eta in _GP])
     Mm, Mb = rotary_mass(L, w, sec)
