@@ -16,8 +16,9 @@ A structure has a ``name``, the ``path`` of its file, its ``parameters``
   ``source``, a file) that lie off the structure;
 - ``write_updated(values, dst, source)``: its file with parameter ``values`` {name: SI} written into
   their targets, the user's comments and layout kept; returns the path written;
-- ``write_enriched(effects, dst)``: its file with the effects a diagnosis found declared in it (the
-  user's comments and layout kept); returns the path written;
+- ``write_enriched(effects, dst, values=None)``: its file with the effects a diagnosis found declared
+  in it and the fitted parameter ``values`` {name: SI} written into their targets (the user's comments
+  and layout kept): the diagnosed model; returns the path written;
 - ``outlines(config=None)``: what a mode-shape picture outlines (plain data: kind, label, points);
 - ``following(lines)``: a copy whose meshes' element edges also follow ``lines`` (polylines on its
   plates, (m, 2) [m] on a board in its plane, (m, 3) in space on a housing), where a diagnosis found
@@ -64,7 +65,7 @@ class Structure(Protocol):
 
     def write_updated(self, values: dict, dst, source: str = "pcbdyn update"): ...
 
-    def write_enriched(self, effects, dst): ...
+    def write_enriched(self, effects, dst, values=None): ...
 
     def outlines(self, config=None) -> list: ...
 

@@ -330,6 +330,12 @@ def append_entry(doc, collection: str, fields: dict, note: str) -> None:
     doc[collection].append(table)
 
 
+def assignments(parameters, values: dict) -> dict:
+    """{target: value [SI]} of the ``parameters`` (ParameterSpec) named in ``values`` {name: SI}: each
+    parameter's value goes to every target it shares."""
+    return {t: float(values[p.name]) for p in parameters if p.name in values for t in p.targets}
+
+
 def updated_text(text: str, assignments: dict) -> str:
     """The TOML ``text`` with each target of ``assignments`` {target: value [SI]} set (:func:`write`),
     everything else as the user wrote it."""

@@ -158,19 +158,24 @@ class Board(Configured):
         nothing declared on them: where a diagnosis found stiffeners (:mod:`pcbdyn.diagnosis.conforming`)."""
         return replace(self, guides=[np.asarray(line, float) for line in lines])
 
-    def write_enriched(self, effects, dst, date: str | None = None) -> Path:
-        """``dst``: this board.toml with the effects a diagnosis found declared (:mod:`.enrich`), written
-        atomically once it loads."""
-        text = enriched_text(self.path.read_text(encoding="utf-8"), effects, date)
-        return write_checked(dst, text, load_board, BoardError)
+    def write_enriched(self, effects, dst, date: str | None = None, values: dict | None = None) -> Path:
+        """``dst``: this board.toml with the effects a diagnosis found declared (:mod:`.enrich`) and the
+        parameters' fitted ``values`` {name: SI} written into their targets, so that it builds the diagnosed
+        model; written atomically once it loads."""
+        text = self._updated_text(values or {}, "pcbdyn diagnose")
+        return write_checked(dst, enriched_text(text, effects, date), load_board, BoardError)
 
     def write_updated(self, values: dict, dst, source: str = "pcbdyn update") -> Path:
         """``dst``: this board.toml with the parameters' ``values`` {name: SI} written into their targets
         (comments and layout kept), checked by loading it before it replaces ``dst``."""
-        assignments = {t: float(values[p.name]) for p in self.parameters if p.name in values for t in p.targets}
+        return write_checked(dst, self._updated_text(values, source), load_board, BoardError)
+
+    def _updated_text(self, values: dict, source: str) -> str:
+        text = self.path.read_text(encoding="utf-8")
+        if not values:
+            return text
         header = f"# {self.path.name} with {', '.join(values)} updated by {source}\n"
-        text = header + targets.updated_text(self.path.read_text(encoding="utf-8"), assignments)
-        return write_checked(dst, text, load_board, BoardError)
+        return header + targets.updated_text(text, targets.assignments(self.parameters, values))
 
 
 def smeared_density(board: Board, c: Component) -> float:

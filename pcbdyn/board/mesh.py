@@ -12,16 +12,15 @@ result is all-quad at ``size``; where that folds an element, the first mesh stay
 triangles. Where the first pass folds (recombination can, in the slivers between close footprints or
 where a line passes a footprint's corner), the subdivided mesh is made, and where that folds too, the
 same with the surfaces that folded not recombined but their triangles split into quads: all quads,
-not the surfaces left in triangles as before. A triangle (:mod:`pcbdyn.fe.elements.shell_tri3`, DKT)
-is a Kirchhoff plate and a quad (MITC4) a Mindlin one, so whole surfaces of triangles changed the
-plate theory with where the mesher gave up: a line 0.1 mm from a part's corner (a rib a diagnosis
+not the surfaces left in triangles as before: a line 0.1 mm from a part's corner (a rib a diagnosis
 fitted) left 86 % of the six-part card's cells in triangles on its own mesh and 88 % on a quarter of
-it, where the card's first eight frequencies rose by up to 0.76 % with nothing on the line (and a
-diagnosis fitted ribs there to move them). The triangles a first pass that does not fold leaves
-where the subdivided one folds stay (0.3 to 20 % of the cells of 7 of the 24 generated boards of
-benchmarks/discovery's splits): meshing the board subdivided wherever a fit's line leaves one changed
-its discretisation between neighbouring lines (:mod:`pcbdyn.diagnosis.geometry_fit` walks them) more
-than they do; a Mindlin triangle would make them consistent."""
+it. The triangles a first pass that does not fold leaves where the subdivided one folds stay (0.3 to
+20 % of the cells of 7 of the 24 generated boards of benchmarks/discovery's splits): meshing the board
+subdivided wherever a fit's line leaves one changed its discretisation between neighbouring lines
+(:mod:`pcbdyn.diagnosis.geometry_fit` walks them) more than they do. A triangle
+(:mod:`pcbdyn.fe.elements.shell_tri3`, DKMT) follows the same Mindlin theory as a quad (MITC4), so a
+mesh mixing them keeps one plate theory; with the Kirchhoff triangles (DKT) used before, the card's
+whole surfaces of triangles raised its first eight frequencies by up to 0.76 %."""
 
 from __future__ import annotations
 

@@ -141,18 +141,26 @@ class Box(Configured):
                   for m in self.masses + added]
         return items
 
-    def write_enriched(self, effects, dst) -> Path:
-        """``dst``: this box.toml with the effects a diagnosis found declared (:mod:`.enrich`), written
-        atomically once it loads."""
-        text = enriched_text(self, Path(self.path).read_text(encoding="utf-8"), effects)
-        return write_checked(dst, text, load_box, BoxError)
+    def write_enriched(self, effects, dst, values: dict | None = None) -> Path:
+        """``dst``: this box.toml with the effects a diagnosis found declared (:mod:`.enrich`) and the
+        parameters' fitted ``values`` {name: SI} written into their targets (as :meth:`write_updated`
+        does), so that it builds the diagnosed model; written atomically once it loads. An effect that
+        scales a plate's modulus scales the fitted one."""
+        text = self._updated_text(values or {}, dst, "pcbdyn diagnose")
+        fitted = parse_box(tomlkit.parse(text).unwrap(), Path(dst)) if values else self
+        return write_checked(dst, enriched_text(fitted, text, effects), load_box, BoxError)
 
     def write_updated(self, values: dict, dst, source: str = "pcbdyn update") -> Path:
         """``dst``: this box.toml with the parameters' ``values`` {name: SI} written into their targets
         (comments and layout kept), checked by loading it before it replaces ``dst``. A card's targets go
         to an updated copy of its board.toml, written beside it and named as ``dst`` is after the box
         (box.updated.2.toml: card1.updated.2.toml), which the updated box then names."""
-        assignments = {t: float(values[p.name]) for p in self.parameters if p.name in values for t in p.targets}
+        return write_checked(dst, self._updated_text(values, dst, source), load_box, BoxError)
+
+    def _updated_text(self, values: dict, dst, source: str) -> str:
+        """The box.toml text of :meth:`write_updated` for ``dst`` (its cards named relative to it), the
+        cards' updated copies written."""
+        assignments = targets.assignments(self.parameters, values)
         dst = Path(dst)
         tail = dst.name[len(self.path.stem):] if dst.name.startswith(self.path.stem) else f".{dst.name}"
         doc = tomlkit.parse(self.path.read_text(encoding="utf-8"))
@@ -167,8 +175,7 @@ class Box(Configured):
             doc["cards"][i]["board"] = os.path.relpath(path.resolve(), dst.resolve().parent).replace(os.sep, "/")
         text = targets.updated_text(tomlkit.dumps(doc), {t: v for t, v in assignments.items()
                                                         if not t.startswith("cards.")})
-        return write_checked(dst, f"# {self.path.name} with {', '.join(values)} updated by {source}\n" + text,
-                             load_box, BoxError)
+        return (f"# {self.path.name} with {', '.join(values)} updated by {source}\n" if values else "") + text
 
 
 def load_box(path) -> Box:

@@ -4,8 +4,8 @@ Fits the declared [[parameters]], tests whether the residual is noise and, when 
 the catalogue of effects (point masses and inertias, ground springs, edge stiffness, region
 stiffness, stiffeners, line masses) for the fewest that explain it, estimated together with the
 parameters (:func:`pcbdyn.diagnosis.pipeline.diagnose`). Prints the effects and the correlation as
-given / parameters only / with the effects; writes ``<board>.diagnosed.toml`` declaring them next
-to the original, the evidence map and tables in ``--out`` (with ``--html``, a page showing the effects
+given / parameters only / with the effects; writes ``<board>.diagnosed.toml`` declaring them, with the
+parameters at their fitted values, next to the original, the evidence map and tables in ``--out`` (with ``--html``, a page showing the effects
 on the modes of the model that declares them), and JSON.
 """
 
@@ -138,15 +138,17 @@ def _page(folder, board_toml, board, d, enriched):
 
 
 def _enriched(board, d, path, final=lambda p: p):
-    """The board with the effects found declared, written to ``path`` (None when there are none, or when it
-    cannot be written: said why); returns where it ends up (``final`` of the path written)."""
+    """The board with the effects found declared and the parameters at their fitted values, written to
+    ``path`` (None when no effect was found, or when it cannot be written: said why); returns where it ends
+    up (``final`` of the path written)."""
     from ..domain import StructureError
     from ..report import diagnosis_report as rep
 
     if not d.effects:
         return None
     try:
-        enriched = final(board.write_enriched(rep.enriched_effects(d), path))
+        values = {name: v["final"] for name, v in d.parameters.items()}
+        enriched = final(board.write_enriched(rep.enriched_effects(d), path, values=values))
     except StructureError as exc:
         click.echo(f"\nnote: the enriched board.toml was not written: {exc}", err=True)
         return None

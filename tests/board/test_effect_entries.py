@@ -359,3 +359,17 @@ def test_merged_region_with_a_long_label_is_written_under_a_short_name(base, tmp
     b = load_board(out)
     assert len(b.regions) == 1 and len(b.regions[0].name) <= MAX_NAME
     assert label in out.read_text()
+
+
+def test_the_enriched_board_carries_the_fitted_parameters(tmp_path):
+    """The diagnosed board is the diagnosed model: its [[parameters]]' targets hold the values diagnose
+    fitted (not the declared ones), beside the effects; comments kept."""
+    board = load_board(Path(__file__).parents[2] / "examples" / "six_part_card" / "board.toml")
+    declared = {p.name: p.value for p in board.parameters}
+    fitted = {"E_board": 0.93 * declared["E_board"], "t_PGA": 1.2 * declared["t_PGA"]}
+    effect = {"type": "point_mass", "name": "m1", "value": 0.012, "at": (0.05, 0.06)}
+    out = board.write_enriched([effect], tmp_path / "board.diagnosed.toml", values=fitted)
+    again = load_board(out)
+    assert {p.name: p.value for p in again.parameters} == pytest.approx({**declared, **fitted}, rel=1e-12)
+    assert again.masses[-1].mass == pytest.approx(0.012) and "found by pcbdyn diagnose" in out.read_text()
+    assert board.path.read_text().splitlines()[0] in out.read_text()

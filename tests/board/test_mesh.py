@@ -131,8 +131,8 @@ def test_crowded_parts_mesh_without_folds():
 def test_a_line_near_a_corner_leaves_the_plate_theory_alone():
     """A line the mesh must follow that passes 0.1 mm from a part's corner (a rib a diagnosis fitted
     on the six-part card) made blossom recombination fold, and the whole board face was left in
-    triangles, which are Kirchhoff plates (DKT) where the quads are Mindlin (MITC4): on a mesh a
-    quarter of the model's the card's first eight frequencies rose by up to 0.76 % with nothing on
+    triangles, which were then Kirchhoff plates (DKT) where the quads are Mindlin (MITC4): on a mesh
+    a quarter of the model's the card's first eight frequencies rose by up to 0.76 % with nothing on
     the line. The mesh is all quads, and the line, which carries nothing, changes them by < 0.1 %."""
     from pcbdyn.fe.modal import solve_modes
 

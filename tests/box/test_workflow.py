@@ -126,6 +126,8 @@ def test_diagnosis_finds_an_undeclared_mass_on_its_plate(diagnosing):
     enriched = load_box(data["enriched_board"])  # the box with the mass declared on its plate
     found = next(m for m in enriched.masses if m.name != "relay")
     assert found.plate == "upper" and np.hypot(found.at[0] - 0.160, found.at[1] - 0.080) < 0.015
+    fitted = {n: v["final"] for n, v in data["parameters"].items()}
+    assert fitted and {p.name: p.value for p in enriched.parameters} == pytest.approx(fitted, rel=1e-5)
 
 
 def test_diagnosis_reports_nothing_on_the_control(diagnosing):

@@ -203,7 +203,10 @@ def check_report(data: dict, out: Path) -> None:
     if data["effects"]:
         assert (out / "evidence.png").stat().st_size > 0
         enriched = Path(data["enriched_board"])
-        assert enriched.name.endswith(".diagnosed.toml") and load_board(enriched).name
+        assert enriched.name.endswith(".diagnosed.toml")
+        # the diagnosed model: its parameters at the values diagnose fitted, not the declared ones
+        declared = {p.name: p.value for p in load_board(enriched).parameters}
+        assert declared == pytest.approx({n: v["final"] for n, v in data["parameters"].items()}, rel=1e-5)
 
 
 def _summary(modes) -> dict:
