@@ -111,3 +111,17 @@ def test_a_board_only_command_says_it_takes_a_board():
     res = CliRunner().invoke(main, ["vibe", str(EXAMPLE), "--psd", "gevs-qual"])
     assert res.exit_code == 2
     assert "error: box.toml: top level: describes a box ([box]); this command takes a board.toml" in res.output
+
+
+def test_the_diagnosed_box_scales_the_fitted_modulus(tmp_path):
+    """A region_stiffness effect found on a plate whose modulus is a fitted parameter: the diagnosed box
+    holds the fitted modulus times the effect's factor (60 GPa x 1.3), not the declared one's (70 GPa),
+    and the other parameters at their fitted values."""
+    box = load_box(EXAMPLE)
+    effect = {"type": "region_stiffness", "name": "stiffer", "plate": "upper", "value": 0.3, "at": (0.1, 0.08, 0.12)}
+    out = box.write_enriched([effect], tmp_path / "box.diagnosed.toml", values={"E_upper": 60e9, "h_back": 12e-3})
+    again = load_box(out)
+    assert again.plate("upper").material.E == pytest.approx(78e9, rel=1e-12)
+    assert {p.name: p.value for p in again.parameters}["h_back"] == pytest.approx(12e-3, rel=1e-12)
+    plain = load_box(box.write_enriched([effect], tmp_path / "plain.toml"))
+    assert plain.plate("upper").material.E == pytest.approx(91e9, rel=1e-12)
