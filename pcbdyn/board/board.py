@@ -171,6 +171,7 @@ class Board(Configured):
         return write_checked(dst, self._updated_text(values, source), load_board, BoardError)
 
     def _updated_text(self, values: dict, source: str) -> str:
+        """This board.toml's text with the parameters' ``values`` written in (itself when there are none)."""
         text = self.path.read_text(encoding="utf-8")
         if not values:
             return text

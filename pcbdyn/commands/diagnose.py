@@ -5,8 +5,8 @@ the catalogue of effects (point masses and inertias, ground springs, edge stiffn
 stiffness, stiffeners, line masses) for the fewest that explain it, estimated together with the
 parameters (:func:`pcbdyn.diagnosis.pipeline.diagnose`). Prints the effects and the correlation as
 given / parameters only / with the effects; writes ``<board>.diagnosed.toml`` declaring them, with the
-parameters at their fitted values, next to the original, the evidence map and tables in ``--out`` (with ``--html``, a page showing the effects
-on the modes of the model that declares them), and JSON.
+parameters at their fitted values, next to the original, the evidence map and tables in ``--out`` (with
+``--html``, a page showing the effects on the modes of the model that declares them), and JSON.
 """
 
 from __future__ import annotations
