@@ -9,18 +9,17 @@ all-quad mesh for most layouts (gmsh's "frontal-Delaunay for quads", algorithm 8
 elements at small standoff pads, so algorithm 6 is used); when some triangles remain, the board is
 meshed at twice the size and every cell is split into quads (gmsh's all-quad subdivision), so the
 result is all-quad at ``size``; where that folds an element, the first mesh stays, with its few
-triangles. Where the first pass folds (recombination can, in the slivers between close footprints or
-where a line passes a footprint's corner), the subdivided mesh is made, and where that folds too, the
-same with the surfaces that folded not recombined but their triangles split into quads: all quads,
-not the surfaces left in triangles as before: a line 0.1 mm from a part's corner (a rib a diagnosis
-fitted) left 86 % of the six-part card's cells in triangles on its own mesh and 88 % on a quarter of
-it. The triangles a first pass that does not fold leaves where the subdivided one folds stay (0.3 to
-20 % of the cells of 7 of the 24 generated boards of benchmarks/discovery's splits): meshing the board
-subdivided wherever a fit's line leaves one changed its discretisation between neighbouring lines
-(:mod:`pcbdyn.diagnosis.geometry_fit` walks them) more than they do. A triangle
-(:mod:`pcbdyn.fe.elements.shell_tri3`, DKMT) follows the same Mindlin theory as a quad (MITC4), so a
-mesh mixing them keeps one plate theory; with the Kirchhoff triangles (DKT) used before, the card's
-whole surfaces of triangles raised its first eight frequencies by up to 0.76 %."""
+triangles. Where the first pass folds (in the slivers between close footprints, or where a line
+passes a footprint's corner), the subdivided mesh is made, and where that folds too, the same with
+the folded surfaces' triangles split into quads (:func:`run_quad_mesh`). Triangles left anywhere are
+Mindlin plates as the quads are (:mod:`pcbdyn.fe.elements.shell_tri3`), so a mixed mesh keeps one
+plate theory; the all-quad fallback is kept because it is the closer of the two: on the six-part card
+with a line 0.1 mm from U6's corner, the first eight frequencies move by 0.13 % (model mesh) and
+0.014 % (a quarter of it) from the card without the line, against 0.18 % and 0.034 % with the folded
+surface left in triangles. Meshing subdivided also where a first pass that does not fold leaves a few
+triangles changed the discretisation between the neighbouring lines a fit walks
+(:mod:`pcbdyn.diagnosis.geometry_fit`) more than the lines do, so those stay (0.3 to 20 % of the
+cells of 7 of the 24 generated boards of benchmarks/discovery's splits)."""
 
 from __future__ import annotations
 

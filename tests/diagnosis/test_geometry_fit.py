@@ -100,8 +100,8 @@ def test_a_finite_oblique_bar_found_from_the_nearest_row(tmp_path):
     of the 221 lines the fit meshes along (the full-span line through the bar) folds gmsh's quad
     recombination; meshed then with whole surfaces of triangles (Kirchhoff, DKT, as they were) among
     the Mindlin quads, the walk ended 0.05 mm from the bar with 0.97 of its EI and chi^2 5.6e-4 of the
-    start; meshed all in quads (:func:`pcbdyn.board.mesh.run_quad_mesh`), 0.75 mm, 0.91 of the EI and 2.1e-3: where the
-    walk stops in this flat valley turns on how single lines are meshed."""
+    start; meshed all in quads (:func:`pcbdyn.board.mesh.run_quad_mesh`), 0.75 mm, 0.91 of the EI and
+    2.1e-3: where the walk stops in this flat valley turns on how single lines are meshed."""
     models, ob = _plate_with_bar(tmp_path)
     res = ModalResidual.of_models(models, [ob])
     layout = dg.from_structure(models.models[0])

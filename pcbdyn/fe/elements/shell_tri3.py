@@ -86,15 +86,15 @@ def _residuals(n: int, edges, B):
     return out
 
 
-def _fields(xl: np.ndarray, phi: np.ndarray):
+def _fields(xl: np.ndarray, edges, phi: np.ndarray):
     """Maps (n, 6, 2, 9) to (u, v) from the membrane block and to beta from the bending block, at
     the six points of the quadratic interpolation (corners, then midsides of edges 1-2, 2-3, 3-1);
-    and the edges' constant tangential shears (n, 3, 9). ``phi`` (n, 3): the edges' shear
-    parameters; the tangential midside increment is d_k = -3 r_k / (2 (1 + phi_k)) for the
-    residual r_k of :func:`_residuals`, and the edge shear r_k + 2 d_k / 3 = phi_k r_k / (1 + phi_k)."""
+    and the edges' constant tangential shears (n, 3, 9). ``edges``: :func:`_edges`; ``phi`` (n, 3):
+    the edges' shear parameters; the tangential midside increment is d_k = -3 r_k / (2 (1 + phi_k))
+    for the residual r_k of :func:`_residuals`, and the edge shear r_k + 2 d_k / 3 =
+    phi_k r_k / (1 + phi_k)."""
     n = xl.shape[0]
     U, B = _corners(n)
-    edges = _edges(xl)
     res = _residuals(n, edges, B)
     gam = []
     for k, ((i, j), (L, s, nrm)) in enumerate(zip(_EDGES, edges)):
@@ -113,23 +113,23 @@ def _along(M: np.ndarray, t: np.ndarray) -> np.ndarray:
     return np.einsum("ni,nij,nj->n", t, M, t)
 
 
-def _shear_parameters(xl: np.ndarray, sec) -> np.ndarray:
+def _shear_parameters(edges, sec) -> np.ndarray:
     """phi_k = 12 D_ss / (S_ss L_k^2) per edge (n, 3): D_ss the bending stiffness for curvature
-    along the edge, S_ss the shear stiffness along it."""
+    along the edge, S_ss the shear stiffness along it (``edges``: :func:`_edges`)."""
     out = []
-    for L, s, _ in _edges(xl):
+    for L, s, _ in edges:
         c, e = s[:, 0], s[:, 1]
         curvature = np.stack([c * c, e * e, 2 * c * e], axis=1)  # (kxx, kyy, 2 kxy) of a unit k_ss
         out.append(12.0 * _along(sec.D, curvature) / (_along(sec.S, s) * L * L))
     return np.stack(out, axis=1)
 
 
-def _shear_rows(xl: np.ndarray, gam: np.ndarray, points: np.ndarray) -> np.ndarray:
+def _shear_rows(xl: np.ndarray, edges, gam: np.ndarray, points: np.ndarray) -> np.ndarray:
     """Rows (n, g, 2, 9) of (gamma_xz, gamma_yz) at ``points`` (n, g, 2) of the field
     a + c (-(y - y0), x - x0) (x0: centroid) whose tangential component on edge k is gam[:, k]."""
     x0 = xl.mean(axis=1)
     A = np.zeros((xl.shape[0], 3, 3))
-    for k, ((i, _), (_, s, _)) in enumerate(zip(_EDGES, _edges(xl))):
+    for k, ((i, _), (_, s, _)) in enumerate(zip(_EDGES, edges)):
         p = xl[:, i] - x0
         A[:, k] = np.stack([s[:, 0], s[:, 1], p[:, 0] * s[:, 1] - p[:, 1] * s[:, 0]], axis=1)
     coef = np.linalg.solve(A, gam)  # (n, 3, 9): a_x, a_y, c
@@ -192,7 +192,8 @@ def local_matrices(xl: np.ndarray, prop, sec=None):
     J = np.stack([xl[:, 1] - xl[:, 0], xl[:, 2] - xl[:, 0]], axis=1)  # J[k, i] = d x_i / d xi_k
     area = 0.5 * (J[:, 0, 0] * J[:, 1, 1] - J[:, 0, 1] * J[:, 1, 0])
     invJ = np.linalg.inv(J)
-    U, Bt, gam = _fields(xl, _shear_parameters(xl, sec))
+    edges = _edges(xl)
+    U, Bt, gam = _fields(xl, edges, _shear_parameters(edges, sec))
 
     Bm = np.zeros((n, 4, 3, 9))  # 3 Gauss points of membrane strains, then the drilling row
     Bb = np.zeros((n, 3, 5, 9))  # curvatures, then the transverse shears
@@ -201,7 +202,7 @@ def local_matrices(xl: np.ndarray, prop, sec=None):
         Bm[:, g] = _strain_rows(dNx, U)
         Bb[:, g, :3] = _strain_rows(dNx, Bt)
     points = xl[:, :1] + np.einsum("gk,nki->ngi", _GP, J)
-    Bb[:, :, 3:] = _shear_rows(xl, gam, points)
+    Bb[:, :, 3:] = _shear_rows(xl, edges, gam, points)
     gx, gy = _gradients(np.einsum("nik,kI->niI", invJ, _quadratic(1 / 3, 1 / 3)), U)
     Bm[:, 3, 0] = -0.5 * (gx[:, 1] - gy[:, 0])  # theta_z - (v,x - u,y) / 2 at the centroid
     Bm[:, 3, 0, 2::3] += 1.0 / 3.0
